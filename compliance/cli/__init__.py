@@ -1,0 +1,80 @@
+"""govcheck command line: a thin dispatcher.
+
+Each sub-command lives in its own module under ``compliance.cli`` with two functions,
+``register(subparsers)`` and ``run(args) -> int``. Exit codes: 0 pass, 1 a requirement
+failed (or a gate tripped), 2 invalid input or a solver failure.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from ..errors import GovcheckError
+
+# command name -> module; the order is the order shown by --help
+_COMMANDS = (
+    ("plants", "plants"),
+    ("simulate", "simulate"),
+    ("reproduce", "reproduce"),
+    ("check", "check"),
+    ("gate", "gate"),
+    ("report", "report"),
+    ("linear", "linear"),
+    ("validate", "validate"),
+    ("characterise", "characterise"),
+    ("diagnose", "diagnose"),
+    ("diagnose-benchmark", "diagnose_benchmark"),
+)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """Build the argument parser with every available sub-command."""
+    from .. import __version__
+
+    parser = argparse.ArgumentParser(
+        prog="govcheck",
+        description=(
+            "Acceptance harness for pneumatic gate servo-positioners of hydro-turbine speed "
+            "governors: simulate, check against IEC 61362 / IEEE 125 requirement files, "
+            "linearise, validate against recordings and diagnose missing physics."
+        ),
+        epilog="Exit codes: 0 all pass, 1 a requirement failed, 2 invalid input.",
+    )
+    parser.add_argument("--version", action="version", version=f"govcheck {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    handlers = {}
+    for name, module in _COMMANDS:
+        try:
+            mod = importlib.import_module(f"{__name__}.{module}")
+        except ModuleNotFoundError as exc:
+            if exc.name == f"{__name__}.{module}":
+                continue  # command not built yet
+            raise
+        p = mod.register(sub)
+        p.set_defaults(_run=mod.run)
+        handlers[name] = mod
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``govcheck`` console script."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "command", None):
+        parser.print_help()
+        return 2
+    try:
+        code = args._run(args)
+    except GovcheckError as exc:
+        print(f"govcheck {args.command}: error: {exc}", file=sys.stderr)
+        return exc.exit_code
+    except KeyboardInterrupt:
+        print("govcheck: interrupted", file=sys.stderr)
+        return 130
+    return int(code or 0)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,65 @@
+"""Controller pieces for plant A: dead-zone compensation, PID step, position filter, saturation."""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def dead_zone_compensation(u_d, dz_pos, dz_neg, slope_pos, slope_neg, width):
+    """Smoothed inverse of the valve dead zone, seed 000 eq. (3) as decoded in reference-plant.md [V].
+
+    Parameters
+    ----------
+    u_d : float
+        Demanded command without dead zone (PID output) [V].
+    dz_pos, dz_neg : float
+        Dead-zone edges zmd and |zme| assumed by the compensator [V].
+    slope_pos, slope_neg : float
+        md and me [-].
+    width : float
+        lc, the width of the linear smoothing about zero [V]; 0 gives the plain inverse.
+    """
+    if u_d >= width:
+        return u_d / slope_pos + dz_pos
+    if u_d <= -width:
+        return u_d / slope_neg - abs(dz_neg)
+    if u_d >= 0.0:
+        return (dz_pos + width / slope_pos) / width * u_d
+    return (abs(dz_neg) + width / slope_neg) / width * u_d
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def saturate(u, limit):
+    """Clip a command to +/- limit [V]."""
+    if u > limit:
+        return limit
+    if u < -limit:
+        return -limit
+    return u
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def first_order_filter_gain(cutoff_hz, sample_time):
+    """Gain alpha of the discrete first-order low-pass y += alpha*(u - y) (exact ZOH discretisation)."""
+    if cutoff_hz <= 0.0:
+        return 1.0
+    return 1.0 - math.exp(-2.0 * math.pi * cutoff_hz * sample_time)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def pid_step(error, filtered_rate, integral, kp, ki, kd, sample_time):
+    """One sample of the position PID with derivative on the filtered measurement [V].
+
+    u_d = K_P*e + K_I*integral(e) - K_D*d(x_f)/dt (seed 000 section 3 eq. 8, lost in the text; the
+    derivative acts on the filtered measured position so a set-point step does not kick).
+
+    Returns
+    -------
+    tuple
+        (u_d [V], updated integral [m*s]).
+    """
+    integral = integral + error * sample_time
+    return kp * error + ki * integral - kd * filtered_rate, integral

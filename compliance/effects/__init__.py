@@ -1,0 +1,15 @@
+"""Declared optional physics: one declaration read by the simulator, linearisation, diagnosis and report.
+
+Each effect has a name, a one-line physical meaning, parameters with SI units, defaults and
+bounds, the states it adds, and the signature it leaves in recorded data. An effect is
+switched on in a configuration with an ``[effects.NAME]`` table.
+"""
+
+from __future__ import annotations
+
+from .base import Effect, Param
+from .catalogue import ALL_EFFECTS
+
+EFFECTS: dict[str, Effect] = {e.name: e for e in ALL_EFFECTS}
+
+__all__ = ["EFFECTS", "Effect", "Param"]

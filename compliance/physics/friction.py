@@ -1,0 +1,83 @@
+"""Seal friction: the Stribeck map, the variable-viscous model with a stick phase, LuGre."""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def stribeck_magnitude(speed, static_force, coulomb_force, stribeck_velocity):
+    """Velocity-weakening part of the friction map g(|v|) = F_C + (F_S - F_C)*exp(-|v|/v_s) [N].
+
+    reference-plant.md, friction (assumed map for seed 000 fig. 3).
+    """
+    return coulomb_force + (static_force - coulomb_force) * math.exp(-abs(speed) / stribeck_velocity)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def stribeck_map(velocity, static_force, coulomb_force, stribeck_velocity, viscous):
+    """Friction-velocity map F(v) = sign(v)*g(|v|) + b*v [N] (reference-plant.md, seed 000 eq. 7 map)."""
+    if velocity == 0.0:
+        return 0.0
+    s = 1.0 if velocity > 0.0 else -1.0
+    return s * stribeck_magnitude(velocity, static_force, coulomb_force, stribeck_velocity) + viscous * velocity
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def variable_viscous_friction(velocity, applied_force, static_force, coulomb_force, stribeck_velocity, viscous, limit_velocity):
+    """Variable viscous friction coefficient model with a stick phase [N] (seed 000 eq. 7).
+
+    Above the limit speed F = f_V(v)*v with f_V(v) = F(v)/v from the friction map; below
+    it the body sticks: friction balances the applied force up to the static force
+    (Karnopp-type stick band, the form Gomes & Rosa 2003 use for the "stick" mode).
+
+    Parameters
+    ----------
+    velocity : float
+        Sliding velocity [m/s].
+    applied_force : float
+        Net non-friction force on the body [N] (used only in the stick band).
+    static_force, coulomb_force : float
+        F_S and F_C [N].
+    stribeck_velocity : float
+        v_s [m/s].
+    viscous : float
+        b [N*s/m].
+    limit_velocity : float
+        Limit speed below which the body is considered stuck [m/s].
+    """
+    if abs(velocity) < limit_velocity:
+        if applied_force > static_force:
+            return static_force
+        if applied_force < -static_force:
+            return -static_force
+        return applied_force
+    return stribeck_map(velocity, static_force, coulomb_force, stribeck_velocity, viscous)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def lugre_bristle_rate(velocity, bristle, stiffness, static_force, coulomb_force, stribeck_velocity):
+    """LuGre bristle deflection rate dz/dt = v - sigma0*|v|*z/g(v) [m/s] (Canudas de Wit et al. 1995)."""
+    g = stribeck_magnitude(velocity, static_force, coulomb_force, stribeck_velocity)
+    return velocity - stiffness * abs(velocity) * bristle / g
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def lugre_force(velocity, bristle, bristle_rate, stiffness, damping, viscous):
+    """LuGre friction force F = sigma0*z + sigma1*dz/dt + sigma2*v [N] (Canudas de Wit et al. 1995).
+
+    Its steady state is the Stribeck map of ``stribeck_map`` with sigma2 = b.
+    """
+    return stiffness * bristle + damping * bristle_rate + viscous * velocity
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def pressure_friction_increment(coefficient, mean_chamber_pressure, atmosphere):
+    """Rise of seal friction with chamber pressure, dF = k_p*(p_mean - p_atm) [N].
+
+    Seal friction grows roughly linearly with the pressure behind the seal lip
+    (Belforte et al. 2003, "Pneumatic cylinder seal friction"; Zillen data in real-data/).
+    """
+    return coefficient * max(mean_chamber_pressure - atmosphere, 0.0)

@@ -1,0 +1,75 @@
+"""Piston forces, cylinder geometry and end stops."""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+
+def circle_area(diameter: float) -> float:
+    """Area of a circle [m^2] from its diameter [m]."""
+    return math.pi * diameter * diameter / 4.0
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def tandem_volumes(x, stroke, dead_volume, area_cap, area_rod):
+    """Side volumes of the tandem pair 2A1 + 2A2 [m^3] (reference-plant.md, decoded eqs. 4-5).
+
+    V_A = 2*V0 + (A_cap + A_rod)*x and V_B = 2*V0 + (A_cap + A_rod)*(L - x).
+    """
+    at = area_cap + area_rod
+    return 2.0 * dead_volume + at * x, 2.0 * dead_volume + at * (stroke - x)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def tandem_force(p_a, p_b, area_cap, area_rod):
+    """Net pneumatic force of the tandem pair F_p = (p_A - p_B)*(A_cap + A_rod) [N] (decoded seed 000 eq. 6)."""
+    return (p_a - p_b) * (area_cap + area_rod)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def single_volumes(x, stroke, dead_volume, area_cap, area_rod):
+    """Chamber volumes of one double-acting cylinder [m^3] (seed 001 fig. 1: V_a = V0 + A1*x, V_b = V0 + A2*(L - x))."""
+    return dead_volume + area_cap * x, dead_volume + area_rod * (stroke - x)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def single_force(p_a, p_b, area_cap, area_rod, p_atm):
+    """Net pneumatic force of one single-rod cylinder [N] (seed 001 eq. 9, with the rod side vented to atmosphere)."""
+    return p_a * area_cap - p_b * area_rod - p_atm * (area_cap - area_rod)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def end_stop_force(x, v, stroke, stiffness, damping):
+    """Contact force of the end stops at x = 0 and x = L [N] (stiff spring-damper, one-sided).
+
+    Positive pushes towards the stroke; zero inside it. The damping only pushes, never pulls.
+    """
+    if x < 0.0:
+        f = -stiffness * x - damping * v
+        return f if f > 0.0 else 0.0
+    if x > stroke:
+        f = -stiffness * (x - stroke) - damping * v
+        return f if f < 0.0 else 0.0
+    return 0.0
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def interp_curve(x, xs, ys):
+    """Piecewise-linear interpolation held flat outside the samples (load curve over the stroke)."""
+    n = xs.shape[0]
+    if x <= xs[0]:
+        return ys[0]
+    if x >= xs[n - 1]:
+        return ys[n - 1]
+    lo = 0
+    hi = n - 1
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if xs[mid] <= x:
+            lo = mid
+        else:
+            hi = mid
+    w = (x - xs[lo]) / (xs[hi] - xs[lo])
+    return ys[lo] + w * (ys[hi] - ys[lo])

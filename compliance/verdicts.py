@@ -1,0 +1,142 @@
+"""Verdicts: a measured value against a limit -> value, limit, margin, pass/fail.
+
+Conventions (docs/metrics.md, "Verdicts"):
+- margin is positive inside the limit and negative outside, in the metric's SI unit;
+  for ``within`` it is the distance to the nearer edge;
+- margin % = margin / |binding limit| x 100 (the binding limit is the nearer edge for
+  ``within``); None when the binding limit is 0;
+- a value equal to the limit within a relative 1e-9 (unit conversion round-off, e.g. 1.6 mm
+  against 1 % of a 0.160 m stroke) counts as exactly at the limit: ``<=``/``>=``/``within``
+  pass, ``<``/``>`` fail.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+COMPARATORS = ("<=", "<", ">=", ">", "within")
+EQUAL_REL_TOL = 1e-9  # round-off of unit conversions; far below any measurement resolution
+
+PASS, FAIL, NOT_EVALUATED, OPEN, DISABLED = "pass", "fail", "not_evaluated", "open", "disabled"
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """A value judged against a limit (all SI)."""
+
+    value: float | None
+    comparator: str
+    limit: tuple[float, ...]
+    margin: float | None
+    margin_pct: float | None
+    status: str
+    reason: str | None = None
+
+    def as_dict(self) -> dict:
+        """Plain-JSON form."""
+        return {
+            "value": self.value,
+            "comparator": self.comparator,
+            "limit": list(self.limit),
+            "margin": self.margin,
+            "margin_pct": self.margin_pct,
+            "status": self.status,
+            "reason": self.reason,
+        }
+
+
+def _equal(a: float, b: float) -> bool:
+    return math.isclose(a, b, rel_tol=EQUAL_REL_TOL, abs_tol=0.0) or a == b
+
+
+def evaluate(value: float | None, comparator: str, limit, reason: str | None = None) -> Verdict:
+    """Judge ``value`` against ``limit``.
+
+    Parameters
+    ----------
+    value : float or None
+        Measured value in SI; None = could not be measured (``reason`` says why).
+    comparator : {"<=", "<", ">=", ">", "within"}
+    limit : float or tuple of float
+        SI limit; a (low, high) pair for ``within``.
+    reason : str, optional
+        Why the value is missing.
+
+    Returns
+    -------
+    Verdict
+    """
+    if comparator not in COMPARATORS:
+        raise ValueError(f"unknown comparator {comparator!r}")
+    lim = tuple(float(v) for v in (limit if isinstance(limit, (tuple, list)) else (limit,)))
+    if comparator == "within":
+        if len(lim) != 2 or lim[0] > lim[1]:
+            raise ValueError("'within' needs (low, high) with low <= high")
+    elif len(lim) != 1:
+        raise ValueError(f"comparator {comparator!r} takes one limit")
+    if value is None or not math.isfinite(value):
+        return Verdict(None, comparator, lim, None, None, NOT_EVALUATED, reason or "no value")
+    v = float(value)
+    if comparator in ("<=", "<"):
+        binding = lim[0]
+        at = _equal(v, binding)
+        margin = 0.0 if at else binding - v
+        ok = (margin >= 0.0) if comparator == "<=" else (margin > 0.0 and not at)
+    elif comparator in (">=", ">"):
+        binding = lim[0]
+        at = _equal(v, binding)
+        margin = 0.0 if at else v - binding
+        ok = (margin >= 0.0) if comparator == ">=" else (margin > 0.0 and not at)
+    else:
+        lo, hi = lim
+        m_lo = 0.0 if _equal(v, lo) else v - lo
+        m_hi = 0.0 if _equal(v, hi) else hi - v
+        margin, binding = (m_lo, lo) if m_lo <= m_hi else (m_hi, hi)
+        ok = margin >= 0.0
+    pct = None if binding == 0.0 else 100.0 * margin / abs(binding)
+    return Verdict(v, comparator, lim, margin, pct, PASS if ok else FAIL, None)
+
+
+def _badness(v: Verdict) -> tuple:
+    """Sort key: fails first, then the smallest margin (in % when known)."""
+    m = v.margin_pct if v.margin_pct is not None else v.margin
+    return (0 if v.status == FAIL else 1, m if m is not None else math.inf)
+
+
+def worst_index(verdicts) -> int | None:
+    """Index of the worst evaluated verdict (a fail with the most negative margin, else the
+    smallest margin); None if none was evaluated."""
+    ev = [(i, v) for i, v in enumerate(verdicts) if v.status in (PASS, FAIL)]
+    if not ev:
+        return None
+    return min(ev, key=lambda iv: _badness(iv[1]))[0]
+
+
+def requirement_status(verdicts) -> str:
+    """Status of one requirement from its rows: fail if any row fails; pass if every row was
+    evaluated and passed; not_evaluated if any row could not be evaluated and none failed."""
+    st = [v.status for v in verdicts]
+    if not st:
+        return NOT_EVALUATED
+    if FAIL in st:
+        return FAIL
+    if NOT_EVALUATED in st:
+        return NOT_EVALUATED
+    return PASS
+
+
+def overall_status(items) -> str:
+    """Overall verdict from (severity, status) pairs.
+
+    ``fail`` if a mandatory requirement fails; ``incomplete`` if none fails but a mandatory
+    requirement could not be evaluated; ``pass`` otherwise. Advisory requirements and
+    requirements whose limit is still open (a purchaser's data-sheet value nobody set) are
+    reported but do not decide the verdict.
+    """
+    mand = [s for sev, s in items if sev == "mandatory"]
+    if FAIL in mand:
+        return "fail"
+    if NOT_EVALUATED in mand:
+        return "incomplete"
+    return "pass"
