@@ -1,0 +1,20 @@
+"""``govcheck plants``: list the reference plant configurations shipped with govcheck."""
+
+from __future__ import annotations
+
+from ..config import load_plant, reference_plants
+
+
+def register(sub):
+    p = sub.add_parser("plants", help="list the reference plant configurations",
+                       description="List the reference configurations usable as --plant NAME or by path.")
+    return p
+
+
+def run(args) -> int:
+    for name in reference_plants():
+        cfg = load_plant(name)
+        arr = cfg.options["cylinder.arrangement"]
+        print(f"{name:10s} {arr:7s} stroke {cfg.p('cylinder.stroke')*1e3:.0f} mm, bore {cfg.p('cylinder.piston_diameter')*1e3:.0f} mm, "
+              f"supply {cfg.p('air.supply_pressure')/1e5:.2f} bar abs  - {cfg.description}")
+    return 0

@@ -1,0 +1,35 @@
+"""``govcheck reproduce plant-a``: the paper's tests beside the simulated figures."""
+
+from __future__ import annotations
+
+import json
+
+from ..config import load_plant
+from ..errors import InputError
+
+
+def register(sub):
+    p = sub.add_parser("reproduce", help="run the seed paper's tests and compare with its measured figures",
+                       description="Run every test of the reference sheet's table 'Results the model must be compared with' "
+                                   "and print simulated settling time and steady error beside the paper's, with the metric "
+                                   "definitions; flagged rows name the assumed parameter that drives the difference.")
+    p.add_argument("plant", help="reference plant name or configuration file (only plant-a has a paper table)")
+    p.add_argument("--no-explain", action="store_true", help="skip the sensitivity runs that name the driving parameter")
+    p.add_argument("--json", help="also write the comparison as JSON")
+    return p
+
+
+def run(args) -> int:
+    from ..reproduce import compare, format_table
+
+    cfg = load_plant(args.plant)
+    if cfg.options["cylinder.arrangement"] != "tandem":
+        raise InputError(f"{args.plant}: the paper comparison exists for the tandem gate servo (plant A) only")
+    comp = compare(cfg, explain=not args.no_explain)
+    print(format_table(comp))
+    if args.json:
+        from ..results_io import write_json_atomic
+
+        write_json_atomic(args.json, {"plant": cfg.name, "stall_error_m": comp.stall_error, "notes": comp.notes,
+                                      "rows": [r.__dict__ for r in comp.rows]})
+    return 0
