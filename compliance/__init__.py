@@ -1,5 +1,35 @@
 """govcheck: acceptance harness for pneumatic gate servo-positioners (package ``compliance``)."""
 
+import hashlib as _hashlib
+import os as _os
+from pathlib import Path as _Path
+
 __version__ = "0.1.0"
+
+
+def _numba_cache_dir() -> str:
+    """A numba cache folder keyed by the compiled sources.
+
+    numba invalidates a cached function only when its own file changes, not when a kernel it
+    inlines from another module does; keying the folder by every compiled source avoids ever
+    running a stale core.
+    """
+    here = _Path(__file__).resolve().parent
+    digest = _hashlib.sha256()
+    for sub in ("physics", "tracking"):
+        for f in sorted((here / sub).glob("*.py")) if (here / sub).is_dir() else ():
+            digest.update(f.read_bytes())
+    for name in ("plant.py", "simulate.py", "control.py", "layout.py"):
+        f = here / name
+        if f.is_file():
+            digest.update(f.read_bytes())
+    return str(here / "__pycache__" / f"numba-{digest.hexdigest()[:16]}")
+
+
+if "NUMBA_CACHE_DIR" not in _os.environ:
+    try:
+        _os.environ["NUMBA_CACHE_DIR"] = _numba_cache_dir()
+    except OSError:  # read-only install: numba falls back to its own default
+        pass
 
 __all__ = ["__version__"]
