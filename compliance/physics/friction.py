@@ -81,3 +81,38 @@ def pressure_friction_increment(coefficient, mean_chamber_pressure, atmosphere):
     (Belforte et al. 2003, "Pneumatic cylinder seal friction"; Zillen data in real-data/).
     """
     return coefficient * max(mean_chamber_pressure - atmosphere, 0.0)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def piecewise_stribeck_friction(velocity, applied_force, breakaway_force, low_speed_coefficient, critical_velocity,
+                                high_speed_coefficient, limit_velocity):
+    """Piecewise friction of seed 001 eq. (8) with a stick band [N].
+
+    F_f = sign(v)*(F_j - k_v1*|v|) for |v| < v_d and
+    F_f = sign(v)*(F_j - k_v1*v_d + k_v2*(|v| - v_d)) for |v| >= v_d; below the limit speed the
+    body sticks while |applied| <= F_j (friction balances the applied force).
+
+    Parameters
+    ----------
+    velocity, applied_force : float
+        [m/s], net non-friction force [N].
+    breakaway_force : float
+        F_j [N].
+    low_speed_coefficient, high_speed_coefficient : float
+        k_v1, k_v2 [N*s/m].
+    critical_velocity : float
+        v_d [m/s].
+    limit_velocity : float
+        Stick band [m/s].
+    """
+    if abs(velocity) < limit_velocity:
+        if applied_force > breakaway_force:
+            return breakaway_force
+        if applied_force < -breakaway_force:
+            return -breakaway_force
+        return applied_force
+    s = 1.0 if velocity > 0.0 else -1.0
+    speed = abs(velocity)
+    if speed < critical_velocity:
+        return s * (breakaway_force - low_speed_coefficient * speed)
+    return s * (breakaway_force - low_speed_coefficient * critical_velocity + high_speed_coefficient * (speed - critical_velocity))
