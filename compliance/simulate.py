@@ -124,9 +124,11 @@ def _interp_uniform(hist, h, t):
 
 
 @njit(cache=True, error_model="numpy")
-def _rk4_step(y, P, u, lx, ly, h, k1, k2, k3, k4, tmp, aux):
+def _rk4_step(y, P, u, lx, ly, h, k1, k2, k3, k4, tmp, aux, k1_ready=False):
+    """One classical RK4 step in place; ``k1_ready`` reuses a slope already evaluated at (y, u)."""
     n = y.shape[0]
-    plant_rhs(y, P, u, lx, ly, k1, aux)
+    if not k1_ready:
+        plant_rhs(y, P, u, lx, ly, k1, aux)
     for i in range(n):
         tmp[i] = y[i] + 0.5 * h * k1[i]
     plant_rhs(tmp, P, u, lx, ly, k2, aux)
@@ -178,7 +180,6 @@ def simulate_core(P, y0, ref, cmd, closed_loop, pos_noise, pos_quantum, lx, ly, 
     k3 = np.zeros(N_STATES)
     k4 = np.zeros(N_STATES)
     tmp = np.zeros(N_STATES)
-    dy = np.zeros(N_STATES)
     aux = np.zeros(N_AUX)
     u_hist = np.zeros(n_samples + 1)
     sensor = P[P_SL_ON] != 0.0
@@ -223,7 +224,7 @@ def simulate_core(P, y0, ref, cmd, closed_loop, pos_noise, pos_quantum, lx, ly, 
         u_hist[k] = u
         # --- record the sample
         u_now = u if valve_delay <= 0.0 else _zoh_average(u_hist, ts, k * ts - valve_delay, k * ts - valve_delay)
-        plant_rhs(y, P, u_now, lx, ly, dy, aux)
+        plant_rhs(y, P, u_now, lx, ly, k1, aux)  # also the first RK4 slope when there is no valve delay
         out[k, O_T] = k * ts
         out[k, O_XM] = xm
         out[k, O_REF] = ref[k]
@@ -250,7 +251,7 @@ def simulate_core(P, y0, ref, cmd, closed_loop, pos_noise, pos_quantum, lx, ly, 
                 u_step = _zoh_average(u_hist, ts, t0 - valve_delay, t0 + h - valve_delay)
             else:
                 u_step = u
-            _rk4_step(y, P, u_step, lx, ly, h, k1, k2, k3, k4, tmp, aux)
+            _rk4_step(y, P, u_step, lx, ly, h, k1, k2, k3, k4, tmp, aux, j == 0 and valve_delay <= 0.0)
             step_index += 1
             if sensor:
                 x_hist[step_index] = y[S_X]

@@ -111,7 +111,7 @@ LINKAGE_COMPLIANCE = Effect(
     name="linkage_compliance",
     meaning="the two cylinders are coupled through a flexible linkage; the sensor sits on 2A1",
     params=(
-        Param("stiffness", "N/m", "linkage stiffness between the cylinders", 2e6, (1e4, 1e9), True),
+        Param("stiffness", "N/m", "linkage stiffness between the cylinders", 2e6, (1e4, 5e7), True),
         Param("damping", "N*s/m", "linkage damping", 2000.0, (0.0, 1e6)),
     ),
     states=("position_2", "velocity_2"),
