@@ -147,8 +147,11 @@ def _driver(cfg: PlantConfig, case: StepCase, idx: int, row: Row) -> str:
             gain = abs(base - row.paper) - abs(got - row.paper)
             if best is None or gain > best[0]:
                 best = (gain, key, sign, got)
-    if best is None or best[0] <= 0:
-        return "no assumed parameter moves it towards the paper by +/-20 %"
+    if best is None or best[0] < 0.1 * abs(base - row.paper):
+        if row.metric == "steady error" and base is not None and base >= 0.9 * stall_error(cfg):
+            return (f"no assumed parameter moves it by +/-20 %: the valve shuts inside the stall band "
+                    f"{stall_error(cfg) * 1e3:.2f} mm set by the paper's lc and K_P (see note)")
+        return "no assumed parameter moves it meaningfully towards the paper by +/-20 %"
     scale = 1e3 if row.unit == "mm" else 1.0
     return (f"{best[1]} {'+' if best[2] > 0 else '-'}{SENSITIVITY_STEP:.0%} moves it to "
             f"{best[3] * scale:.3g} {row.unit}")
