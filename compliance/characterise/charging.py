@@ -22,7 +22,7 @@ from scipy.integrate import solve_ivp
 
 from ..errors import InputError
 from ..units import ATMOSPHERE_PA
-from .derivative import odd_window, smoothed_derivative
+from .derivative import noise_std, odd_window, savgol_weights, smoothed_derivative
 from .flow_law import GAMMA, LAWS, R_AIR, T0, FlowFit, rank_flow_laws
 
 DERIVATIVE_ORDER = 3  # cubic Savitzky-Golay: same centre-point noise as quadratic, smaller bias
@@ -54,12 +54,18 @@ def mass_flow_from_pressure(time, pressure, volume, temperature, *, mode="charge
         the temperature of the gas that flows [K].
     """
     p, dpdt = smoothed_derivative(time, pressure, window, DERIVATIVE_ORDER)
+    factor, t_gas = _flow_factor(p, volume, temperature, mode, gamma, r_gas)
+    return p, factor * dpdt, t_gas
+
+
+def _flow_factor(p, volume, temperature, mode, gamma=GAMMA, r_gas=R_AIR):
+    """q = factor * dp/dt for the rigid volume; returns (factor [kg/Pa], gas temperature [K])."""
     if mode == "charge":
         t_gas = np.full_like(p, float(temperature))
-        return p, volume / (gamma * r_gas * t_gas) * dpdt, t_gas  # seed 001 eq. (3), dV/dt = 0
+        return volume / (gamma * r_gas * t_gas), t_gas  # seed 001 eq. (3) with dV/dt = 0
     if mode == "discharge":
         t_gas = temperature * (np.clip(p, 1.0, None) / p[0]) ** ((gamma - 1.0) / gamma)  # isentropic expansion
-        return p, -volume / (gamma * r_gas * t_gas) * dpdt, t_gas  # energy balance, rigid volume
+        return -volume / (gamma * r_gas * t_gas), t_gas  # energy balance of the rigid volume (Beater 2007)
     raise InputError(f"mode must be 'charge' or 'discharge', got {mode!r}")
 
 
@@ -74,6 +80,7 @@ class ValveCharacterisation:
     window: int
     derivative: str
     fits: tuple[FlowFit, ...]
+    pressure_noise: float
     time: np.ndarray
     p_up: np.ndarray
     p_down: np.ndarray
@@ -95,6 +102,7 @@ class ValveCharacterisation:
             "derivative": self.derivative,
             "window_samples": self.window,
             "samples_used": int(self.time.size),
+            "pressure_noise_Pa": self.pressure_noise,
             "time_range_s": [float(self.time[0]), float(self.time[-1])],
             "ranking": [
                 {"law": f.law, "equation": f.equation, "params": f.params, "stderr": f.stderr, "units": f.units,
@@ -167,7 +175,18 @@ def characterise_valve(
     if window is None:
         transient = np.count_nonzero((change > 0.05 * total) & (change < 0.95 * total))
         window = odd_window(max(7, 0.04 * transient), DERIVATIVE_ORDER)
-    p, q, t_gas = mass_flow_from_pressure(t, p_raw, volume, temperature, mode=mode, window=window)
+    if mode not in ("charge", "discharge"):
+        raise InputError(f"{source}: mode must be 'auto', 'charge' or 'discharge', got {mode!r}")
+    if window % 2 == 0 or window <= DERIVATIVE_ORDER + 1 or t.size < 2 * window:
+        raise InputError(
+            f"{source}: derivative window {window} samples must be odd, > {DERIVATIVE_ORDER + 1} and at most half "
+            f"the recording ({t.size} samples)"
+        )
+    idx, w_value, w_deriv = savgol_weights(t, window, DERIVATIVE_ORDER)
+    p = np.sum(w_value * p_raw[idx], axis=1)
+    factor, t_gas = _flow_factor(p, volume, temperature, mode)
+    q = factor * np.sum(w_deriv * p_raw[idx], axis=1)
+    sigma_p = noise_std(t, p_raw, window, DERIVATIVE_ORDER, weights=(idx, w_value, w_deriv))
     if mode == "charge":
         if "supply_pressure" in frame.columns:
             p_up = frame["supply_pressure"].to_numpy(dtype=float)
@@ -189,11 +208,14 @@ def characterise_valve(
             f"{source}: only {max(used.stop - used.start, 0)} samples between the valve opening and the pressure ratio "
             f"{max_ratio}; record faster or a larger volume"
         )
-    fits = rank_flow_laws(p_up[used], p_down[used], t_up[used], q[used], laws, correlation_length=float(window))
+    flow_noise = (idx[used], factor[used, None] * w_deriv[used], sigma_p)
+    fits = rank_flow_laws(
+        p_up[used], p_down[used], t_up[used], q[used], laws, correlation_length=float(window), flow_noise=flow_noise
+    )
     return ValveCharacterisation(
         source=source, mode=mode, volume=float(volume), temperature=float(temperature), window=int(window),
         derivative=f"Savitzky-Golay, cubic, {window} samples, on the sample times",
-        fits=tuple(fits), time=t[used], p_up=p_up[used], p_down=p_down[used], t_up=t_up[used], mass_flow=q[used],
+        fits=tuple(fits), pressure_noise=sigma_p, time=t[used], p_up=p_up[used], p_down=p_down[used], t_up=t_up[used], mass_flow=q[used],
     )
 
 
@@ -249,8 +271,18 @@ def synthetic_charging(
         q = fit.predict(p, exhaust_pressure, t_gas)[0]
         return [-GAMMA * R_AIR * t_gas * q / volume]
 
+    target = supply_pressure if mode == "charge" else exhaust_pressure
+
+    def settled(t, y):  # laws with dq/dp -> inf at dp = 0 reach equilibrium in finite time
+        return abs(target - y[0]) - 1.0
+
+    settled.terminal = True
     n = int(round(duration / sample_time)) + 1
     t = np.arange(n) * sample_time
-    sol = solve_ivp(rhs, (0.0, t[-1]), [initial_pressure], t_eval=t, rtol=1e-10, atol=1e-3, max_step=sample_time * 10)
-    p = sol.y[0] + np.random.default_rng(seed).normal(0.0, noise_std, n) if noise_std > 0 else sol.y[0]
+    sol = solve_ivp(rhs, (0.0, t[-1]), [initial_pressure], t_eval=t, rtol=1e-10, atol=1e-3, max_step=sample_time * 10,
+                    events=settled)
+    p = np.full(n, target, dtype=float)  # within 1 Pa of equilibrium once settled
+    p[: sol.y.shape[1]] = sol.y[0]
+    if noise_std > 0:
+        p = p + np.random.default_rng(seed).normal(0.0, noise_std, n)
     return pd.DataFrame({"time": t, "pressure_a": p, "supply_pressure": np.full(n, float(supply_pressure))})

@@ -155,7 +155,7 @@ def _solve(law: _Law, shape, pu, pd, tu, q):
     return coefs, float(resid @ resid), basis
 
 
-def fit_flow_law(name: str, p_up, p_down, t_up, mass_flow, *, correlation_length: float = 1.0) -> FlowFit:
+def fit_flow_law(name: str, p_up, p_down, t_up, mass_flow, *, correlation_length: float = 1.0, flow_noise=None) -> FlowFit:
     """Fit one flow law by least squares on mass flow.
 
     Parameters
@@ -169,9 +169,14 @@ def fit_flow_law(name: str, p_up, p_down, t_up, mass_flow, *, correlation_length
     mass_flow : array_like
         Measured mass flow [kg/s].
     correlation_length : float
-        Samples per independent observation (the derivative window): the residuals of a
-        smoothed derivative are correlated over it, so standard errors are inflated by its
-        square root and AIC counts ``n / correlation_length`` observations.
+        Samples per independent observation (the derivative window): AIC counts
+        ``n / correlation_length`` observations, because a smoothed derivative's residuals
+        are not independent from sample to sample.
+    flow_noise : (idx, weights, sigma), optional
+        The mass-flow noise as a linear map of white sensor noise of std ``sigma``:
+        noise_i = sum_j weights[i, j] * e[idx[i, j]]. If given, standard errors are this noise
+        propagated through the (linearised) fit; otherwise the ordinary least-squares
+        estimate s^2 (J^T J)^-1, which assumes independent residuals.
 
     Returns
     -------
@@ -201,12 +206,7 @@ def fit_flow_law(name: str, p_up, p_down, t_up, mass_flow, *, correlation_length
         h = 1e-5 * (law.shape[3] - law.shape[2])
         dq = (law.basis(shape + h, pu, pd, tu) - law.basis(shape - h, pu, pd, tu)) @ coefs / (2 * h)
         jac = np.column_stack((basis, dq))
-    s2 = rss / (n - k)
-    try:
-        cov = np.linalg.inv(jac.T @ jac) * s2 * correlation_length
-        se = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-    except np.linalg.LinAlgError:
-        se = np.full(k, np.inf)
+    se = _stderr(jac, rss, flow_noise)
     names = [p for p, _ in law.linear] + ([law.shape[0]] if law.shape else [])
     units = dict(law.linear + ((law.shape[:2],) if law.shape else ()))
     values = list(map(float, coefs)) + ([shape] if law.shape else [])
@@ -218,7 +218,24 @@ def fit_flow_law(name: str, p_up, p_down, t_up, mass_flow, *, correlation_length
     )
 
 
-def rank_flow_laws(p_up, p_down, t_up, mass_flow, laws=tuple(LAWS), *, correlation_length: float = 1.0):
+def _stderr(jac: np.ndarray, rss: float, flow_noise) -> np.ndarray:
+    n, k = jac.shape
+    try:
+        pinv = np.linalg.solve(jac.T @ jac, jac.T)  # (k, n): linearised parameter sensitivity
+    except np.linalg.LinAlgError:
+        return np.full(k, np.inf)
+    if flow_noise is None:
+        return np.sqrt(np.clip(np.sum(pinv**2, axis=1) * rss / (n - k), 0.0, None))
+    idx, weights, sigma = flow_noise
+    size = int(idx.max()) + 1
+    sens = np.array([np.bincount(idx.ravel(), (pinv[r][:, None] * weights).ravel(), minlength=size) for r in range(k)])
+    return sigma * np.sqrt(np.sum(sens**2, axis=1))  # linear propagation of white sensor noise
+
+
+def rank_flow_laws(p_up, p_down, t_up, mass_flow, laws=tuple(LAWS), *, correlation_length: float = 1.0, flow_noise=None):
     """Fit every law in ``laws`` and return the fits sorted by AIC (best first)."""
-    fits = [fit_flow_law(n, p_up, p_down, t_up, mass_flow, correlation_length=correlation_length) for n in laws]
+    fits = [
+        fit_flow_law(n, p_up, p_down, t_up, mass_flow, correlation_length=correlation_length, flow_noise=flow_noise)
+        for n in laws
+    ]
     return sorted(fits, key=lambda f: f.aic)
