@@ -19,6 +19,8 @@ from .errors import InputError
 
 # fraction of the commanded step that defines the time constant (1 - 1/e, first-order response)
 TAU_FRACTION = 1.0 - math.exp(-1.0)
+# default motion threshold for the dead time, fraction of the commanded step
+DETECT_FRACTION = 0.01
 
 
 @dataclass(frozen=True)
@@ -34,26 +36,26 @@ class MetricInfo:
     options: tuple[str, ...] = ()
 
 
-_STEP_OPTS = ("settling_band", "settling_band_abs", "detect", "final_window")
+_SETTLE_OPTS = ("settling_band", "settling_band_abs", "final_window")
 
 METRICS: dict[str, MetricInfo] = {
     m.name: m
     for m in (
-        MetricInfo("dead_time", "s", "s", 1.0, ("steps",), "command step to first detectable motion", _STEP_OPTS),
+        MetricInfo("dead_time", "s", "s", 1.0, ("steps",), "command step to first detectable motion", ("detect",)),
         MetricInfo(
             "time_constant", "s", "s", 1.0, ("steps",),
-            "end of dead time to 63.2 % of the commanded step, steps out of the rate limit only", _STEP_OPTS,
+            "end of dead time to 63.2 % of the commanded step, steps out of the rate limit only", ("detect",),
         ),
-        MetricInfo("rise_time", "s", "s", 1.0, ("steps",), "10 % to 90 % of the actual change", _STEP_OPTS),
-        MetricInfo("settling_time", "s", "s", 1.0, ("steps",), "step to last exit from the settling band", _STEP_OPTS),
-        MetricInfo("overshoot", "", "%", 100.0, ("steps",), "peak beyond the final value, per cent of the change", _STEP_OPTS),
+        MetricInfo("rise_time", "s", "s", 1.0, ("steps",), "10 % to 90 % of the actual change", ("final_window",)),
+        MetricInfo("settling_time", "s", "s", 1.0, ("steps",), "step to last exit from the settling band", _SETTLE_OPTS),
+        MetricInfo("overshoot", "", "%", 100.0, ("steps",), "peak beyond the final value, per cent of the change", ("final_window",)),
         MetricInfo(
             "steady_state_error", "m", "mm", 1e3, ("steps", "hold"),
-            "|reference - mean position| over the final window", _STEP_OPTS,
+            "|reference - mean position| over the final window", ("final_window",),
         ),
         MetricInfo(
             "max_positioning_error", "m", "mm", 1e3, ("steps", "hold"),
-            "max |reference - position| over the final (settled) windows", _STEP_OPTS,
+            "max |reference - position| over the final (settled) windows", ("final_window",),
         ),
         MetricInfo("tracking_rms_error", "m", "mm", 1e3, ("sine",), "RMS of reference - position after the skip"),
         MetricInfo("tracking_max_error", "m", "mm", 1e3, ("sine",), "max |reference - position| after the skip"),
@@ -93,7 +95,7 @@ METRICS: dict[str, MetricInfo] = {
 STEP_OPTION_DEFAULTS = {
     "settling_band": ("", "2 %", "half-width of the settling band, fraction of the actual change (step_info)"),
     "settling_band_abs": ("m", "0 mm", "lower bound on the band half-width (sensor resolution)"),
-    "detect": ("m", "0 mm", "motion threshold for the dead time; 0 = max(2 % of the step, 5 x pre-step noise)"),
+    "detect": ("m", "0 mm", "motion threshold for the dead time; 0 = max(1 % of the step, 5 x pre-step noise)"),
     "final_window": ("s", "0.5 s", "window before the next step over which the settled position is taken"),
 }
 
@@ -245,11 +247,12 @@ def find_steps(time, reference, min_size=5e-5, merge=0.005):
             groups[-1][1] = i + 1
         else:
             groups.append([i, i + 1])
+    # a step is dated by the first sample holding the new value (or the start of a spread step)
+    starts = [float(time[i0 + 1]) if i1 == i0 + 1 else float(time[i0]) for i0, i1 in groups]
     events = []
     for g, (i0, i1) in enumerate(groups):
-        t_end = float(time[groups[g + 1][0]]) if g + 1 < len(groups) else float(time[-1])
-        events.append(StepEvent(float(time[i0 + 1]) if i1 == i0 + 1 else float(time[i0]), t_end,
-                                float(reference[i0]), float(reference[i1])))
+        t_end = starts[g + 1] if g + 1 < len(groups) else float(time[-1]) + (float(time[-1] - time[-2]) if time.size > 1 else 0.0)
+        events.append(StepEvent(starts[g], t_end, float(reference[i0]), float(reference[i1])))
     return events
 
 
@@ -302,8 +305,9 @@ def step_response(
     settling_band_abs : float
         Lower bound on the band half-width [m].
     detect : float
-        Motion threshold for the dead time [m]; 0 = max(2 % of |step|, 5 x the standard
-        deviation of the position over ``pre_window`` before the step).
+        Motion threshold for the dead time [m]; 0 = max(1 % of |step|, 5 x the standard
+        deviation of the position over ``pre_window`` before the step). For a first-order
+        lag the time constant then reads low by tau*ln(1/0.99) = 1 % (docs/metrics.md).
     final_window : float
         Settled position = mean over the last ``final_window`` before ``t_end`` [s].
     pre_window : float
@@ -338,7 +342,7 @@ def step_response(
     vmax = speed_extremes(time, position, event.t_step, event.t_end)[0]
 
     # dead time: first detectable motion in the commanded direction
-    thr = detect if detect > 0 else max(0.02 * abs(dr), 5.0 * noise)
+    thr = detect if detect > 0 else max(DETECT_FRACTION * abs(dr), 5.0 * noise)
     t_move = _crossing(tt, sgn * (xx - x0), thr, 0, +1) if tt.size else None
     dead_time = None if t_move is None else t_move - event.t_step
     if t_move is None:

@@ -148,10 +148,16 @@ _MODEL_FIELDS = {
 }
 
 
+_UNION_TAGS = {"str", "list[str]", "dict[str,str]", "bool", "float", "int"}
+
+
 def _pydantic_message(exc: ValidationError, path: str) -> str:
     err = exc.errors()[0]
-    loc = [str(x) for x in err["loc"]]
+    loc = [str(x) for x in err["loc"] if str(x) not in _UNION_TAGS]
     keypath = ".".join("schema" if x == "schema_" else x for x in loc) or "<top>"
+    if len(loc) >= 3 and loc[0] == "requirements" and loc[2] == "limit":
+        return (f"{path}: {'.'.join(loc[:3])}: expected a string with a unit such as '1.6 mm', "
+                f"a [low, high] pair of them, or '{OPEN_LIMIT}' (got {err.get('input')!r})")
     if err["type"] == "extra_forbidden":
         key = loc[-1]
         parent = tuple(loc[:1]) if len(loc) > 2 else ()
@@ -167,7 +173,7 @@ class OperatingPoint:
     name: str
     title: str
     initial_position: Amount | None
-    load: float | str | None  # closing force [N], "curve", or None (no load)
+    load: float | str | None  # closing force [N], "curve", "nominal" (load.nominal_force) or None
     load_text: str
     flow_control: bool | None  # None = as configured in the plant
     note: str = ""
@@ -452,8 +458,8 @@ def _build_op(name: str, e: dict, origin) -> OperatingPoint:
     if load_text is None or load_text.strip().lower() in ("none", "0", ""):
         load = None
         load_text = "none"
-    elif load_text.strip().lower() == "curve":
-        load = "curve"
+    elif load_text.strip().lower() in ("curve", "nominal"):
+        load = load_text.strip().lower()
     else:
         load = parse_amount(load_text, "N", _where(origin, "operating_points", name, "load")).value
     return OperatingPoint(name, e.get("title") or name, pos, load, load_text, e.get("flow_control"), e.get("note") or "")

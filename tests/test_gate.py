@@ -1,0 +1,133 @@
+"""The regression gate: comparison rules on synthetic results, then a degraded plant end to end."""
+
+import copy
+import json
+from pathlib import Path
+
+import pytest
+
+from compliance.cli import main
+from compliance.gate import compare, gate_markdown
+
+ROOT = Path(__file__).resolve().parents[1]
+
+REQS = """
+schema = "govcheck-requirements/1"
+name = "gate-test"
+[operating_points.mid]
+initial_position = "50 %stroke"
+load = "none"
+[procedures.s5]
+kind = "steps"
+size = "5 %stroke"
+dwell = "3 s"
+[requirements.POS]
+title = "positioning"
+clause = "clause unknown"
+metric = "max_positioning_error"
+comparator = "<="
+limit = "1 %stroke"
+procedures = ["s5"]
+operating_points = ["mid"]
+[requirements.TC]
+title = "time constant"
+clause = "clause unknown"
+metric = "time_constant"
+comparator = "within"
+limit = ["0.10 s", "0.25 s"]
+procedures = ["s5"]
+operating_points = ["mid"]
+"""
+
+
+def entry(rid, status, margin_pct, value=1.0):
+    return {"id": rid, "title": rid, "metric": "m", "limit_text": "<= 1", "severity": "mandatory", "status": status,
+            "worst": {"margin_pct": margin_pct, "value": value, "display": {"value": f"{value}"}}}
+
+
+def results(*entries, digest="d1"):
+    return {"schema": "govcheck-results/1", "requirements": list(entries),
+            "plant": {"name": "p", "digest": "x", "path": "p.toml"}, "summary": {"status": "pass"},
+            "requirement_set": {"name": "r", "digest": digest, "path": "r.toml"}}
+
+
+def test_rules():
+    base = results(entry("A", "pass", 40.0), entry("B", "pass", 10.0), entry("C", "fail", -5.0), entry("D", "pass", 30.0))
+    same = compare(base, copy.deepcopy(base), max_margin_loss=5)
+    assert same["status"] == "pass" and same["tripped"] == []
+    cand = results(entry("A", "pass", 33.0), entry("B", "fail", -1.0), entry("C", "fail", -50.0),
+                   entry("E", "fail", -3.0))
+    g = compare(base, cand, max_margin_loss=5)
+    rows = {r["id"]: r for r in g["rows"]}
+    assert rows["A"]["tripped"] and "margin lost 7.0 pp" in rows["A"]["reasons"][0]
+    assert rows["B"]["tripped"] and "pass -> fail" in rows["B"]["reasons"]
+    assert rows["C"]["preexisting_failure"] and rows["C"]["tripped"]  # still failing, but lost 45 pp
+    assert rows["D"]["tripped"] and "removed" in rows["D"]["reasons"][0]
+    assert rows["E"]["tripped"] and "new requirement fails" in rows["E"]["reasons"]
+    assert g["status"] == "fail"
+    # without a threshold only status changes count; a margin loss alone does not trip
+    g = compare(base, results(entry("A", "pass", 1.0), entry("B", "pass", 10.0), entry("C", "fail", -90.0),
+                              entry("D", "pass", 30.0)))
+    assert g["status"] == "pass" and g["max_margin_loss"] is None
+    # a pass that is no longer evaluated is a regression (a check must not silently stop)
+    g = compare(base, results(entry("A", "not_evaluated", None), entry("B", "pass", 10.0), entry("C", "fail", -5.0),
+                              entry("D", "pass", 30.0)))
+    assert g["tripped"] == ["A"]
+    # exactly at the threshold is allowed
+    g = compare(base, results(entry("A", "pass", 35.0), entry("B", "pass", 10.0), entry("C", "fail", -5.0),
+                              entry("D", "pass", 30.0)), max_margin_loss=5)
+    assert g["status"] == "pass"
+
+
+def test_markdown_is_a_table_with_the_verdict():
+    base = results(entry("A", "pass", 40.0))
+    md = gate_markdown(compare(base, results(entry("A", "fail", -10.0), digest="d2"), 5))
+    assert md.startswith("### govcheck gate: FAILED - 1 regression(s)")
+    assert "| `A` A | <= 1 | PASS 1.0 (+40.0 %) | FAIL 1.0 (-10.0 %) | -50.0 pp | **tripped**" in md
+    assert "requirement files differ" in md
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    d = tmp_path_factory.mktemp("gate")
+    (d / "reqs.toml").write_text(REQS)
+    text = (ROOT / "models" / "plant-a.toml").read_text()
+    assert 'kp = { value = "280 V/m"' in text
+    (d / "half-kp.toml").write_text(text.replace('kp = { value = "280 V/m"', 'kp = { value = "140 V/m"'))
+    assert main(["check", "plant-a", "-r", str(d / "reqs.toml"), "--json", str(d / "base.json"), "-q", "-j", "1"]) in (0, 1)
+    return d
+
+
+def test_halved_kp_trips_the_gate(files, capsys):
+    """Halving K_P doubles the dead-zone stall error (zmd lc / ((zmd + lc) K_P): 0.86 -> 1.73 mm)."""
+    d = files
+    code = main(["gate", "--baseline", str(d / "base.json"), "--candidate", str(d / "half-kp.toml"),
+                 "--max-margin-loss", "10", "--markdown", str(d / "gate.md"), "--json", str(d / "gate.json"), "-j", "1"])
+    out = capsys.readouterr().out
+    assert code == 1
+    g = json.loads((d / "gate.json").read_text())
+    assert g["status"] == "fail" and "POS" in g["tripped"]
+    pos = {r["id"]: r for r in g["rows"]}["POS"]
+    assert pos["candidate"]["value"] > pos["baseline"]["value"]
+    assert "GATE: FAIL" in out and "POS" in (d / "gate.md").read_text()
+
+
+def test_same_plant_passes_the_gate(files, capsys):
+    d = files
+    assert main(["gate", "--baseline", str(d / "base.json"), "--candidate", "plant-a", "--max-margin-loss", "0", "-q", "-j", "1"]) == 0
+    assert capsys.readouterr().out.strip() == "GATE: PASS"
+    # two results files compare without running anything
+    assert main(["gate", "--baseline", str(d / "base.json"), "--candidate", str(d / "base.json"), "-q"]) == 0
+
+
+def test_gate_bad_inputs(files, tmp_path, capsys):
+    d = files
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps({"schema": "something-else"}))
+    assert main(["gate", "--baseline", str(bad), "--candidate", "plant-a"]) == 2
+    assert "schema" in capsys.readouterr().err
+    (tmp_path / "broken.json").write_text("{not json")
+    assert main(["gate", "--baseline", str(tmp_path / "broken.json"), "--candidate", "plant-a"]) == 2
+    assert main(["gate", "--baseline", "plant-a", "--candidate", "plant-a"]) == 2  # no requirement file
+    assert "--requirements is needed" in capsys.readouterr().err
+    assert main(["gate", "--baseline", str(d / "base.json"), "--candidate", "plant-a", "--max-margin-loss", "-1"]) == 2
