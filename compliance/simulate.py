@@ -9,7 +9,7 @@ each step so results move continuously with the delay (needed by the diagnosis f
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
@@ -69,6 +69,9 @@ class Scenario:
     seed : int
     initial_pressures : tuple of float or None
         (p_A, p_B) [Pa abs]; None = at rest balancing the load.
+    position_noise : numpy.ndarray or None
+        A given additive position-noise sequence per controller sample [m] (e.g. the noise
+        estimated from a recording, for a closed-loop replay); replaces the seeded noise.
     """
 
     duration: float
@@ -80,6 +83,7 @@ class Scenario:
     noise: SensorNoise | None = None
     seed: int = 0
     initial_pressures: tuple[float, float] | None = None
+    position_noise: np.ndarray | None = field(default=None, compare=False, repr=False)
 
 
 OUTPUT_COLUMNS = (
@@ -306,6 +310,10 @@ def simulate(cfg: PlantConfig, scenario: Scenario) -> pd.DataFrame:
     noise = scenario.noise
     rng = np.random.default_rng(scenario.seed)
     pos_noise = rng.normal(0.0, noise.position_std, t.size) if noise and noise.position_std > 0 else np.zeros(t.size)
+    if scenario.position_noise is not None:
+        given = np.asarray(scenario.position_noise, dtype=float)
+        pos_noise = np.zeros(t.size)
+        pos_noise[: min(t.size, given.size)] = given[: t.size]
     y0 = initial_state(cfg, P, scenario.initial_position, scenario.initial_pressures)
     lx, ly = load_curve_arrays(cfg)
     out = np.zeros((n_samples + 1, N_OUT))

@@ -1,0 +1,224 @@
+"""``govcheck linear``: linearised analysis of a plant at an operating point, maps, cross-check, HYGOV."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from ..errors import InputError
+
+_PLOT_SUFFIXES = (".png", ".svg", ".pdf")
+
+
+def register(subparsers):
+    """Add the ``linear`` sub-command."""
+    p = subparsers.add_parser(
+        "linear",
+        help="linearise the plant: time constant, margins, bandwidth, maps, HYGOV parameters",
+        description=(
+            "Trim the nonlinear plant at rest at a position and load, linearise it (numerical Jacobians of the "
+            "simulator's own right-hand side), close the loop with the configured PID and report the pneumatic "
+            "natural frequency, time constant, bandwidth and gain/phase margins. Options add operating maps over "
+            "stroke x load, a cross-check against nonlinear step responses and HYGOV-style governor parameters. "
+            "Quantities accept units ('136 mm', '11.4 kN', '85 %' of stroke); bare numbers are SI."
+        ),
+    )
+    p.add_argument("plant", help="plant configuration (TOML path or reference name such as plant-a)")
+    p.add_argument("--at", default="50 %", help="operating position, e.g. '136 mm', 0.136 or '85 %%' (default: mid stroke)")
+    p.add_argument("--load", default="none", help="closing load, e.g. '11.4 kN', 11400, 'curve' or 'none' (default)")
+    p.add_argument("--gain", choices=("mean", "opening", "closing"), default="mean",
+                   help="valve slope of the linear model: mean of both directions (default) or one direction")
+    p.add_argument("--flow-control", action=argparse.BooleanOptionalAction, default=None,
+                   help="force the meter-out flow-control valves in or out (default: as configured)")
+    p.add_argument("--map", action="store_true", help="operating map of time constant and margins over stroke x load")
+    p.add_argument("--crosscheck", action="store_true", help="compare with nonlinear 1 %% and 5 %% steps at the paper's operating points")
+    p.add_argument("--governor", action="store_true", help="equivalent HYGOV parameters (Tg, VELM, UO/UC, GMAX/GMIN)")
+    p.add_argument("--stroke-load", default="default",
+                   help="load during the governor's full-stroke runs: a force, 'curve' or 'none' (default: the stroke average of the load curve)")
+    p.add_argument("--json", metavar="OUT.json", help="write everything as JSON")
+    p.add_argument("--governor-json", metavar="OUT.json", help="write only the HYGOV parameters as JSON (implies --governor)")
+    p.add_argument("--plot", metavar="OUT.png", help="write Bode, Nyquist, pole-zero and step plots (.png, .svg or .pdf)")
+    return p
+
+
+def _position(text: str, stroke: float) -> float:
+    from ..units import parse_quantity
+
+    t = str(text).strip()
+    if t.endswith("%"):
+        try:
+            return float(t[:-1]) / 100.0 * stroke
+        except ValueError:
+            raise InputError(f"--at {text!r}: expected a percentage of stroke such as '85 %'") from None
+    try:
+        return float(t)
+    except ValueError:
+        return parse_quantity(t, "m", f"--at {text!r}")
+
+
+def parse_load(text, flag: str = "--load"):
+    """'none' -> None, 'curve' -> 'curve', '11.4 kN' -> 11400.0, '11400' -> 11400.0 [N]."""
+    from ..units import parse_quantity
+
+    t = str(text).strip()
+    if t.lower() in ("none", "0", ""):
+        return None
+    if t.lower() == "curve":
+        return "curve"
+    try:
+        return float(t)
+    except ValueError:
+        return parse_quantity(t, "N", f"{flag} {text!r}")
+
+
+def _check_out(path, flag, suffixes=None):
+    if not path:
+        return
+    pth = Path(path)
+    if str(pth.parent) and not pth.parent.is_dir():
+        raise InputError(f"{flag} {path}: folder '{pth.parent}' does not exist")
+    if suffixes and pth.suffix.lower() not in suffixes:
+        raise InputError(f"{flag} {path}: expected a file ending in {', '.join(suffixes)}")
+
+
+def _fmt(v, scale=1.0, digits=3, unit=""):
+    return "-" if v is None else f"{v*scale:.{digits}f} {unit}".rstrip()
+
+
+def _summary(cfg, a) -> str:
+    f, op = a.figures, a.op
+    load = "none" if op.load is None else (f"curve ({op.load_force/1e3:.2f} kN)" if isinstance(op.load, str) else f"{op.load_force/1e3:.2f} kN")
+    lines = [
+        f"plant {cfg.name}: linear model at {op.position*1e3:.1f} mm, load {load}, valve slope '{a.info['gain']}'",
+        f"  trim pressures p_A {op.pressure_a/1e5:.3f} bar abs, p_B {op.pressure_b/1e5:.3f} bar abs (p_A + p_B = p_s + p_atm)",
+        f"  states {', '.join(a.plant.state_labels)} ({a.info['unobservable_or_uncontrollable_states']} mode(s) not seen from u_d to x)",
+        f"  pneumatic natural frequency {_fmt(f['natural_frequency_hz'], 1, 2, 'Hz')} (analytic {_fmt(f['natural_frequency_analytic_hz'], 1, 2, 'Hz')}), "
+        f"damping {_fmt(f['pneumatic_damping_ratio'], 1, 3)}",
+        f"  plant velocity gain {_fmt(f['plant_velocity_gain'], 1e3, 2, 'mm/s per V')}, loop gain K_P*K_q {_fmt(f['loop_gain'], 1, 2, '1/s')}",
+        f"  time constant {_fmt(f['time_constant'], 1e3, 1, 'ms')} (step metric, sampled loop); dominant pole {_fmt(f['dominant_time_constant'], 1e3, 1, 'ms')}; "
+        f"first-order estimate (1 + K_q K_D)/(K_q K_P) {_fmt(f['first_order_time_constant'], 1e3, 1, 'ms')}",
+        f"  -3 dB bandwidth {_fmt(f['bandwidth_hz'], 1, 2, 'Hz')}; least closed-loop damping {_fmt(f['damping_ratio'], 1, 3)}; stable: {'yes' if f['stable'] else 'NO'}",
+        f"  gain margin {_fmt(f['gain_margin_db'], 1, 1, 'dB')} at {_fmt(f['phase_crossover_hz'], 1, 1, 'Hz')}, "
+        f"phase margin {_fmt(f['phase_margin_deg'], 1, 1, 'deg')} at {_fmt(f['gain_crossover_hz'], 1, 1, 'Hz')} (sampled loop; continuous "
+        f"{_fmt(f.get('gain_margin_db_continuous'), 1, 1, 'dB')}, {_fmt(f.get('phase_margin_deg_continuous'), 1, 1, 'deg')})",
+        "  closed-loop poles: " + ", ".join(f"{p[0]:.2f}{p[1]:+.2f}j" for p in a.data["poles"]["closed_loop"]),
+    ]
+    tau = f["time_constant"]
+    if tau is not None:
+        lines.append(f"  IEC 61362 window 0.10-0.25 s: {'inside' if 0.10 <= tau <= 0.25 else 'OUTSIDE'}")
+    return "\n".join(lines)
+
+
+def run(args) -> int:
+    """Run the analysis, print a summary, write JSON / plots."""
+    from ..config import load_plant
+    from ..linear import analyse, jsonable
+
+    _check_out(args.json, "--json")
+    _check_out(args.governor_json, "--governor-json")
+    _check_out(args.plot, "--plot", _PLOT_SUFFIXES)
+    cfg = load_plant(args.plant)
+    L = cfg.p("cylinder.stroke")
+    x = _position(args.at, L)
+    load = parse_load(args.load)
+    a = analyse(cfg, x, load, flow_control=args.flow_control, gain=args.gain)
+    print(_summary(cfg, a))
+    out = {"schema": "govcheck-linear/1", "plant": cfg.name, "path": cfg.path, "digest": cfg.digest, "analysis": a.to_dict()}
+    omap = None
+    if args.map:
+        from ..linear_maps import map_table, operating_map
+
+        omap = operating_map(cfg, flow_control=args.flow_control, gain=args.gain)
+        print("\ntime constant [ms] over stroke x load (* outside 100-250 ms):")
+        print(map_table(omap))
+        print("\ngain margin [dB]:")
+        print(map_table(omap, "gain_margin_db", 1.0, 1))
+        print("\nphase margin [deg]:")
+        print(map_table(omap, "phase_margin_deg", 1.0, 0))
+        for n in omap.notes:
+            print(f"  note: {n}")
+        out["map"] = omap.to_dict()
+    if args.crosscheck:
+        from ..linear_maps import crosscheck, crosscheck_table
+
+        rows = crosscheck(cfg, flow_control=args.flow_control)
+        print("\ncross-check, linear vs nonlinear time constant (metric: dead time to 63.2 % of the commanded step):")
+        print(crosscheck_table(rows))
+        out["crosscheck"] = jsonable(rows)
+    if args.governor or args.governor_json:
+        from ..governor_model import governor_parameters
+
+        sl = "default" if args.stroke_load == "default" else parse_load(args.stroke_load, "--stroke-load")
+        gov = governor_parameters(cfg, stroke_load=sl)
+        print("\nequivalent HYGOV parameters:")
+        print(gov.table())
+        out["governor"] = gov.to_dict()
+        if args.governor_json:
+            from ..results_io import write_text_atomic
+
+            write_text_atomic(args.governor_json, gov.to_json() + "\n")
+    if args.json:
+        from ..results_io import write_text_atomic
+
+        write_text_atomic(args.json, json.dumps(jsonable(out), indent=1) + "\n")
+        print(f"\nwrote {args.json}")
+    if args.plot:
+        _plot(a, args.plot, omap)
+        print(f"wrote {args.plot}")
+    return 0
+
+
+def _plot(a, path, omap=None) -> None:
+    """Bode (loop), Nyquist, closed-loop pole-zero map, predicted step and, with --map, the time-constant map."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    d = a.data
+    fig, ax = plt.subplots(2, 3, figsize=(15, 8.5))
+    fhz = np.array(d["bode"]["frequency_hz"])
+    ax[0, 0].semilogx(fhz, d["bode"]["loop_discrete_magnitude_db"], label="loop L (sampled)")
+    ax[0, 0].semilogx(fhz, d["bode"]["closed_loop_magnitude_db"], label="closed loop T")
+    ax[0, 0].axhline(0, color="k", lw=0.5)
+    ax[0, 0].axhline(-3, color="k", lw=0.5, ls=":")
+    ax[0, 0].set(xlabel="frequency [Hz]", ylabel="magnitude [dB]", title="Bode magnitude")
+    ax[0, 0].legend()
+    ax[1, 0].semilogx(fhz, d["bode"]["loop_discrete_phase_deg"], label="loop L (sampled)")
+    ax[1, 0].semilogx(fhz, d["bode"]["closed_loop_phase_deg"], label="closed loop T")
+    ax[1, 0].axhline(-180, color="k", lw=0.5)
+    ax[1, 0].set(xlabel="frequency [Hz]", ylabel="phase [deg]", title="Bode phase")
+    re, im = np.array(d["nyquist"]["loop_real"]), np.array(d["nyquist"]["loop_imag"])
+    ax[0, 1].plot(re, im, label="L(jw)")
+    ax[0, 1].plot(re, -im, ls="--", lw=0.7)
+    ax[0, 1].plot([-1], [0], "r+", ms=12)
+    ax[0, 1].set(xlim=(-3, 1), ylim=(-3, 3), xlabel="Re", ylabel="Im", title="Nyquist (sampled loop)")
+    p = np.array(d["poles"]["closed_loop"])
+    z = np.array(d["poles"]["closed_loop_zeros"]).reshape(-1, 2)
+    ax[1, 1].plot(p[:, 0], p[:, 1], "x", label="closed-loop poles")
+    if z.size:
+        ax[1, 1].plot(z[:, 0], z[:, 1], "o", mfc="none", label="zeros")
+    pp = np.array(d["poles"]["plant_minimal"])
+    ax[1, 1].plot(pp[:, 0], pp[:, 1], "k.", label="plant poles")
+    ax[1, 1].set(xlabel="Re [1/s]", ylabel="Im [rad/s]", title="pole-zero map", xlim=(min(-50, p[:, 0].min() * 1.1 if p.size else -50), 5))
+    ax[1, 1].legend(fontsize=8)
+    ax[0, 2].plot(d["step"]["time"], np.array(d["step"]["position"]) * 1e3, label="sampled loop")
+    ax[0, 2].plot(d["step"]["time_continuous"], np.array(d["step"]["position_continuous"]) * 1e3, ls="--", label="continuous")
+    ax[0, 2].set(xlabel="time [s]", ylabel="position [mm]", title=f"predicted {abs(d['step']['size'])*1e3:.0f} mm step")
+    ax[0, 2].legend()
+    if omap is not None:
+        tau = np.array([[np.nan if v is None else v * 1e3 for v in row] for row in omap.values["time_constant"]])
+        im_ = ax[1, 2].imshow(tau, aspect="auto", origin="lower", cmap="viridis")
+        ax[1, 2].set_xticks(range(len(omap.positions)), [f"{100*x/omap.positions[-1]:.0f}" for x in omap.positions])
+        ax[1, 2].set_yticks(range(len(omap.loads)), ["none" if v is None else (v if isinstance(v, str) else f"{v/1e3:.1f}") for v in omap.loads])
+        ax[1, 2].set(xlabel="stroke [%]", ylabel="load [kN]", title="time constant [ms]")
+        fig.colorbar(im_, ax=ax[1, 2])
+    else:
+        ax[1, 2].axis("off")
+    fig.suptitle(f"{a.op.position*1e3:.1f} mm, load {a.op.load_force/1e3:.2f} kN: "
+                 f"tau {a.figures['time_constant']*1e3:.0f} ms" if a.figures["time_constant"] else "")
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
