@@ -16,7 +16,7 @@ def _numba_cache_dir() -> str:
     """
     here = _Path(__file__).resolve().parent
     digest = _hashlib.sha256()
-    for sub in ("physics", "tracking"):
+    for sub in ("physics",):
         for f in sorted((here / sub).glob("*.py")) if (here / sub).is_dir() else ():
             digest.update(f.read_bytes())
     for name in ("plant.py", "simulate.py", "control.py", "layout.py"):

@@ -38,6 +38,8 @@ PARAM_NAMES = (
     "sl_on", "sl_tau", "sl_delay",
     "ld_on", "ld_vol", "ld_cond",
     "lc_on", "lc_stiff", "lc_damp",
+    # piecewise Stribeck friction, seed 001 eq. (8) (appended: earlier indices unchanged)
+    "f_breakaway", "kv_low", "v_critical", "kv_high",
 )
 N_PARAMS = len(PARAM_NAMES)
 PI = {n: i for i, n in enumerate(PARAM_NAMES)}
@@ -124,6 +126,10 @@ P_LD_COND = PI["ld_cond"]
 P_LK_ON = PI["lc_on"]
 P_LK_K = PI["lc_stiff"]
 P_LK_C = PI["lc_damp"]
+P_FJ = PI["f_breakaway"]
+P_KV1 = PI["kv_low"]
+P_VD = PI["v_critical"]
+P_KV2 = PI["kv_high"]
 
 # effect name -> (flag index, {param name: index}) — the bridge from declarations to the core
 EFFECT_SLOTS = {

@@ -95,6 +95,17 @@ BASE_PARAMS: tuple[BaseParam, ...] = (
     _P("controller.compensation_slope_positive", "", "compensator's md", 1.0, 0.0, 100.0, True),
     _P("controller.compensation_slope_negative", "", "compensator's me", 1.0, 0.0, 100.0, True),
     _P("simulation.step", "s", "fixed integration step (pinned for determinism)", 1e-4, 0.0, 0.01, True),
+    # --- piecewise Stribeck friction, seed 001 eq. (8) (friction.model = "piecewise_stribeck")
+    _P("friction.breakaway_force", "N", "seed 001 eq. (8) F_j: friction at rest (piecewise Stribeck model)", 0.0, 0.0, 1e6),
+    _P("friction.low_speed_coefficient", "N*s/m", "seed 001 eq. (8) k_v1: friction drop per speed below v_d", 0.0, 0.0, 1e7),
+    _P("friction.critical_velocity", "m/s", "seed 001 eq. (8) v_d: speed where the friction stops falling", 0.01, 0.0, 10.0, True),
+    _P("friction.high_speed_coefficient", "N*s/m", "seed 001 eq. (8) k_v2: viscous slope above v_d", 0.0, 0.0, 1e7),
+    # --- state feedback with observers, seed 001 eqs. (10)-(11) (controller.type = "state_feedback")
+    _P("controller.closed_loop_bandwidth", "rad/s", "state feedback: magnitude of the three placed closed-loop poles", 0.0, 0.0, 1e5),
+    _P("controller.closed_loop_damping", "", "state feedback: damping ratio of the placed complex pole pair", 0.7, 0.0, 1.0, True),
+    _P("controller.acceleration_observer_bandwidth", "rad/s", "pole of the reduced-order acceleration observer (seed 001 eq. 10)", 0.0, 0.0, 1e6),
+    _P("controller.friction_observer_bandwidth", "rad/s", "pole of the reduced-order friction-force observer (seed 001 eq. 11)", 0.0, 0.0, 1e6),
+    _P("controller.velocity_filter_cutoff", "Hz", "first-order filter on the differentiated position (0 = no filter)", 0.0, 0.0, 1e5),
 )
 
 BASE_BY_KEY: dict[str, BaseParam] = {p.key: p for p in BASE_PARAMS}
@@ -102,10 +113,12 @@ BASE_BY_KEY: dict[str, BaseParam] = {p.key: p for p in BASE_PARAMS}
 # option keys (strings / booleans) and their allowed values
 OPTIONS: dict[str, tuple[str, ...]] = {
     "cylinder.arrangement": ("tandem", "single"),
-    "friction.model": ("lugre", "variable_viscous"),
+    "friction.model": ("lugre", "variable_viscous", "piecewise_stribeck"),
     "valve.flow_law": ("iso6358", "sanville", "bobrow", "power_law"),
-    "controller.type": ("pid",),
+    "controller.type": ("pid", "state_feedback"),
     "flow_control.installed": ("true", "false"),
+    "controller.friction_compensation": ("true", "false"),
+    "controller.feedforward": ("true", "false"),
 }
 OPTION_DEFAULTS: dict[str, str] = {
     "cylinder.arrangement": "tandem",
@@ -113,5 +126,7 @@ OPTION_DEFAULTS: dict[str, str] = {
     "valve.flow_law": "iso6358",
     "controller.type": "pid",
     "flow_control.installed": "false",
+    "controller.friction_compensation": "false",
+    "controller.feedforward": "false",
 }
 SOURCES = ("paper", "assumed", "derived", "user")

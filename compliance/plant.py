@@ -20,6 +20,7 @@ from .physics.chamber import chamber_pressure_rate, chamber_temperature_rate, wa
 from .physics.friction import (
     lugre_bristle_rate,
     lugre_force,
+    piecewise_stribeck_friction,
     pressure_friction_increment,
     variable_viscous_friction,
 )
@@ -41,7 +42,7 @@ from .physics.valve_flow import (
 from .physics.valve_opening import valve_openings
 
 FLOW_LAWS = {"iso6358": 0, "sanville": 1, "bobrow": 2, "power_law": 3}
-FRICTION_MODELS = {"lugre": 0, "variable_viscous": 1}
+FRICTION_MODELS = {"lugre": 0, "variable_viscous": 1, "piecewise_stribeck": 2}
 STICK_TIME_CONSTANT = 1e-3  # s; variable-viscous model: how fast a stuck body's residual speed is removed
 
 
@@ -103,6 +104,17 @@ def parameter_vector(cfg: PlantConfig, *, load: float | str | None = None, flow_
     P[P_VLIM] = p["friction.limit_velocity"]
     P[P_SIG0] = p["friction.bristle_stiffness"]
     P[P_SIG1] = p["friction.bristle_damping"]
+    P[P_FJ] = p["friction.breakaway_force"]  # seed 001 eq. (8)
+    P[P_KV1] = p["friction.low_speed_coefficient"]
+    P[P_VD] = p["friction.critical_velocity"]
+    P[P_KV2] = p["friction.high_speed_coefficient"]
+    if P[P_FRM] == 2.0 and P[P_FJ] - P[P_KV1] * P[P_VD] < 0.0:
+        from .errors import InputError
+
+        raise InputError(
+            f"{cfg.path or cfg.name}: friction.breakaway_force - friction.low_speed_coefficient * friction.critical_velocity "
+            f"= {P[P_FJ] - P[P_KV1] * P[P_VD]:g} N; seed 001 eq. (8) needs it >= 0 (friction never aids the motion)"
+        )
     P[P_KSTOP] = p["end_stop.stiffness"]
     P[P_CSTOP] = p["end_stop.damping"]
     if isinstance(load, str):
@@ -170,6 +182,11 @@ def _body_friction(P, v, z, applied, fs, fc, n):
     if P[P_FRM] == 0.0:
         dz = lugre_bristle_rate(v, z, P[P_SIG0], fs, fc, P[P_VS])  # LuGre (Canudas de Wit 1995)
         return n * lugre_force(v, z, dz, P[P_SIG0], P[P_SIG1], P[P_BV]), dz, False
+    if P[P_FRM] == 2.0:
+        fj = P[P_FJ] + (fs - P[P_FS])  # pressure-dependent friction raises F_j by the same increment
+        f = n * piecewise_stribeck_friction(v, applied / n, fj, P[P_KV1], P[P_VD], P[P_KV2], P[P_VLIM])  # seed 001 eq. (8)
+        stuck = abs(v) < P[P_VLIM] and abs(applied) <= n * fj
+        return f, 0.0, stuck
     f = n * variable_viscous_friction(v, applied / n, fs, fc, P[P_VS], P[P_BV], P[P_VLIM])  # seed 000 eq. (7)
     stuck = abs(v) < P[P_VLIM] and abs(applied) <= n * fs
     return f, 0.0, stuck
