@@ -299,6 +299,8 @@ def simulate(cfg: PlantConfig, scenario: Scenario) -> pd.DataFrame:
         raise InputError(f"initial position {scenario.initial_position*1e3:.1f} mm is outside the stroke 0..{stroke*1e3:.0f} mm")
     if not (scenario.duration > 0 and math.isfinite(scenario.duration)):
         raise InputError(f"duration must be a positive number of seconds, got {scenario.duration}")
+    if scenario.command is None and cfg.options["controller.type"] != "pid":
+        return _simulate_state_feedback(cfg, scenario)
     P = parameter_vector(cfg, load=scenario.load, flow_control=scenario.flow_control)
     ts = P[P_TSAMP]
     n_sub = int(round(ts / cfg.p("simulation.step")))
@@ -332,4 +334,27 @@ def simulate(cfg: PlantConfig, scenario: Scenario) -> pd.DataFrame:
             df[col] = vals
     df.attrs["plant"] = cfg.name
     df.attrs["closed_loop"] = closed
+    return df
+
+
+def _simulate_state_feedback(cfg: PlantConfig, scenario: Scenario) -> pd.DataFrame:
+    """Closed loop under the seed 001 state-feedback controller (plant B), via compliance.tracking."""
+    from .tracking import AxisReference, simulate_axis
+
+    if isinstance(scenario.load, str):
+        raise InputError(f"{cfg.name}: a load curve is not supported with controller.type = '{cfg.options['controller.type']}'")
+    ts = cfg.p("controller.sample_time")
+    n = int(round(scenario.duration / ts))
+    t = np.arange(n + 1) * ts
+    r = _sample_profile(scenario.reference, t, scenario.initial_position)
+    if abs(r[0] - scenario.initial_position) > 1e-9:
+        raise InputError("state-feedback runs start at rest on the reference: the reference must begin at the initial position")
+    v = np.gradient(r, ts)  # reference derivatives for the feed-forward terms (seed 001 fig. 6)
+    a = np.gradient(v, ts)
+    noise = scenario.noise or SensorNoise()
+    df = simulate_axis(cfg, AxisReference(r, v, a), load=None if scenario.load is None else float(scenario.load),
+                       position_noise=noise.position_std, position_quantum=noise.position_quantum,
+                       pressure_noise=noise.pressure_std, seed=scenario.seed)
+    df.attrs["plant"] = cfg.name
+    df.attrs["closed_loop"] = True
     return df
