@@ -31,6 +31,10 @@ def warm_up(cfg):
     from .simulate import Scenario, simulate
 
     simulate(cfg, Scenario(0.01, 0.5 * cfg.p("cylinder.stroke")))
+    if cfg.options["controller.type"] != "pid":
+        from .tracking import warm_up as warm_up_tracking
+
+        warm_up_tracking(cfg)
 
 
 class _Progress:

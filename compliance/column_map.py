@@ -30,13 +30,13 @@ selected by name (``"zillen-friction"``).
 
 from __future__ import annotations
 
-import difflib
 import tomllib
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 from types import MappingProxyType
 
+from .close_match import did_you_mean
 from .errors import InputError
 
 # canonical column -> SI unit ("Pa" columns are absolute pressures); recording-format.md
@@ -125,9 +125,7 @@ class ColumnMap:
         return None
 
 
-def _suggest(word: str, choices) -> str:
-    close = difflib.get_close_matches(str(word), list(choices), n=1)
-    return f"; did you mean '{close[0]}'?" if close else ""
+_suggest = did_you_mean
 
 
 def builtin_column_maps() -> list[str]:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import difflib
 import hashlib
 import math
 import os
@@ -16,6 +15,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from .close_match import did_you_mean
 from .effects import EFFECTS
 from .errors import InputError
 from .parameters import BASE_BY_KEY, BASE_PARAMS, OPTION_DEFAULTS, OPTIONS, SOURCES
@@ -25,9 +25,7 @@ _TOP_KEYS = {"name", "description", "provenance", "effects"}
 _SECTIONS = sorted({k.split(".")[0] for k in BASE_BY_KEY} | {k.split(".")[0] for k in OPTIONS})
 
 
-def _suggest(word: str, choices) -> str:
-    close = difflib.get_close_matches(word, list(choices), n=1)
-    return f"; did you mean '{close[0]}'?" if close else ""
+_suggest = did_you_mean
 
 
 @dataclass(frozen=True)

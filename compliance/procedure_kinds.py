@@ -104,6 +104,8 @@ def parse_setting(setting: Setting, value, where: str):
         a = parse_amount(value, _SI[t], where)
         if a.value < 0:
             raise InputError(f"{where}: must not be negative")
+        if t == "frequency" and a.value == 0:
+            raise InputError(f"{where}: a frequency must be positive")
         return a
     if t in ("number", "count"):
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:

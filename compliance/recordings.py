@@ -168,5 +168,5 @@ def _check_time(path: Path, time: np.ndarray, row) -> None:
     if bad.size:
         i = int(bad[0]) + 1
         raise InputError(
-            f"{path}: {row(i)}: time not strictly increasing (t = {time[i]!r} s after {time[i - 1]!r} s at {row(i - 1)})"
+            f"{path}: {row(i)}: time not strictly increasing (t = {float(time[i]):.9g} s after {float(time[i - 1]):.9g} s at {row(i - 1)})"
         )

@@ -118,6 +118,16 @@ def _load_chain(path: Path, seen: tuple[str, ...]) -> list[tuple[Path, str, dict
     return chain
 
 
+def _register_plugin_kinds() -> None:
+    """Add plant B's tracking procedures and metrics to the shared tables (idempotent).
+
+    Imported here, at call time, because compliance.tracking itself imports the procedure tables.
+    """
+    from .tracking import register
+
+    register()
+
+
 def load_requirements(source: str | os.PathLike) -> RequirementSet:
     """Load a requirement file (path or reference name) with everything it extends.
 
@@ -126,6 +136,7 @@ def load_requirements(source: str | os.PathLike) -> RequirementSet:
     InputError
         One message naming the file and key path of the first problem.
     """
+    _register_plugin_kinds()
     path = resolve_requirements_path(source)
     chain = _load_chain(path, ())
     merged: dict[str, dict[str, dict]] = {"operating_points": {}, "procedures": {}, "requirements": {}}

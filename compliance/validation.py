@@ -7,7 +7,6 @@ TOML (limits, locate parameters, windows) of ``docs/validation.md``.
 
 from __future__ import annotations
 
-import difflib
 import math
 import tomllib
 from dataclasses import dataclass, field
@@ -16,6 +15,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .close_match import did_you_mean
 from . import __version__
 from .config import PlantConfig
 from .errors import InputError
@@ -83,9 +83,6 @@ _SECTIONS = {
 _LOCATE_UNITS = {"smoothing": "s", "min_duration": "s", "merge_gap": "s"}
 
 
-def _suggest(word: str, choices) -> str:
-    close = difflib.get_close_matches(word, list(choices), n=1)
-    return f"; did you mean '{close[0]}'?" if close else ""
 
 
 def _number(value, unit: str, where: str) -> float:
@@ -113,14 +110,14 @@ def settings_from_dict(data: dict, where: str = "<settings>") -> ValidationSetti
         raise InputError(f"{where}: expected a table")
     for sec in data:
         if sec not in _SECTIONS:
-            raise InputError(f"{where}: unknown section [{sec}]{_suggest(sec, _SECTIONS)} (expected {', '.join(_SECTIONS)})")
+            raise InputError(f"{where}: unknown section [{sec}]{did_you_mean(sec, _SECTIONS)} (expected {', '.join(_SECTIONS)})")
     for sec, keys in _SECTIONS.items():
         if keys and sec in data:
             if not isinstance(data[sec], dict):
                 raise InputError(f"{where}: [{sec}] must be a table")
             for k in data[sec]:
                 if k not in keys:
-                    raise InputError(f"{where}: {sec}.{k}: unknown key{_suggest(k, keys)} (expected {', '.join(keys)})")
+                    raise InputError(f"{where}: {sec}.{k}: unknown key{did_you_mean(k, keys)} (expected {', '.join(keys)})")
     rep = data.get("replay", {})
     modes = rep.get("modes", list(MODES))
     if isinstance(modes, str):
@@ -129,7 +126,7 @@ def settings_from_dict(data: dict, where: str = "<settings>") -> ValidationSetti
         raise InputError(f"{where}: replay.modes: expected a list of {', '.join(MODES)} (or \"both\")")
     for m in modes:
         if m not in MODES:
-            raise InputError(f"{where}: replay.modes: '{m}' is not one of {', '.join(MODES)}{_suggest(m, MODES)}")
+            raise InputError(f"{where}: replay.modes: '{m}' is not one of {', '.join(MODES)}{did_you_mean(m, MODES)}")
     noise = rep.get("noise", "auto")
     loc = {k: _number(v, _LOCATE_UNITS.get(k, ""), f"{where}: locate.{k}") for k, v in data.get("locate", {}).items()}
     try:
@@ -157,19 +154,19 @@ def _limits_from_dict(table, where: str):
         raise InputError(f"{where}: [limits] must be a table of [limits.SIGNAL.KIND] tables")
     for sig, kinds in table.items():
         if sig not in SIGNAL_UNITS:
-            raise InputError(f"{where}: limits.{sig}: unknown signal{_suggest(sig, SIGNAL_UNITS)} (expected {', '.join(SIGNAL_UNITS)})")
+            raise InputError(f"{where}: limits.{sig}: unknown signal{did_you_mean(sig, SIGNAL_UNITS)} (expected {', '.join(SIGNAL_UNITS)})")
         if not isinstance(kinds, dict):
             raise InputError(f"{where}: limits.{sig} must be a table of steady / transient tables")
         for kind, vals in kinds.items():
             if kind not in WINDOW_KINDS:
-                raise InputError(f"{where}: limits.{sig}.{kind}: unknown window kind{_suggest(kind, WINDOW_KINDS)} (expected {', '.join(WINDOW_KINDS)})")
+                raise InputError(f"{where}: limits.{sig}.{kind}: unknown window kind{did_you_mean(kind, WINDOW_KINDS)} (expected {', '.join(WINDOW_KINDS)})")
             if not isinstance(vals, dict):
                 raise InputError(f"{where}: limits.{sig}.{kind} must be a table of {', '.join(MEASURES)}")
             cur = limits.get((sig, kind), ErrorLimits()).as_dict()
             for m, v in vals.items():
                 kw = f"{where}: limits.{sig}.{kind}.{m}"
                 if m not in MEASURES:
-                    raise InputError(f"{kw}: unknown measure{_suggest(m, MEASURES)} (expected {', '.join(MEASURES)})")
+                    raise InputError(f"{kw}: unknown measure{did_you_mean(m, MEASURES)} (expected {', '.join(MEASURES)})")
                 if isinstance(v, str) and v.strip().lower() in ("none", "off"):
                     cur[m] = None
                     continue

@@ -40,7 +40,7 @@ def write(tmp_path, text, name="mine.toml"):
 def test_shipped_files_are_identical_to_package_data():
     shipped = sorted(p.name for p in (ROOT / "requirements").glob("*.toml"))
     data = sorted(p.name for p in (ROOT / "compliance" / "data" / "requirements").glob("*.toml"))
-    assert shipped == data == ["iec60308.toml", "iec61362.toml", "ieee125.toml", "shpp-400kw.toml"]
+    assert shipped == data == ["iec60308.toml", "iec61362.toml", "ieee125.toml", "shpp-400kw.toml", "tracking-robot.toml"]
     for n in shipped:
         assert filecmp.cmp(ROOT / "requirements" / n, ROOT / "compliance" / "data" / "requirements" / n, shallow=False), n
     assert reference_requirement_files() == [n[:-5] for n in shipped]

@@ -1,0 +1,97 @@
+"""``govcheck report``: re-render the HTML / PDF report from saved results, without simulating."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from ..errors import InputError
+
+
+def register(subparsers):
+    """Add the ``report`` sub-command."""
+    p = subparsers.add_parser(
+        "report",
+        help="render the HTML/PDF report from a saved results JSON (no simulation)",
+        description=(
+            "Render the compliance report of a results file written by 'govcheck check --json' (or the "
+            "validation report of a file written by 'govcheck validate --json') as one self-contained HTML "
+            "file and/or an A4 PDF. Nothing is simulated. Without --html and --pdf the HTML is written next "
+            "to the results with the suffix .html. Exit 0 when written, 2 on invalid input."
+        ),
+        epilog="example: govcheck report /tmp/r.json --html reports/plant-a.html --pdf reports/plant-a.pdf",
+    )
+    p.add_argument("results", help="results JSON (schema govcheck-results/1 or govcheck.validation/1)")
+    p.add_argument("--html", metavar="OUT.html", help="write the HTML report here")
+    p.add_argument("--pdf", metavar="OUT.pdf", help="write the PDF report here")
+    p.add_argument("--linear", metavar="LINEAR.json", action="append",
+                   help="add the linear analysis written by 'govcheck linear --map --crosscheck --governor --json'; "
+                        "repeat for more critical points (their Bode diagrams and poles are overlaid; map, "
+                        "cross-check and governor parameters are taken from the first file that has them)")
+    p.add_argument("--validation", metavar="VALIDATION.json",
+                   help="add a model validation written by 'govcheck validate --json'")
+    p.add_argument("--jobs", "-j", type=int, default=None, help="processes drawing figures (default: available cores)")
+    return p
+
+
+def read_json(path, what: str) -> dict:
+    """Read a JSON object from ``path``; InputError naming the file otherwise."""
+    p = Path(path)
+    try:
+        data = json.loads(p.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise InputError(f"{p}: {what} file not found") from None
+    except IsADirectoryError:
+        raise InputError(f"{p}: is a folder; expected a {what} JSON file") from None
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise InputError(f"{p}: not a JSON {what} file ({exc})") from None
+    if not isinstance(data, dict):
+        raise InputError(f"{p}: expected a JSON object ({what}), got {type(data).__name__}")
+    return data
+
+
+def merge_linear(docs) -> dict:
+    """Several ``govcheck linear --json`` documents -> one ``linear`` entry with every analysis."""
+    out: dict = {"schema": "govcheck-linear/1", "analyses": []}
+    for path, lin in docs:
+        if lin.get("schema") != "govcheck-linear/1":
+            raise InputError(f"{path}: key 'schema' is {lin.get('schema')!r}; expected 'govcheck-linear/1' "
+                             "(written by govcheck linear --json)")
+        if lin.get("analysis"):
+            out["analyses"].append(lin["analysis"])
+        for key in ("map", "crosscheck", "governor"):
+            if lin.get(key) and key not in out:
+                out[key] = lin[key]
+    return out
+
+
+def run(args) -> int:
+    """Render the report(s); print where they were written."""
+    from ..report.content import check_results
+    from ..report.render import VALIDATION_SCHEMA, check_validation, render_report, render_validation_report
+
+    if args.jobs is not None and args.jobs < 1:
+        raise InputError(f"--jobs {args.jobs}: expected a positive number of processes")
+    data = read_json(args.results, "results")
+    html = args.html
+    if not html and not args.pdf:
+        html = str(Path(args.results).with_suffix(".html"))
+    if data.get("schema") == VALIDATION_SCHEMA:
+        if args.linear or args.validation:
+            raise InputError(f"{args.results}: a validation results file takes no --linear / --validation")
+        check_validation(data, str(args.results))
+        if not html:
+            raise InputError("a validation report needs --html (the PDF is made from it)")
+        render_validation_report(data, html, args.pdf, workers=args.jobs)
+    else:
+        check_results(data, str(args.results))
+        if args.linear:
+            data["linear"] = merge_linear([(p, read_json(p, "linear analysis")) for p in args.linear])
+        if args.validation:
+            val = read_json(args.validation, "validation")
+            check_validation(val, str(args.validation))
+            data["validation"] = val
+        render_report(data, html, args.pdf, workers=args.jobs)
+    written = [p for p in (html, args.pdf) if p]
+    print("report: " + ", ".join(written))
+    return 0

@@ -1,0 +1,200 @@
+"""Optional report sections: linear analysis and model validation (what exists is shown).
+
+Linear data is the document ``govcheck linear --json`` writes (schema ``govcheck-linear/1``:
+``analysis`` or ``analyses``, ``map``, ``crosscheck``, ``governor``), found in a results dict
+under ``linear``. Validation data is ``compliance.validation.validate`` output (schema
+``govcheck.validation/1``), optionally with a ``diagnosis`` entry (``after`` overlays and the
+physics added with its fitted parameters). Missing parts are reported as "not run".
+"""
+
+from __future__ import annotations
+
+from .content import fmt_num, pretty_unit
+from .figures_linear import MAP_QUANTITIES
+
+SIGNAL_DISPLAY = {  # signal -> (label, unit shown, scale from SI)
+    "position": ("position", "mm", 1e3),
+    "valve_command": ("valve command", "V", 1.0),
+    "pressure_a": ("chamber A pressure", "bar abs", 1e-5),
+    "pressure_b": ("chamber B pressure", "bar abs", 1e-5),
+    "supply_pressure": ("supply pressure", "bar abs", 1e-5),
+}
+
+
+def _op_label(a: dict) -> str:
+    op = a.get("operating_point") or {}
+    if a.get("label"):
+        return str(a["label"])
+    x = op.get("position")
+    ld = op.get("load")
+    load = "no load" if ld is None else (f"load curve ({(op.get('load_force') or 0) / 1e3:.1f} kN)" if isinstance(ld, str)
+                                          else f"{ld / 1e3:+.1f} kN")
+    return f"{x * 1e3:.0f} mm, {load}" if isinstance(x, (int, float)) else "operating point"
+
+
+def linear_section(linear: dict | None, start: int) -> tuple[dict | None, list[dict]]:
+    """Context of the linear-analysis section and its figure specs (ids from ``start``)."""
+    if not linear:
+        return None, []
+    specs = []
+
+    def add(kind, **kw):
+        fid = f"fig-{start + len(specs)}"
+        specs.append({"id": fid, "kind": kind, **kw})
+        return fid
+
+    analyses = list(linear.get("analyses") or ([linear["analysis"]] if linear.get("analysis") else []))
+    labelled = [(_op_label(a), a) for a in analyses]
+    maps = []
+    omap = linear.get("map")
+    if omap:
+        for name in ("time_constant", "gain_margin_db", "phase_margin_deg"):
+            if (omap.get("values") or {}).get(name):
+                maps.append({"id": add("map", omap=omap, name=name), "title": MAP_QUANTITIES[name][0],
+                             "unit": MAP_QUANTITIES[name][1]})
+    points = []
+    for label, a in labelled:
+        f = a.get("figures") or {}
+        points.append({"label": label, "time_constant": _ms(f.get("time_constant")),
+                       "gain_margin": fmt_num(f.get("gain_margin_db"), 3), "phase_margin": fmt_num(f.get("phase_margin_deg"), 3),
+                       "bandwidth": fmt_num(f.get("bandwidth_hz"), 3), "damping": fmt_num(f.get("damping_ratio"), 3),
+                       "natural_frequency": fmt_num(f.get("natural_frequency_hz"), 3),
+                       "stable": f.get("stable")})
+    bode = add("bode", analyses=labelled) if any(a.get("bode") for _, a in labelled) else None
+    poles = add("poles", analyses=labelled) if any((a.get("poles") or {}).get("closed_loop") for _, a in labelled) else None
+    cross = []
+    for r in linear.get("crosscheck") or []:
+        if "skipped" in r:
+            cross.append({"position": _mm(r.get("position")), "load": _load(r.get("load")), "skipped": r["skipped"]})
+            continue
+        cross.append({"position": _mm(r.get("position")), "load": _load(r.get("load"), r.get("load_force")),
+                      "step": f"{r['step'] * 100:+.0f} %" if r.get("step") is not None else "\u2013",
+                      "tau_linear": _ms(r.get("tau_linear")), "tau_nonlinear": _ms(r.get("tau_nonlinear"), "stalled"),
+                      "ratio": fmt_num(r.get("ratio"), 3), "steady_error": _mm(r.get("steady_error"), 2),
+                      "why": r.get("why") or "agrees within 20 %"})
+    gov = None
+    g = linear.get("governor")
+    if g:
+        units = g.get("units") or {}
+        params = dict(g.get("parameters") or {})
+        params.update({k: v for k, v in (g.get("rate_limits") or {}).items()})
+        rows = [{"name": k, "value": fmt_num(v, 4), "unit": units.get(k, "")} for k, v in params.items()]
+        if g.get("Tg_linear") is not None:
+            rows.append({"name": "Tg (linear)", "value": fmt_num(g["Tg_linear"], 4), "unit": "s"})
+        gov = {"model": g.get("model", "HYGOV"), "rows": rows,
+               "basis": [{"key": k, "value": _basis_text(v)} for k, v in (g.get("basis") or {}).items()]}
+    notes = list((omap or {}).get("notes") or [])
+    ctx = {"maps": maps, "points": points, "bode": bode, "poles": poles, "crosscheck": cross, "governor": gov,
+           "notes": notes, "window": (omap or {}).get("window")}
+    return ctx, specs
+
+
+def _basis_text(v) -> str:
+    if isinstance(v, float):
+        return fmt_num(v)
+    if isinstance(v, dict):
+        return ", ".join(f"{k} = {_basis_text(x)}" for k, x in v.items())
+    if isinstance(v, list):
+        return ", ".join(_basis_text(x) for x in v)
+    return str(v)
+
+
+def _ms(v, none="\u2013"):
+    return none if v is None else f"{v * 1e3:.0f} ms"
+
+
+def _mm(v, digits=0):
+    return "\u2013" if v is None else f"{v * 1e3:.{digits}f} mm"
+
+
+def _load(ld, force=None):
+    if ld is None:
+        return "none"
+    if isinstance(ld, str):
+        return ld + (f" ({force / 1e3:.1f} kN)" if isinstance(force, (int, float)) else "")
+    return f"{ld / 1e3:+.1f} kN"
+
+
+# --------------------------------------------------------------------------- validation
+def validation_section(val: dict | None, start: int) -> tuple[dict | None, list[dict]]:
+    """Context of the model-validation section and its figure specs (ids from ``start``)."""
+    if not val:
+        return None, []
+    specs = []
+    modes = []
+    diag = val.get("diagnosis") or {}
+    after_modes = (diag.get("after") or {}).get("modes") or {}
+    for mode, m in (val.get("modes") or {}).items():
+        windows = m.get("located_windows") or []
+        after = after_modes.get(mode) or {}
+        figs = []
+        for sig, ov in (m.get("overlays") or {}).items():
+            label, unit, scale = SIGNAL_DISPLAY.get(sig, (sig, ov.get("unit", ""), 1.0))
+            series = [("recorded", ov.get("time"), ov.get("recorded"), "recorded"),
+                      ("simulated" + (" (before)" if after else ""), ov.get("time"), ov.get("simulated"), "before")]
+            aov = (after.get("overlays") or {}).get(sig)
+            if aov:
+                series.append(("simulated (after)", aov.get("time"), aov.get("simulated"), "after"))
+            fid = f"fig-{start + len(specs)}"
+            specs.append({"id": fid, "kind": "waveform", "series": series, "scale": scale, "ylabel": f"{label} [{unit}]",
+                          "windows": [(w["start"], w["end"]) for w in windows if w.get("signal") == sig]})
+            figs.append({"id": fid, "signal": label, "role": ov.get("role")})
+        fits = [{"signal": SIGNAL_DISPLAY.get(s, (s,))[0], "fit": fmt_num(f.get("fit_percent"), 3),
+                 "nrmse": fmt_num(f.get("nrmse"), 3), "rms": _sig(f.get("rms_error"), s), "max": _sig(f.get("max_abs_error"), s),
+                 "fit_after": fmt_num(((after.get("fits") or {}).get(s) or {}).get("fit_percent"), 3) if after else None}
+                for s, f in (m.get("fits") or {}).items()]
+        rows = _window_table(m.get("window_metrics") or [])
+        located = [{"signal": SIGNAL_DISPLAY.get(w.get("signal"), (w.get("signal"),))[0], "start": fmt_num(w.get("start"), 4),
+                    "end": fmt_num(w.get("end"), 4), "peak_ratio": fmt_num(w.get("peak_ratio"), 3),
+                    "regimes": ", ".join(w.get("dominant") or [])} for w in windows]
+        modes.append({"name": mode, "pass": m.get("pass"), "figures": figs, "fits": fits, "rows": rows, "located": located,
+                      "has_after": bool(after)})
+    added = []
+    for eff in diag.get("added") or diag.get("effects") or []:
+        added.append({"name": eff.get("name"), "meaning": eff.get("meaning") or "",
+                      "params": [{"name": p.get("name"), "value": fmt_num(p.get("value"), 4), "unit": pretty_unit(p.get("unit", "")),
+                                  "bounds": " .. ".join(fmt_num(b, 3) for b in (p.get("bounds") or []))}
+                                 for p in eff.get("params") or []]})
+    rec = val.get("recording") or {}
+    ctx = {"recording": rec, "plant": val.get("plant") or {}, "conditions": val.get("conditions") or {},
+           "modes": modes, "added": added, "diagnosis": bool(diag), "explanation": diag.get("explanation"),
+           "warnings": val.get("warnings") or [], "pass": (val.get("summary") or {}).get("pass")}
+    return ctx, specs
+
+
+def _window_table(metrics: list) -> dict:
+    """Windowed errors pivoted: one row per window, one cell per signal (max / mean |error| [pu])."""
+    signals, rows, index = [], [], {}
+    for r in metrics:
+        sig = r.get("signal")
+        if sig not in signals:
+            signals.append(sig)
+        key = (r.get("window"), r.get("kind"), r.get("start"))
+        if key not in index:
+            index[key] = {"window": r.get("window"), "kind": r.get("kind"), "cells": {}, "pass": True}
+            rows.append(index[key])
+        row = index[key]
+        row["cells"][sig] = {"text": f"{_pct(r.get('max_error'))} / {_pct(r.get('mean_absolute_error'))}",
+                             "pass": r.get("pass"), "failed": ", ".join(r.get("failed") or [])}
+        row["pass"] = row["pass"] and bool(r.get("pass"))
+    for row in rows:
+        row["cells"] = [row["cells"].get(sig) for sig in signals]
+    limits = {}
+    for r in metrics:
+        limits.setdefault((r.get("signal"), r.get("kind")), r.get("limits") or {})
+    lim_rows = [{"signal": SIGNAL_DISPLAY.get(sg, (sg,))[0], "kind": k,
+                 "text": ", ".join(f"{name.replace('_', ' ')} {_pct(v)} %" for name, v in lim.items() if v is not None)}
+                for (sg, k), lim in limits.items()]
+    return {"signals": [SIGNAL_DISPLAY.get(sg, (sg,))[0] for sg in signals], "rows": rows, "limits": lim_rows}
+
+
+def _pct(v) -> str:
+    """A per-unit error as per cent of its base, two decimals (``0.00056`` -> ``0.06``)."""
+    return "\u2013" if v is None else f"{100.0 * v:.2f}"
+
+
+def _sig(v, signal):
+    if v is None:
+        return "\u2013"
+    label, unit, scale = SIGNAL_DISPLAY.get(signal, (signal, "", 1.0))
+    return f"{fmt_num(v * scale, 3)} {unit}"

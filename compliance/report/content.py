@@ -1,0 +1,310 @@
+"""Results dict (docs/results-schema.md) -> what the compliance report shows.
+
+Checks the keys the report needs (bad input -> ``InputError`` naming the key), formats numbers
+with units, groups runs by procedure and lists the figures to draw. No rendering here: the
+figures are produced by :mod:`compliance.report.figures` from the specs built below, the
+text by the jinja2 templates.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import hashlib
+import math
+import shlex
+
+from ..errors import InputError
+from ..metrics import METRICS
+
+RESULTS_SCHEMA = "govcheck-results/1"
+STATUS_WORD = {"pass": "PASS", "fail": "FAIL", "not_evaluated": "NOT EVALUATED", "open": "OPEN",
+               "disabled": "DISABLED", "incomplete": "INCOMPLETE"}
+# metrics whose limit is a position tolerance drawn as the error band on the run's plot
+TOLERANCE_METRICS = ("max_positioning_error", "tracking_max_error", "steady_state_error")
+SOURCES = ("paper", "assumed", "derived", "user")
+
+_REQUIRED = {
+    "plant": ("name", "digest", "parameters"),
+    "requirement_set": ("name", "path", "digest", "requirements"),
+    "summary": ("status", "counts"),
+}
+_REQ_KEYS = ("id", "title", "metric", "status", "severity", "limit_text", "rows")
+_RUN_KEYS = ("id", "procedure", "operating_point", "kind", "traces")
+
+
+def _need(obj, key, where, typ=None):
+    if not isinstance(obj, dict) or key not in obj:
+        raise InputError(f"{where}: key '{key}' is missing (expected a govcheck results file, schema '{RESULTS_SCHEMA}')")
+    v = obj[key]
+    if typ is not None and not isinstance(v, typ):
+        raise InputError(f"{where}: key '{key}' should be a {typ.__name__ if isinstance(typ, type) else 'list'}, "
+                         f"got {type(v).__name__}")
+    return v
+
+
+def check_results(results, where: str = "results") -> None:
+    """Check a results dict has everything the report needs.
+
+    Raises
+    ------
+    InputError
+        Wrong schema version, or a missing / mistyped key (named with its path).
+    """
+    if not isinstance(results, dict):
+        raise InputError(f"{where}: expected a JSON object (a govcheck results file), got {type(results).__name__}")
+    schema = _need(results, "schema", where)
+    if schema != RESULTS_SCHEMA:
+        raise InputError(f"{where}: key 'schema' is '{schema}'; this govcheck reads '{RESULTS_SCHEMA}' "
+                         "(re-run 'govcheck check' to regenerate the results)")
+    for section, keys in _REQUIRED.items():
+        sec = _need(results, section, where, dict)
+        for k in keys:
+            _need(sec, k, f"{where}: {section}")
+    reqs = _need(results, "requirements", where, list)
+    for i, e in enumerate(reqs):
+        for k in _REQ_KEYS:
+            _need(e, k, f"{where}: requirements[{i}]")
+    runs = results.get("runs") or []
+    if not isinstance(runs, list):
+        raise InputError(f"{where}: key 'runs' should be a list, got {type(runs).__name__}")
+    for i, r in enumerate(runs):
+        for k in _RUN_KEYS:
+            _need(r, k, f"{where}: runs[{i}]")
+
+
+# --------------------------------------------------------------------------- formatting
+_SUPERSCRIPT = str.maketrans("-0123456789", "\u207b\u2070\u00b9\u00b2\u00b3\u2074\u2075\u2076\u2077\u2078\u2079")
+
+
+def fmt_num(v, digits: int = 4) -> str:
+    """A float for a table: 4 significant digits, plain notation where reasonable."""
+    if v is None:
+        return "\u2013"
+    if isinstance(v, bool):
+        return "yes" if v else "no"
+    if not isinstance(v, (int, float)):
+        return str(v)
+    if not math.isfinite(v):
+        return "\u2013"
+    if v == 0:
+        return "0"
+    a = abs(v)
+    if 1e-3 <= a < 10**digits:
+        s = f"{v:.{digits}g}"
+    elif 10**digits <= a < 1e7:
+        s = f"{v:.0f}"  # 800000 Pa, 12000 N: whole numbers read better than mantissas
+    else:
+        m, e = f"{v:.{digits - 1}e}".split("e")
+        mant = m.rstrip("0").rstrip(".") if "." in m else m
+        s = f"{mant}\u00d710{str(int(e)).translate(_SUPERSCRIPT)}"
+    return s.replace("-", "\u2212")
+
+
+def fmt_metric(value, metric: str) -> str:
+    """A SI value of ``metric`` in its display unit (``0.0016`` m -> ``1.6 mm``)."""
+    if value is None:
+        return "\u2013"
+    info = METRICS.get(metric)
+    if info is None:
+        return fmt_num(value)
+    unit = info.display_unit
+    return f"{fmt_num(value * info.display_scale, 3)} {unit}".strip()
+
+
+_UNIT_PRETTY = (("Pa^0.5", "\u221aPa"), ("^3", "\u00b3"), ("^2", "\u00b2"), ("*", "\u00b7"))
+
+
+def pretty_unit(unit: str) -> str:
+    """``m^3/(s*Pa)`` -> ``m³/(s·Pa)``; ``""`` -> ``–`` (dimensionless)."""
+    if not unit:
+        return "\u2013"
+    if unit == "number":
+        return "(see meaning)"
+    for a, b in _UNIT_PRETTY:
+        unit = unit.replace(a, b)
+    return unit
+
+
+def fmt_date(iso: str | None) -> str:
+    """ISO time stamp -> ``2026-05-10 12:00 UTC``."""
+    if not iso:
+        return "\u2013"
+    try:
+        d = _dt.datetime.fromisoformat(str(iso))
+    except ValueError:
+        return str(iso)
+    if d.tzinfo is not None:
+        d = d.astimezone(_dt.timezone.utc)
+        return d.strftime("%Y-%m-%d %H:%M UTC")
+    return d.strftime("%Y-%m-%d %H:%M")
+
+
+def status_class(status: str | None) -> str:
+    """CSS class of a status badge."""
+    return {"pass": "pass", "fail": "fail", "incomplete": "warn", "not_evaluated": "warn"}.get(status or "", "neutral")
+
+
+def status_word(status: str | None) -> str:
+    """Upper-case word of a status."""
+    return STATUS_WORD.get(status or "", str(status or "\u2013").upper())
+
+
+# --------------------------------------------------------------------------- sections
+def _display(row: dict, metric: str) -> dict:
+    d = dict(row.get("display") or {})
+    d.setdefault("value", fmt_metric(row.get("value"), metric))
+    if not d.get("limit") and row.get("limit"):
+        d["limit"] = " .. ".join(fmt_metric(v, metric) for v in row["limit"])
+    d.setdefault("margin", fmt_metric(row.get("margin"), metric))
+    if d.get("margin_pct") is None and row.get("margin_pct") is not None:
+        d["margin_pct"] = f"{row['margin_pct']:+.1f} %"
+    return d
+
+
+def summary_rows(results: dict) -> list[dict]:
+    """One row per requirement: worst value, limit, margin, status, where the worst case was."""
+    out = []
+    run_ids = {r.get("id") for r in results.get("runs") or []}
+    for e in results["requirements"]:
+        w = e.get("worst") or {}
+        d = _display(w, e["metric"]) if w else {}
+        reason = None
+        if e["status"] == "not_evaluated":
+            reason = "; ".join(sorted({r.get("reason") for r in e["rows"] if r.get("reason")})) or "not evaluated"
+        where = None
+        if w:
+            where = w.get("run") or f"{w.get('procedure')}@{w.get('operating_point')}"
+        out.append({
+            "id": e["id"], "title": e["title"], "metric": e["metric"], "severity": e["severity"],
+            "source": e.get("source", "simulation"), "standard": e.get("standard"), "clause": e.get("clause"),
+            "limit_text": e["limit_text"],
+            "limit": d.get("limit") or ("open" if e.get("limit") is None else (e.get("limit_display") or e["limit_text"])),
+            "value": d.get("value", "\u2013"), "margin": d.get("margin", "\u2013") if w.get("margin") is not None else "\u2013",
+            "margin_pct": d.get("margin_pct"), "status": e["status"], "where": where, "which": w.get("which"),
+            "procedure": w.get("procedure"), "operating_point": w.get("operating_point"), "reason": reason,
+            "anchor": "run-" + _slug(where) if where in run_ids else None,
+            "note": e.get("note"), "loosened": e.get("loosened") or [],
+        })
+    return out
+
+
+def _run_evidence(results: dict, run_id: str) -> list[dict]:
+    """Requirement rows judged on one run, with every sample measured for them."""
+    rows = []
+    for e in results["requirements"]:
+        for r in e["rows"]:
+            if r.get("run") != run_id:
+                continue
+            d = _display(r, e["metric"])
+            samples = []
+            for s in r.get("samples") or []:
+                samples.append({"label": s.get("label"), "value": s.get("display") or fmt_metric(s.get("value"), e["metric"]),
+                                "excluded": not s.get("eligible", True) or s.get("value") is None, "reason": s.get("reason")})
+            rows.append({"id": e["id"], "metric": e["metric"], "value": d.get("value"), "which": r.get("which"),
+                         "limit": d.get("limit") or ("open" if e.get("limit") is None else e["limit_text"]), "margin": d.get("margin") if r.get("margin") is not None else "\u2013",
+                         "margin_pct": d.get("margin_pct"), "status": r.get("status"), "reason": r.get("reason"),
+                         "samples": samples})
+    return rows
+
+
+def _tolerance(results: dict, run_id: str):
+    """Smallest position tolerance [m] a requirement applies to this run (the error band), or None."""
+    tol = []
+    for e in results["requirements"]:
+        if e["metric"] not in TOLERANCE_METRICS:
+            continue
+        for r in e["rows"]:
+            lim = r.get("limit")
+            if r.get("run") == run_id and lim:
+                tol.append(max(lim))
+    return min(tol) if tol else None
+
+
+def _params_by_key(results: dict) -> dict:
+    return {p.get("key"): p.get("value") for p in results["plant"]["parameters"] if isinstance(p, dict)}
+
+
+def valve_marks(results: dict) -> dict:
+    """Valve full-opening voltage and dead zone [V] for the command panels (from the plant)."""
+    p = _params_by_key(results)
+    out = {}
+    if p.get("valve.saturation_voltage"):
+        out["saturation_voltage"] = p["valve.saturation_voltage"]
+    if p.get("valve.dead_zone_positive") or p.get("valve.dead_zone_negative"):
+        out["dead_zone"] = [p.get("valve.dead_zone_positive") or 0.0, p.get("valve.dead_zone_negative") or 0.0]
+    if p.get("valve.command_limit"):
+        out["command_limit"] = p["valve.command_limit"]
+    return out
+
+
+def procedure_sections(results: dict) -> tuple[list[dict], list[dict]]:
+    """Runs grouped by procedure (in the requirement set's order) and the figure specs.
+
+    Returns
+    -------
+    (sections, figure_specs)
+        ``figure_specs`` items: ``{"id", "kind": "trace", "trace", "marks", "run_kind",
+        "tolerance"}``; a section's runs refer to their figures by ``id``.
+    """
+    rs = results["requirement_set"]
+    procs = rs.get("procedures") or {}
+    ops = rs.get("operating_points") or {}
+    runs = results.get("runs") or []
+    order = list(procs) + sorted({r["procedure"] for r in runs} - set(procs))
+    specs, sections = [], []
+    for pname in order:
+        pruns = [r for r in runs if r["procedure"] == pname]
+        if not pruns:
+            continue
+        p = procs.get(pname) or {}
+        op_order = list(ops)
+        pruns.sort(key=lambda r: op_order.index(r["operating_point"]) if r["operating_point"] in op_order else len(op_order))
+        items = []
+        for run in pruns:
+            figs = []
+            tol = _tolerance(results, run["id"])
+            for j, tr in enumerate(run.get("traces") or []):
+                fid = f"fig-{len(specs) + 1}"
+                specs.append({"id": fid, "kind": "trace", "trace": tr, "marks": run.get("marks") or [],
+                              "run_kind": run["kind"], "tolerance": tol})
+                figs.append({"id": fid, "label": tr.get("label") or run["id"], "points": tr.get("points"),
+                             "samples": tr.get("samples")})
+            op = ops.get(run["operating_point"]) or {}
+            items.append({"id": run["id"], "anchor": "run-" + _slug(run["id"]), "operating_point": run["operating_point"],
+                          "op_title": op.get("title"), "initial_position": op.get("initial_position"),
+                          "load": op.get("load_text") if op.get("load_text") is not None else op.get("load"),
+                          "flow_control": op.get("flow_control"), "error": run.get("error"), "notes": run.get("notes") or [],
+                          "evidence": _run_evidence(results, run["id"]), "figures": figs, "tolerance": tol,
+                          "wall_time": run.get("wall_time")})
+        settings = p.get("settings") or {}
+        sections.append({"name": pname, "anchor": "proc-" + _slug(pname), "title": p.get("title") or pname,
+                         "kind": p.get("kind") or pruns[0]["kind"], "settings": settings, "note": p.get("note"),
+                         "runs": items})
+    return sections, specs
+
+
+def _slug(text: str) -> str:
+    """An id-safe slug of a user string (ids must not carry markup or spaces)."""
+    text = str(text)
+    out = "".join(c if (c.isascii() and c.isalnum()) or c in "-_" else "-" for c in text)
+    if out == text and out:
+        return out
+    return (out.strip("-") or "x")[:60] + "-" + hashlib.sha1(text.encode("utf-8")).hexdigest()[:8]
+
+
+def parameter_rows(results: dict) -> list[dict]:
+    """Appendix table: every configuration parameter with value, unit, meaning and source."""
+    rows = []
+    for p in sorted(results["plant"]["parameters"], key=lambda q: str(q.get("key"))):
+        src = p.get("source") or "\u2013"
+        rows.append({"key": p.get("key"), "value": fmt_num(p.get("value"), 6), "unit": pretty_unit(p.get("unit", "")),
+                     "meaning": p.get("meaning") or "", "source": src, "source_class": src if src in SOURCES else "other"})
+    return rows
+
+
+def command_text(results: dict) -> str:
+    """The exact command line that produced the results."""
+    c = results.get("command_line") or results.get("command")
+    if isinstance(c, list):
+        return shlex.join(str(x) for x in c)
+    return str(c) if c else "not recorded"

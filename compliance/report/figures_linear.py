@@ -1,0 +1,163 @@
+"""Report figures of the linear analysis: operating maps, Bode diagrams, pole maps.
+
+Inputs are the plain-JSON forms written by ``compliance.linear`` (``LinearAnalysis.to_dict``)
+and ``compliance.linear_maps`` (``OperatingMap.to_dict``), in SI units (s, Hz, dB, deg, m, N).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.colors import ListedColormap
+
+from .svg import COLORS, message_axes, new_figure, plain, styled, to_svg
+
+MAP_QUANTITIES = {  # name -> (label, unit, display scale, requirement-window key or None)
+    "time_constant": ("time constant", "ms", 1e3, "window"),
+    "gain_margin_db": ("gain margin", "dB", 1.0, None),
+    "phase_margin_deg": ("phase margin", "deg", 1.0, None),
+    "bandwidth_hz": ("bandwidth", "Hz", 1.0, None),
+    "damping_ratio": ("least damping ratio", "\u2013", 1.0, None),
+}
+
+
+def _load_labels(loads):
+    out = []
+    for ld in loads:
+        if ld is None:
+            out.append("none")
+        elif isinstance(ld, str):
+            out.append(ld)
+        else:
+            out.append(f"{ld / 1e3:+.1f} kN")
+    return out
+
+
+@styled
+def map_figure(omap: dict, name: str, prefix: str) -> str:
+    """Heat map of one linear figure over stroke x load, the requirement window outlined.
+
+    Parameters
+    ----------
+    omap : dict
+        ``positions`` [m], ``loads`` (N / "curve" / None), ``values[name][i][j]`` at load i,
+        position j (None: no trim), ``window`` [s] for the time constant.
+    name : str
+        Key of ``MAP_QUANTITIES``.
+    """
+    label, unit, scale, wkey = MAP_QUANTITIES[name]
+    fig, ax = new_figure("map")
+    vals = omap.get("values", {}).get(name)
+    pos = np.asarray(omap.get("positions") or [], float)
+    if not vals or pos.size == 0:
+        message_axes(ax, f"{label}: not in the results")
+        return to_svg(fig, prefix)
+    z = np.array([[np.nan if v is None else v * scale for v in row] for row in vals], float)
+    cmap = ListedColormap(["#f7fbff", "#deebf7", "#c6dbef", "#9ecae1", "#6baed6", "#4292c6", "#2171b5", "#08519c"])
+    cmap.set_bad("#e0e0e0")
+    # pcolormesh, not imshow: cells stay vector rectangles (imshow would embed a raster image)
+    im = ax.pcolormesh(np.arange(pos.size + 1) - 0.5, np.arange(len(vals) + 1) - 0.5, np.ma.masked_invalid(z),
+                       cmap=cmap, shading="flat", edgecolors="white", linewidth=0.6)
+    ax.set_xlim(-0.5, pos.size - 0.5)
+    ax.set_ylim(-0.5, len(vals) - 0.5)
+    ax.set_xticks(range(pos.size), [f"{x * 1e3:.0f}" for x in pos])
+    ax.set_yticks(range(len(vals)), [plain(x) for x in _load_labels(omap.get("loads") or [None] * len(vals))])
+    ax.set_xlabel("position [mm]")
+    ax.set_ylabel("closing load")
+    ax.grid(False)
+    cb = fig.colorbar(im, ax=ax, pad=0.015, fraction=0.04)
+    cb.set_label(f"{label} [{unit}]")
+    cb.outline.set_linewidth(0.4)
+    win = omap.get(wkey) if wkey else None
+    for i in range(z.shape[0]):
+        for j in range(z.shape[1]):
+            v = z[i, j]
+            if not np.isfinite(v):
+                ax.text(j, i, "no trim", ha="center", va="center", fontsize=5.5, color="#666666")
+                continue
+            outside = win is not None and not (win[0] * scale <= v <= win[1] * scale)
+            dark = im.norm(v) > 0.6
+            ax.text(j, i, f"{v:.0f}" if abs(v) >= 10 else f"{v:.2g}", ha="center", va="center", fontsize=6,
+                    color="white" if dark else "#1f2a33", fontweight="bold" if outside else "normal")
+            if outside:  # cells outside the requirement window: red outline
+                ax.add_patch(_cell(j, i, COLORS["limit"]))
+    if win is not None:
+        ax.plot([], [], "s", mfc="none", mec=COLORS["limit"], label=f"outside {win[0] * scale:g}\u2013{win[1] * scale:g} {unit}")
+        ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=2, borderaxespad=0.2)
+    fig.subplots_adjust(left=0.12, right=0.93, top=0.9, bottom=0.15)
+    return to_svg(fig, prefix)
+
+
+def _cell(j, i, color):
+    from matplotlib.patches import Rectangle
+
+    return Rectangle((j - 0.46, i - 0.46), 0.92, 0.92, fill=False, ec=color, lw=1.0)
+
+
+@styled
+def bode_figure(analyses: list, prefix: str) -> str:
+    """Bode magnitude and phase of the sampled loop L at each critical point.
+
+    Parameters
+    ----------
+    analyses : list of (label, dict)
+        ``dict`` is ``LinearAnalysis.to_dict()`` with ``bode`` arrays (frequency [Hz],
+        ``loop_discrete_magnitude_db`` / ``loop_magnitude_db``, ``..._phase_deg``).
+    """
+    fig, (am, ap) = new_figure("bode", 2, 1, sharex=True, gridspec_kw={"hspace": 0.1})
+    shown = 0
+    palette = ["#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9"]
+    for k, (label, a) in enumerate(analyses):
+        b = a.get("bode") or {}
+        f = b.get("frequency_hz")
+        mag = b.get("loop_discrete_magnitude_db") or b.get("loop_magnitude_db")
+        ph = b.get("loop_discrete_phase_deg") or b.get("loop_phase_deg")
+        if not f or not mag:
+            continue
+        c = palette[k % len(palette)]
+        am.semilogx(f, mag, color=c, label=plain(label))
+        if ph:
+            ap.semilogx(f, ph, color=c)
+        figs = a.get("figures") or {}
+        if figs.get("gain_crossover_hz") and figs.get("phase_margin_deg") is not None:
+            ap.plot(figs["gain_crossover_hz"], figs["phase_margin_deg"] - 180.0, "o", ms=3.5, mfc="white", mec=c)
+        shown += 1
+    if not shown:
+        message_axes(am, "no Bode data in the results")
+        message_axes(ap, "")
+        return to_svg(fig, prefix)
+    am.axhline(0.0, color="#333333", lw=0.6)
+    ap.axhline(-180.0, color="#333333", lw=0.6)
+    am.set_ylabel("|L| [dB]")
+    ap.set_ylabel("phase [deg]")
+    ap.set_xlabel("frequency [Hz]")
+    am.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=4, borderaxespad=0.2)
+    fig.subplots_adjust(left=0.1, right=0.985, top=0.9, bottom=0.12)
+    return to_svg(fig, prefix)
+
+
+@styled
+def pole_figure(analyses: list, prefix: str) -> str:
+    """Closed-loop poles (continuous) at each critical point, with the 0.25 s time-constant line."""
+    fig, ax = new_figure("map")
+    palette = ["#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9"]
+    shown = 0
+    for k, (label, a) in enumerate(analyses):
+        poles = (a.get("poles") or {}).get("closed_loop")
+        if not poles:
+            continue
+        p = np.asarray(poles, float).reshape(-1, 2)
+        ax.plot(p[:, 0], p[:, 1], "x", ms=5, mew=1.2, color=palette[k % len(palette)], label=plain(label))
+        shown += 1
+    if not shown:
+        message_axes(ax, "no pole data in the results")
+        return to_svg(fig, prefix)
+    ax.set_xscale("symlog", linthresh=10.0)
+    ax.set_yscale("symlog", linthresh=10.0)
+    for tau, ls in ((0.25, (0, (4, 2))), (0.10, ":")):
+        ax.axvline(-1.0 / tau, color=COLORS["limit"], lw=0.7, ls=ls, label=f"\u03c4 = {tau:g} s")
+    ax.axvline(0.0, color="#333333", lw=0.6)
+    ax.set_xlabel("real part [1/s] (symmetric log)")
+    ax.set_ylabel("imaginary part [rad/s]")
+    ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=3, borderaxespad=0.2)
+    fig.subplots_adjust(left=0.1, right=0.985, top=0.8, bottom=0.16)
+    return to_svg(fig, prefix)

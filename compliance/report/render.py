@@ -1,0 +1,308 @@
+"""Render compliance and validation reports: one self-contained HTML file and its PDF.
+
+The HTML is rendered with jinja2 (autoescaping on: every name from a user file is escaped),
+CSS inlined, figures inline SVG; it references nothing outside itself. The PDF is the same
+document laid out by WeasyPrint (A4, running header with the plant name, page numbers, table
+of contents with page numbers); there the figures are the same SVG passed as data URIs, which
+WeasyPrint draws without running its HTML cascade over every SVG node (~20x faster).
+
+Writing is atomic: everything is rendered in memory first, then each file is written to a
+temporary file in its target folder and moved over the target with ``os.replace``; a failed
+render leaves no partial file and any previous report intact.
+"""
+
+from __future__ import annotations
+
+import base64
+import datetime as _dt
+import os
+import platform
+import tempfile
+import time
+from importlib import resources
+from pathlib import Path
+
+import jinja2
+
+from .. import __version__
+from ..errors import InputError
+from . import content as C
+from .analysis_sections import linear_section, validation_section
+
+TEMPLATES = resources.files("compliance.report") / "templates"
+VALIDATION_SCHEMA = "govcheck.validation/1"
+_FIG_CTX: dict = {}  # figure specs, set before worker processes fork (no pickling of traces)
+
+
+# --------------------------------------------------------------------------- figures
+def _draw(spec: dict, valve: dict | None = None) -> str:
+    from . import figures, figures_linear
+
+    k = spec["kind"]
+    if k == "trace":
+        return figures.trace_figure(spec["trace"], spec["marks"], spec["run_kind"], spec["id"],
+                                    tolerance=spec.get("tolerance"), valve=valve)
+    if k == "map":
+        return figures_linear.map_figure(spec["omap"], spec["name"], spec["id"])
+    if k == "bode":
+        return figures_linear.bode_figure(spec["analyses"], spec["id"])
+    if k == "poles":
+        return figures_linear.pole_figure(spec["analyses"], spec["id"])
+    if k == "waveform":
+        sc = spec.get("scale", 1.0)
+        series = [(lab, t, [float("nan") if v is None else v * sc for v in y], role)
+                  for lab, t, y, role in spec["series"] if t is not None and y is not None]
+        return figures.waveform_figure(series, spec["id"], ylabel=spec["ylabel"], windows=spec.get("windows") or ())
+    raise ValueError(f"unknown figure kind {k!r}")
+
+
+def _draw_chunk(indices):
+    specs, valve = _FIG_CTX["specs"], _FIG_CTX["valve"]
+    return [(i, _draw(specs[i], valve)) for i in indices]
+
+
+def draw_figures(specs: list[dict], valve: dict | None = None, workers: int | None = None) -> dict:
+    """Draw every figure spec -> ``{id: svg}``; in parallel (forked workers) when it pays."""
+    n = len(specs)
+    if workers is None:
+        try:
+            workers = len(os.sched_getaffinity(0))
+        except AttributeError:  # pragma: no cover - not Linux
+            workers = os.cpu_count() or 1
+    import multiprocessing as mp
+
+    workers = max(1, min(workers, n // 4))  # a worker pays off from ~4 figures (fork + import ~0.2 s)
+    out = {}
+    if workers == 1 or "fork" not in mp.get_all_start_methods():
+        for s in specs:
+            out[s["id"]] = _draw(s, valve)
+        return out
+    from concurrent.futures import ProcessPoolExecutor
+
+    _FIG_CTX.update(specs=specs, valve=valve)
+    try:
+        chunks = [list(range(w, n, workers)) for w in range(workers)]  # interleaved: similar costs per worker
+        with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("fork")) as pool:
+            for part in pool.map(_draw_chunk, chunks):
+                for i, svg in part:
+                    out[specs[i]["id"]] = svg
+    finally:
+        _FIG_CTX.clear()
+    return out
+
+
+def _svg_data_uri(svg: str) -> str:
+    """A standalone SVG document as a data URI (namespaces restored) for WeasyPrint."""
+    doc = svg.replace("<svg", '<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink"', 1)
+    return "data:image/svg+xml;base64," + base64.b64encode(doc.encode("utf-8")).decode("ascii")
+
+
+# --------------------------------------------------------------------------- templates
+def _environment() -> jinja2.Environment:
+    env = jinja2.Environment(
+        loader=jinja2.FileSystemLoader(str(TEMPLATES)),
+        autoescape=True,  # every template, whatever its extension: user strings never become markup
+        # lenient: an optional key a producer left out renders as nothing, never a crash
+        undefined=jinja2.ChainableUndefined,
+        trim_blocks=True,
+        lstrip_blocks=True,
+    )
+    env.filters.update(status_class=C.status_class, status_word=C.status_word, num=C.fmt_num)
+    return env
+
+
+def _css() -> str:
+    return (TEMPLATES / "style.css").read_text(encoding="utf-8")
+
+
+def _render(template: str, ctx: dict, svgs: dict, for_pdf: bool) -> str:
+    env = _environment()
+
+    def figure(fid):
+        svg = svgs.get(fid)
+        if svg is None:
+            return jinja2.utils.markupsafe.Markup('<p class="missing">figure not available</p>')
+        if for_pdf:
+            return jinja2.utils.markupsafe.Markup(f'<img class="figure-img" alt="" src="{_svg_data_uri(svg)}">')
+        return jinja2.utils.markupsafe.Markup(svg)  # our own SVG, user text never inside (see svg.py)
+
+    return env.get_template(template).render(**ctx, css=jinja2.utils.markupsafe.Markup(_css()), figure=figure,
+                                             for_pdf=for_pdf)
+
+
+def _pdf_bytes(html: str) -> bytes:
+    import logging
+
+    import weasyprint
+    from weasyprint.urls import URLFetcher
+
+    logging.getLogger("weasyprint").setLevel(logging.ERROR)  # font-subsetting chatter
+    # data: URIs only (the figures): the document is self-contained by construction, and a
+    # stray reference fails the render instead of reaching the network or the disk
+    fetcher = URLFetcher(allowed_protocols=("data",), fail_on_errors=True)
+    return weasyprint.HTML(string=html, base_url=None, url_fetcher=fetcher).write_pdf()
+
+
+# --------------------------------------------------------------------------- writing
+def _check_target(path, flag: str) -> Path:
+    p = Path(path)
+    folder = p.parent if str(p.parent) else Path(".")
+    if not folder.is_dir():
+        raise InputError(f"{flag} {p}: folder '{folder}' does not exist")
+    if p.is_dir():
+        raise InputError(f"{flag} {p}: is a folder; expected a file name")
+    return p
+
+
+def write_atomic(path, data: bytes) -> None:
+    """Write ``data`` to ``path`` via a temporary file in the same folder and ``os.replace``."""
+    p = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent if str(p.parent) else ".")
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # a report is for reading: ordinary file permissions
+        os.replace(tmp, p)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+
+
+def _emit(template: str, ctx: dict, svgs: dict, html_path, pdf_path) -> dict:
+    """Render HTML and PDF fully in memory, then write both atomically; returns timings [s]."""
+    t0 = time.perf_counter()
+    html = _render(template, ctx, svgs, for_pdf=False) if html_path else None
+    t1 = time.perf_counter()
+    pdf = _pdf_bytes(_render(template, ctx, svgs, for_pdf=True)) if pdf_path else None
+    t2 = time.perf_counter()
+    if html is not None:
+        write_atomic(html_path, html.encode("utf-8"))
+    if pdf is not None:
+        write_atomic(pdf_path, pdf)
+    return {"html": t1 - t0, "pdf": t2 - t1}
+
+
+def _now() -> str:
+    return _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+
+
+def _common(results: dict) -> dict:
+    v = dict(results.get("versions") or {})
+    v.setdefault("govcheck", __version__)
+    v.setdefault("python", platform.python_version())
+    try:
+        import matplotlib
+        import weasyprint
+
+        v.setdefault("matplotlib (report)", matplotlib.__version__)
+        v.setdefault("weasyprint (report)", weasyprint.__version__)
+        v.setdefault("jinja2 (report)", jinja2.__version__)
+    except ImportError:  # pragma: no cover - both are dependencies
+        pass
+    return {"versions": v, "rendered": C.fmt_date(_now()), "govcheck_version": __version__}
+
+
+# --------------------------------------------------------------------------- API
+def build_report(results: dict, workers: int | None = None) -> tuple[dict, dict]:
+    """Check the results and build the template context and the figures (no file written)."""
+    C.check_results(results)
+    sections, specs = C.procedure_sections(results)
+    lin_ctx, lin_specs = linear_section(results.get("linear"), len(specs) + 1)
+    val_ctx, val_specs = validation_section(results.get("validation"), len(specs) + len(lin_specs) + 1)
+    svgs = draw_figures(specs + lin_specs + val_specs, C.valve_marks(results), workers)
+    plant, rs, summary = results["plant"], results["requirement_set"], results["summary"]
+    ctx = {
+        **_common(results),
+        "plant": plant,
+        "rs": rs,
+        "summary": summary,
+        "verdict": summary["status"],
+        "created": C.fmt_date(results.get("created")),
+        "rows": C.summary_rows(results),
+        "sections": sections,
+        "linear": lin_ctx,
+        "validation": val_ctx,
+        "parameters": C.parameter_rows(results),
+        "options": sorted((plant.get("options") or {}).items()),
+        "effects": plant.get("effects") or [],
+        "load_curve": plant.get("load_curve"),
+        "provenance": sorted((plant.get("provenance") or {}).items()),
+        "command": C.command_text(results),
+        "timing": results.get("timing") or {},
+    }
+    return ctx, svgs
+
+
+def render_report(results: dict, html_path=None, pdf_path=None, *, workers: int | None = None) -> None:
+    """Render the compliance report of a ``govcheck check`` results dict.
+
+    Parameters
+    ----------
+    results : dict
+        Results of ``compliance.harness.run_campaign`` (schema ``govcheck-results/1``,
+        docs/results-schema.md), optionally with ``linear`` (``govcheck linear --json``) and
+        ``validation`` (``compliance.validation.validate``) entries.
+    html_path, pdf_path : path, optional
+        Where to write the HTML and the PDF; at least one.
+    workers : int, optional
+        Processes drawing figures (default: the available cores).
+
+    Raises
+    ------
+    InputError
+        Bad results (missing key, wrong schema version) or a target folder that does not exist.
+    """
+    if not html_path and not pdf_path:
+        raise InputError("render_report: give html_path and/or pdf_path")
+    if html_path:
+        _check_target(html_path, "--report")
+    if pdf_path:
+        _check_target(pdf_path, "--pdf")
+    ctx, svgs = build_report(results, workers)
+    _emit("report.html.j2", ctx, svgs, html_path, pdf_path)
+
+
+def check_validation(result, where: str = "validation results") -> None:
+    """Check a validation result has what its report needs (``InputError`` naming the key)."""
+    if not isinstance(result, dict):
+        raise InputError(f"{where}: expected a JSON object, got {type(result).__name__}")
+    schema = result.get("schema")
+    if schema is None:
+        raise InputError(f"{where}: key 'schema' is missing (expected '{VALIDATION_SCHEMA}')")
+    if schema != VALIDATION_SCHEMA:
+        raise InputError(f"{where}: key 'schema' is '{schema}'; expected '{VALIDATION_SCHEMA}'")
+    for key in ("recording", "plant", "modes", "summary"):
+        if key not in result:
+            raise InputError(f"{where}: key '{key}' is missing")
+    if not isinstance(result["modes"], dict):
+        raise InputError(f"{where}: key 'modes' should be an object of replay modes")
+
+
+def render_validation_report(result: dict, html_path, pdf_path=None, *, workers: int | None = None) -> None:
+    """Render the model-validation report of ``govcheck validate`` / ``govcheck diagnose``.
+
+    Parameters
+    ----------
+    result : dict
+        ``compliance.validation.validate`` output (schema ``govcheck.validation/1``), optionally
+        with ``diagnosis`` (``after``: a validation result of the model with the physics added;
+        ``added``: effects with fitted parameters; ``explanation``: text).
+    html_path : path
+    pdf_path : path, optional
+    """
+    _check_target(html_path, "--report")
+    if pdf_path:
+        _check_target(pdf_path, "--pdf")
+    check_validation(result)
+    ctx, specs = validation_section(result, 1)
+    svgs = draw_figures(specs, None, workers)
+    plant = dict(result.get("plant") or {})
+    ctx = {**_common({"versions": {"govcheck": (result.get("tool") or {}).get("version", __version__)}}),
+           "v": ctx, "plant": plant, "settings": result.get("settings") or {}, "windows": result.get("windows") or [],
+           "created": C.fmt_date(result.get("created"))}
+    _emit("validation.html.j2", ctx, svgs, html_path, pdf_path)

@@ -1,0 +1,363 @@
+"""HTML and PDF reports: self-contained, escaped, complete, atomic; checked as a reader would.
+
+The fixture ``tests/data/results_fixture.json`` is a trimmed real run (see ``regenerate``
+at the bottom: ``python -m tests.test_report --regenerate`` rebuilds it from
+``govcheck check plant-a -r shpp-400kw``, ``govcheck linear`` and ``govcheck validate``).
+"""
+
+from __future__ import annotations
+
+import copy
+import html.parser
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from compliance.cli import main
+from compliance.errors import InputError
+from compliance.report import render as R
+from compliance.report.figures import decimate
+from compliance.report.render import render_report, render_validation_report
+
+FIXTURE = Path(__file__).parent / "data" / "results_fixture.json"
+EVIL = "<script>alert(1)</script>"
+
+
+def _results() -> dict:
+    return json.loads(FIXTURE.read_text(encoding="utf-8"))
+
+
+class _Doc(html.parser.HTMLParser):
+    """Collect tags, attributes and text of an HTML document."""
+
+    def __init__(self):
+        super().__init__(convert_charrefs=True)
+        self.tags, self.attrs, self.text, self.ids = [], [], [], []
+        self._stack = []
+
+    def handle_starttag(self, tag, attrs):
+        self.tags.append(tag)
+        self.attrs.append((tag, dict(attrs)))
+        d = dict(attrs)
+        if "id" in d:
+            self.ids.append(d["id"])
+
+    def handle_data(self, data):
+        self.text.append(data)
+
+
+def _parse(text: str) -> _Doc:
+    d = _Doc()
+    d.feed(text)
+    return d
+
+
+@pytest.fixture(scope="module")
+def rendered(tmp_path_factory):
+    """The full fixture rendered once (HTML + PDF) with a hostile plant name."""
+    res = _results()
+    res["plant"]["name"] = EVIL
+    res["requirements"][0]["title"] = 'dead time <img src="x" onerror="alert(2)"> & "quotes"'
+    out = tmp_path_factory.mktemp("report")
+    html_path, pdf_path = out / "r.html", out / "r.pdf"
+    render_report(res, html_path, pdf_path)
+    return res, html_path, pdf_path
+
+
+# --------------------------------------------------------------------------- HTML
+def test_html_is_self_contained_with_every_figure_inline(rendered):
+    res, html_path, _ = rendered
+    text = html_path.read_text(encoding="utf-8")
+    doc = _parse(text)
+    # one <figure> per trace of every run, per linear plot and per validation overlay, each an inline <svg>
+    n_traces = sum(len(r["traces"]) for r in res["runs"])
+    n_val = sum(len(m["overlays"]) for m in res["validation"]["modes"].values())
+    n_lin = 3 + 2  # three maps (time constant, gain and phase margins) + Bode + poles
+    assert doc.tags.count("figure") == n_traces + n_val + n_lin
+    assert doc.tags.count("svg") == doc.tags.count("figure")
+    # nothing outside the file: no scheme, no import, no src/href to anything but an in-page anchor
+    assert "http:" not in text and "https:" not in text
+    assert "@import" not in text and "url(http" not in text
+    for tag in ("script", "link", "img", "iframe", "object"):
+        assert tag not in doc.tags, tag
+    for tag, attrs in doc.attrs:
+        for k, v in attrs.items():
+            if k in ("src", "href", "xlink:href"):
+                assert v.startswith("#"), (tag, k, v)
+    # ids unique across the whole document (figure ids are prefixed per figure)
+    assert len(doc.ids) == len(set(doc.ids))
+
+
+def test_user_strings_are_escaped(rendered):
+    _, html_path, _ = rendered
+    text = html_path.read_text(encoding="utf-8")
+    assert "&lt;script&gt;alert(1)&lt;/script&gt;" in text
+    assert "<script" not in text
+    assert '<img src="x"' not in text and "&lt;img src=&#34;x&#34;" in text
+    doc = _parse(text)
+    assert "script" not in doc.tags and "img" not in doc.tags
+    assert EVIL in "".join(doc.text)  # shown to the reader as text
+
+
+def test_contents_in_order_and_every_requirement_in_summary(rendered):
+    res, html_path, _ = rendered
+    text = html_path.read_text(encoding="utf-8")
+    pos = [text.index(f'id="{s}"') for s in ("cover", "summary", "procedures", "linear", "validation", "appendix")]
+    assert pos == sorted(pos)
+    summary = text[text.index('id="summary"'):text.index('id="procedures"')]
+    for e in res["requirements"]:
+        assert e["id"] in summary
+    # the cover carries both sha256 digests, the verdict and the version
+    cover = text[:text.index('id="contents"')]
+    assert res["plant"]["digest"] in cover and res["requirement_set"]["digest"] in cover
+    assert res["summary"]["status"].upper() in cover
+    # appendix: every parameter key with its source, the command line
+    appendix = text[text.index('id="appendix"'):]
+    for p in res["plant"]["parameters"]:
+        assert p["key"] in appendix
+    assert "govcheck check" in appendix
+
+
+def test_measured_points_are_marked_on_the_plots(rendered):
+    _, html_path, _ = rendered
+    text = html_path.read_text(encoding="utf-8")
+    # legend entries of the marks drawn by figures.trace_figure (text kept as <text> in the SVG)
+    for label in ("63.2 % point", "settling instant", "settling band", "tolerance", "full opening", "chamber A"):
+        assert label in text, label
+    assert "outside 100" in text  # the time-constant map outlines the IEC 61362 window 100-250 ms
+
+
+def test_absent_sections_say_not_run(tmp_path):
+    res = _results()
+    del res["linear"], res["validation"]
+    res["runs"] = res["runs"][:1]
+    out = tmp_path / "r.html"
+    render_report(res, out)
+    text = out.read_text(encoding="utf-8")
+    assert "Linear analysis (govcheck linear): not run." in text
+    assert "Model validation against recordings (govcheck validate): not run." in text
+    assert _parse(text).tags.count("svg") == len(res["runs"][0]["traces"])
+
+
+# --------------------------------------------------------------------------- PDF
+def test_pdf_has_pages_verdict_and_every_requirement(rendered):
+    pypdf = pytest.importorskip("pypdf")
+    res, _, pdf_path = rendered
+    reader = pypdf.PdfReader(str(pdf_path))
+    # cover + contents + summary + at least one page per run figure pair + linear + validation + appendix
+    assert len(reader.pages) >= 8
+    text = "\n".join(p.extract_text() for p in reader.pages)
+    assert res["summary"]["status"].upper() in reader.pages[0].extract_text()
+    for e in res["requirements"]:
+        assert e["id"] in text, e["id"]
+    # running footer with page numbers and a table of contents with page numbers
+    assert f"Page 2 of {len(reader.pages)}" in text
+    toc = reader.pages[1].extract_text()
+    assert re.search(r"1\. Summary of requirements[ .]*\d+", toc)
+
+
+def _png_stats(path):
+    from PIL import Image
+
+    im = np.asarray(Image.open(path).convert("L"), dtype=float)
+    return im.shape, float(im.std())
+
+
+def test_pdf_first_page_is_not_blank(rendered, tmp_path):
+    if shutil.which("pdftoppm") is None:
+        pytest.skip("pdftoppm not installed (Debian package poppler-utils)")
+    _, _, pdf_path = rendered
+    subprocess.run(["pdftoppm", "-r", "50", "-png", "-f", "1", "-l", "1", "-singlefile", str(pdf_path),
+                    str(tmp_path / "p1")], check=True, timeout=60)
+    shape, std = _png_stats(tmp_path / "p1.png")
+    # A4 at 50 dpi is 413 x 585 px; text, the verdict box and rules give a grey-level spread far
+    # above a blank page's 0 (a white page with a few lines of text already exceeds 10)
+    assert abs(shape[1] - 413) <= 2 and abs(shape[0] - 585) <= 2
+    assert std > 10.0
+
+
+def test_html_renders_in_headless_chromium(rendered, tmp_path):
+    exe = shutil.which("chromium") or shutil.which("chromium-browser") or shutil.which("google-chrome")
+    if exe is None:
+        pytest.skip("headless Chromium not installed (Debian packages chromium chromium-driver)")
+    _, html_path, _ = rendered
+    png = tmp_path / "shot.png"
+    cmd = [exe, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+           "--disable-background-networking", "--disable-component-update", "--disable-sync",
+           f"--user-data-dir={tmp_path / 'profile'}", f"--screenshot={png}", "--window-size=1280,2000",
+           html_path.resolve().as_uri()]
+    subprocess.run(cmd, check=False, timeout=120, capture_output=True)
+    if not png.exists():
+        pytest.skip("chromium ran but wrote no screenshot (sandbox restrictions of this machine)")
+    shape, std = _png_stats(png)
+    assert shape == (2000, 1280)
+    assert std > 10.0  # the cover: title, verdict box, tables - not a blank page
+
+
+# --------------------------------------------------------------------------- validation report
+def test_validation_report_renders(tmp_path):
+    val = _results()["validation"]
+    val["recording"]["description"] = EVIL
+    out_h, out_p = tmp_path / "v.html", tmp_path / "v.pdf"
+    render_validation_report(val, out_h, out_p)
+    text = out_h.read_text(encoding="utf-8")
+    doc = _parse(text)
+    assert doc.tags.count("svg") == sum(len(m["overlays"]) for m in val["modes"].values())
+    assert "Diagnosis (govcheck diagnose): not run." in text
+    assert "mismatch window" in text  # located windows shaded on the overlays
+    assert "script" not in doc.tags and "&lt;script&gt;" in text
+    assert out_p.read_bytes().startswith(b"%PDF")
+
+
+def test_validation_report_shows_before_after_and_fitted_physics(tmp_path):
+    val = _results()["validation"]
+    val["diagnosis"] = {
+        "after": copy.deepcopy(val),
+        "added": [{"name": "internal_leakage", "meaning": "laminar leak across the piston seals",
+                   "params": [{"name": "conductance", "value": 3.2e-10, "unit": "kg/(s*Pa)", "bounds": [0.0, 1e-8]}]}],
+        "explanation": "pressures drift towards each other while holding",
+    }
+    out = tmp_path / "v.html"
+    render_validation_report(val, out)
+    text = out.read_text(encoding="utf-8")
+    assert "simulated (after)" in text and "simulated (before)" in text  # overlays: recording, before, after
+    assert "internal_leakage" in text and "kg/(s·Pa)" in text and "3.2×10⁻¹⁰" in text
+    assert "not run" not in text.split("Physics added")[1]
+
+
+# --------------------------------------------------------------------------- bad input, atomicity
+@pytest.mark.parametrize("path, key", [(("plant", "digest"), "digest"), (("summary",), "summary"),
+                                       (("requirements", 0, "rows"), "rows"), (("runs", 0, "traces"), "traces")])
+def test_missing_key_is_an_input_error_naming_it(tmp_path, path, key):
+    res = _results()
+    obj = res
+    for k in path[:-1]:
+        obj = obj[k]
+    del obj[path[-1]]
+    with pytest.raises(InputError, match=f"'{key}'"):
+        render_report(res, tmp_path / "x.html")
+    assert not (tmp_path / "x.html").exists()
+
+
+def test_wrong_schema_version_exit_2(tmp_path, capsys):
+    res = _results()
+    res["schema"] = "govcheck-results/0"
+    bad = tmp_path / "old.json"
+    bad.write_text(json.dumps(res))
+    code = main(["report", str(bad), "--html", str(tmp_path / "x.html")])
+    assert code == 2
+    err = capsys.readouterr().err
+    assert "old.json" in err and "'schema'" in err and "govcheck-results/1" in err
+    assert not (tmp_path / "x.html").exists()
+
+
+def test_failed_render_leaves_previous_report_intact(tmp_path, monkeypatch):
+    res = _results()
+    res["runs"] = res["runs"][:1]
+    h, p = tmp_path / "r.html", tmp_path / "r.pdf"
+    h.write_text("previous html")
+    p.write_bytes(b"previous pdf")
+
+    def boom(html):
+        raise RuntimeError("layout failed")
+
+    monkeypatch.setattr(R, "_pdf_bytes", boom)
+    with pytest.raises(RuntimeError):
+        render_report(res, h, p)
+    assert h.read_text() == "previous html" and p.read_bytes() == b"previous pdf"
+    assert sorted(os.listdir(tmp_path)) == ["r.html", "r.pdf"]  # no temporary file left behind
+
+
+def test_cli_report_rerenders_without_simulating(tmp_path, monkeypatch, capsys):
+    import compliance.simulate as sim
+
+    def no_sim(*a, **k):
+        raise AssertionError("govcheck report must not simulate")
+
+    monkeypatch.setattr(sim, "simulate", no_sim)
+    res = _results()
+    res["runs"] = res["runs"][:1]
+    del res["linear"], res["validation"]
+    src = tmp_path / "res.json"
+    src.write_text(json.dumps(res))
+    assert main(["report", str(src), "--jobs", "1"]) == 0  # default: HTML next to the results
+    assert (tmp_path / "res.html").read_text(encoding="utf-8").startswith("<!DOCTYPE html>")
+    assert "res.html" in capsys.readouterr().out
+    assert main(["report", str(src), "--html", str(tmp_path / "no" / "x.html")]) == 2
+
+
+# --------------------------------------------------------------------------- numerics of the plots
+def test_decimation_keeps_extremes_and_bounds_points():
+    t = np.linspace(0.0, 10.0, 20001)
+    y = np.sin(2 * np.pi * 0.3 * t)
+    y[12345] = 5.0  # a one-sample spike must survive: it may be the evidence of a fault
+    y[777] = -4.0
+    td, yd = decimate(t, y, buckets=250)
+    assert td.size <= 3 * 250 + 1
+    assert yd.max() == 5.0 and yd.min() == -4.0
+    assert np.all(np.diff(td) > 0)
+    # the decimated curve stays on the signal: every kept point is an original sample
+    assert np.array_equal(np.interp(td, t, y), yd)
+
+
+# --------------------------------------------------------------------------- regeneration
+def regenerate(path: Path = FIXTURE) -> None:  # pragma: no cover - run by hand
+    """Rebuild the fixture from real runs (simulates; ~1 min on 2 cores)."""
+    tmp = Path(os.environ.get("TMPDIR", "/tmp")) / "govcheck-fixture"
+    tmp.mkdir(exist_ok=True)
+    py = [sys.executable, "-m", "compliance"]
+    subprocess.run(py + ["check", "plant-a", "--requirements", "requirements/shpp-400kw.toml", "--json", str(tmp / "r.json"), "-q"])
+    subprocess.run(py + ["linear", "plant-a", "--map", "--crosscheck", "--governor", "--json", str(tmp / "lin.json")],
+                   check=True, stdout=subprocess.DEVNULL)
+    subprocess.run(py + ["validate", "/work/shared/practice-recordings/practice_internal_leakage.csv.gz", "--plant", "plant-a",
+                        "--json", str(tmp / "val.json")], stdout=subprocess.DEVNULL)
+    res = json.loads((tmp / "r.json").read_text())
+    keep = ("steps-5@mid-no-load", "steps-10@region2-80", "full-stroke@governor-setup", "sine-8mm@region2-80",
+            "hold@region2-90", "dead-band@mid-no-load")
+    res["runs"] = [r for r in res["runs"] if r["id"] in keep]
+    for r in res["runs"]:
+        for tr in r["traces"]:
+            n = len(tr["time"])
+            idx = np.unique(np.linspace(0, n - 1, min(n, 300)).round().astype(int))
+            for k, v in list(tr.items()):
+                if isinstance(v, list) and len(v) == n:
+                    tr[k] = [v[i] for i in idx]
+            tr["points"] = int(idx.size)
+        r["metrics"] = {}
+    lin = json.loads((tmp / "lin.json").read_text())
+    a = lin["analysis"]
+    b = a["bode"]
+    sel = np.unique(np.linspace(0, len(b["frequency_hz"]) - 1, 60).round().astype(int))
+    a["bode"] = {k: [v[i] for i in sel] for k, v in b.items()}
+    for k in ("nyquist", "step", "plant"):
+        a.pop(k, None)
+    res["linear"] = lin
+    val = json.loads((tmp / "val.json").read_text())
+    for m in val["modes"].values():
+        m.pop("residuals", None)
+        m["window_metrics"] = m["window_metrics"][:10]
+        for ov in m["overlays"].values():
+            n = len(ov["time"])
+            sel = np.unique(np.linspace(0, n - 1, min(n, 300)).round().astype(int))
+            for k in ("time", "recorded", "simulated"):
+                ov[k] = [ov[k][i] for i in sel]
+    res["validation"] = val
+    res["fixture_provenance"] = (
+        "trimmed real run: govcheck check plant-a -r requirements/shpp-400kw.toml --json; runs " + ", ".join(keep)
+        + " kept with traces cut to 300 points; 'linear' = govcheck linear plant-a --map --crosscheck --governor --json "
+        "(Bode cut to 60 points); 'validation' = govcheck validate practice_internal_leakage.csv.gz --plant plant-a "
+        "--json (overlays cut to 300 points); rebuilt by python -m tests.test_report --regenerate")
+    path.write_text(json.dumps(res, separators=(",", ":")) + "\n", encoding="utf-8")
+    print(f"wrote {path} ({path.stat().st_size / 1e3:.0f} kB)")
+
+
+if __name__ == "__main__":  # pragma: no cover
+    if "--regenerate" in sys.argv:
+        regenerate()
