@@ -17,6 +17,7 @@ import importlib
 import platform
 import time
 
+from .display_paths import display_path
 from . import __version__
 from .campaign_plan import Job, plan
 from .campaign_pool import available_cores, execute, warm_up
@@ -88,7 +89,7 @@ def plant_section(cfg) -> dict:
     return {
         "name": cfg.name,
         "description": cfg.description,
-        "path": cfg.path,
+        "path": display_path(cfg.path),
         "digest": cfg.digest,
         "parameters": params,
         "options": dict(cfg.options),

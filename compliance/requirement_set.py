@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from .display_paths import display_path
 from .amounts import Amount
 from .metric_catalogue import METRICS
 
@@ -175,9 +176,9 @@ class RequirementSet:
         return {
             "name": self.name,
             "title": self.title,
-            "path": self.path,
+            "path": display_path(self.path),
             "digest": self.digest,
-            "files": [{"path": p, "digest": d} for p, d in self.files],
+            "files": [{"path": display_path(p), "digest": d} for p, d in self.files],
             "operating_points": {k: v.as_dict() for k, v in self.operating_points.items()},
             "procedures": {k: v.as_dict() for k, v in self.procedures.items()},
             "requirements": [r.as_dict() for r in self.requirements],

@@ -28,6 +28,9 @@ def register(subparsers):
     p.add_argument("--junit", metavar="OUT.xml", help="write JUnit XML for CI")
     p.add_argument("--report", metavar="OUT.html", help="write the HTML report")
     p.add_argument("--pdf", metavar="OUT.pdf", help="write the PDF report")
+    p.add_argument("--linear", action="store_true",
+                   help="add the linear analysis to the results and report: every operating point, the stroke x load map, "
+                        "the linear/nonlinear cross-check and the HYGOV parameters (adds ~20-40 s)")
     p.add_argument("--jobs", "-j", type=int, default=None, help="worker processes (default: available cores)")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bar; print only the verdict line")
     return p
@@ -59,6 +62,8 @@ def command_line(args, name: str = "check") -> str:
         v = getattr(args, flag, None)
         if v is not None:
             parts += [f"--{flag}", str(v)]
+    if getattr(args, "linear", False):
+        parts.append("--linear")
     if getattr(args, "quiet", False):
         parts.append("--quiet")
     return shlex.join(parts)
@@ -79,6 +84,10 @@ def run(args) -> int:
     cfg = load_plant(args.plant)
     reqset = load_requirements(args.requirements)
     results = run_campaign(cfg, reqset, workers=args.jobs, progress=not args.quiet, command_line=command_line(args))
+    if args.linear:
+        from ..linear_campaign import linear_for_campaign
+
+        results["linear"] = linear_for_campaign(cfg, reqset)
     table = summary_table(results)
     if args.quiet:
         print(table.rstrip().splitlines()[-1])
