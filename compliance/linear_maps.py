@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .dead_zone_stall import stall_error
 from . import metrics as M
 from .config import PlantConfig
 from .errors import InputError
@@ -102,22 +103,6 @@ def operating_map(cfg: PlantConfig, positions=None, loads=None, *, curve: bool =
         for n in values:
             values[n].append(rows[n])
     return OperatingMap(positions, [ld if isinstance(ld, str) or ld is None else float(ld) for ld in loads], values, notes)
-
-
-def stall_error(cfg: PlantConfig, direction: str = "opening") -> float:
-    """Error below which the compensated valve stays shut [m]: zmd*lc/((zmd + lc/md)*K_P) (reference-plant.md).
-
-    With zme, me for the closing direction; without compensation (lc = 0) the mismatch of
-    the valve and compensator dead zones divided by K_P.
-    """
-    p = cfg.params
-    side = "positive" if direction == "opening" else "negative"
-    lc, kp = p["controller.compensation_width"], p["controller.kp"]
-    dz_v, dz_c = p[f"valve.dead_zone_{side}"], p[f"controller.compensation_dead_zone_{side}"]
-    md = p[f"controller.compensation_slope_{side}"]
-    if lc <= 0.0:
-        return max(dz_v - dz_c, 0.0) * md / kp
-    return dz_v * lc / ((dz_c + lc / md) * kp)
 
 
 def _no_dead_zone(cfg: PlantConfig) -> PlantConfig:

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .config import PlantConfig
+from .dead_zone_stall import stall_error
 from .metrics import find_steps, speed_extremes, step_response, stroke_time
 from .profiles import Profile, steps
 from .simulate import Scenario, simulate
@@ -155,22 +156,6 @@ def _driver(cfg: PlantConfig, case: StepCase, idx: int, row: Row) -> str:
     scale = 1e3 if row.unit == "mm" else 1.0
     return (f"{best[1]} {'+' if best[2] > 0 else '-'}{SENSITIVITY_STEP:.0%} moves it to "
             f"{best[3] * scale:.3g} {row.unit}")
-
-
-def stall_error(cfg: PlantConfig) -> float:
-    """Error below which the compensated valve stays shut [m] (reference-plant.md, 'Known tension').
-
-    The compensator output reaches the valve's dead zone zmd at u_d = zmd*lc/(zmd + lc/md)
-    (the smoothed branch of seed 000 eq. 3), i.e. at |e| = that / K_P.
-    """
-    zmd = cfg.p("valve.dead_zone_positive")
-    lc = cfg.p("controller.compensation_width")
-    czmd = cfg.p("controller.compensation_dead_zone_positive")
-    md = cfg.p("controller.compensation_slope_positive")
-    kp = cfg.p("controller.kp")
-    if lc <= 0 or kp <= 0:
-        return 0.0
-    return zmd * lc / (czmd + lc / md) / kp
 
 
 def full_stroke(cfg: PlantConfig, load: float = 5700.0) -> dict:

@@ -187,8 +187,8 @@ def step_response(
             if u.size and np.max(np.abs(u)) >= command_saturation * (1.0 - 1e-9):
                 rate_limited = True
                 reasons["time_constant"] = (
-                    f"rate limited: valve command reached {np.max(np.abs(u)):.2f} V >= full opening "
-                    f"{command_saturation:.2f} V before 63.2 %"
+                    f"rate limited: valve command reached {np.max(np.abs(u)):.2f} V >= flow saturation "
+                    f"{command_saturation:.2f} V (valve fully open, or flow-control valve limiting) before 63.2 %"
                 )
 
     # step_info-style metrics on the actual change

@@ -6,7 +6,8 @@ import pytest
 
 from compliance.cli import main
 from compliance.config import load_plant
-from compliance.reproduce import CASES, _step_metrics, stall_error
+from compliance.dead_zone_stall import stall_error
+from compliance.reproduce import CASES, _step_metrics
 
 
 def test_stall_error_formula():
