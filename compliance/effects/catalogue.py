@@ -1,4 +1,10 @@
-"""The effect library (names fixed by issue 6; equations in compliance/plant.py cite their sources)."""
+"""The effect library (names fixed by issue 6; equations in compliance/plant.py cite their sources).
+
+Bounds are physical ranges cut where the pinned RK4 step (0.5 ms for plant A) would go unstable:
+the fastest eigenvalue of each effect times the step stays below ~2 (RK4's limit is 2.8), e.g.
+a hose node relaxes at R*T*rho0*C*w'/V, so C/V <= 3e-4 (conductance <= 3e-8 m^3/(s*Pa) with
+volume >= 1e-4 m^3); linkage damping/(M/2) and regulator refill R*T*k/V_r likewise.
+"""
 
 from __future__ import annotations
 
@@ -49,7 +55,7 @@ SUPPLY_DROOP = Effect(
     meaning="supply pressure sags under flow: finite reservoir refilled through a regulator",
     params=(
         Param("reservoir_volume", "m^3", "reservoir plus supply line volume", 0.02, (1e-3, 0.5), True),
-        Param("regulator_conductance", "kg/(s*Pa)", "regulator refill flow per pressure deficit", 1e-7, (1e-10, 1e-4), True),
+        Param("regulator_conductance", "kg/(s*Pa)", "regulator refill flow per pressure deficit", 1e-7, (1e-10, 1e-5), True),
     ),
     states=("supply_pressure",),
     signature="supply pressure dips during fast moves; the filling side's pressure rises more slowly than modelled",
@@ -99,8 +105,8 @@ LINE_DYNAMICS = Effect(
     name="line_dynamics",
     meaning="hoses between valve and cylinders add volume and a flow restriction",
     params=(
-        Param("volume", "m^3", "hose volume per side", 2e-4, (1e-6, 5e-3), True),
-        Param("conductance", "m^3/(s*Pa)", "sonic conductance of each hose", 3e-8, (1e-9, 1e-6), True),
+        Param("volume", "m^3", "hose volume per side", 2e-4, (1e-4, 5e-3), True),
+        Param("conductance", "m^3/(s*Pa)", "sonic conductance of each hose", 3e-8, (1e-9, 3e-8), True),
     ),
     states=("line_pressure_a", "line_pressure_b"),
     signature="chamber pressures respond later and smoother than the valve command; the loop is less damped",
@@ -112,7 +118,7 @@ LINKAGE_COMPLIANCE = Effect(
     meaning="the two cylinders are coupled through a flexible linkage; the sensor sits on 2A1",
     params=(
         Param("stiffness", "N/m", "linkage stiffness between the cylinders", 2e6, (1e4, 5e7), True),
-        Param("damping", "N*s/m", "linkage damping", 2000.0, (0.0, 1e6)),
+        Param("damping", "N*s/m", "linkage damping", 2000.0, (0.0, 2e4)),
     ),
     states=("position_2", "velocity_2"),
     signature="a resonance at the linkage frequency rings in command and pressures after steps",
