@@ -127,7 +127,7 @@ def _interp_uniform(hist, h, t):
     return hist[i] * (1.0 - w) + hist[i + 1] * w
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _rk4_step(y, P, u, lx, ly, h, k1, k2, k3, k4, tmp, aux, k1_ready=False):
     """One classical RK4 step in place; ``k1_ready`` reuses a slope already evaluated at (y, u)."""
     n = y.shape[0]

@@ -13,7 +13,10 @@ def stribeck_magnitude(speed, static_force, coulomb_force, stribeck_velocity):
 
     reference-plant.md, friction (assumed map for seed 000 fig. 3).
     """
-    return coulomb_force + (static_force - coulomb_force) * math.exp(-abs(speed) / stribeck_velocity)
+    r = abs(speed) / stribeck_velocity
+    if r > 40.0:  # exp(-40) < 5e-18: the Stribeck hump is gone, skip the exponential
+        return coulomb_force
+    return coulomb_force + (static_force - coulomb_force) * math.exp(-r)
 
 
 @njit(cache=True, error_model="numpy", inline="always")

@@ -59,9 +59,10 @@ def iso6358_mass_flow(opening, conductance, p_up, p_down, t_up, b, rho0, t0):
     """
     if opening <= 0.0 or conductance <= 0.0:
         return 0.0
+    temp = 1.0 if t_up == t0 else math.sqrt(t0 / t_up)  # sqrt(T0/T1); 1 in the isothermal base model
     if p_up >= p_down:
-        return opening * conductance * p_up * rho0 * math.sqrt(t0 / t_up) * iso6358_flow_function(p_down / p_up, b)
-    return -opening * conductance * p_down * rho0 * math.sqrt(t0 / t_up) * iso6358_flow_function(p_up / p_down, b)
+        return opening * conductance * p_up * rho0 * temp * iso6358_flow_function(p_down / p_up, b)
+    return -opening * conductance * p_down * rho0 * temp * iso6358_flow_function(p_up / p_down, b)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
