@@ -190,9 +190,12 @@ def simulate_core(P, y0, ref, cmd, closed_loop, pos_noise, pos_quantum, lx, ly, 
     x_hist = np.zeros(n_samples * n_sub + 1) if sensor else np.zeros(1)
     x_hist[0] = y[S_X]
     x_sensor = y[S_X]
-    lag_gain = 1.0
+    xd_prev = y[S_X]
+    lag_decay = 0.0  # exp(-h/tau): 0 = no lag
+    lag_ramp = 1.0  # tau -> 0 limit: the sensor reads the (delayed) position itself
     if sensor and P[P_SL_TAU] > 0.0:
-        lag_gain = 1.0 - math.exp(-h / P[P_SL_TAU])
+        lag_decay = math.exp(-h / P[P_SL_TAU])
+        lag_ramp = 1.0 - P[P_SL_TAU] / h * (1.0 - lag_decay)
     alpha = first_order_filter_gain(P[P_FILT], ts)
     x_filt = 0.0
     integral = 0.0
@@ -260,7 +263,9 @@ def simulate_core(P, y0, ref, cmd, closed_loop, pos_noise, pos_quantum, lx, ly, 
             if sensor:
                 x_hist[step_index] = y[S_X]
                 xd = _interp_uniform(x_hist, h, step_index * h - sensor_delay)
-                x_sensor += lag_gain * (xd - x_sensor)
+                # first-order lag integrated exactly for an input linear over the step
+                x_sensor = lag_decay * x_sensor + (1.0 - lag_decay) * xd_prev + (xd - xd_prev) * lag_ramp
+                xd_prev = xd
         if not (math.isfinite(y[S_X]) and math.isfinite(y[S_PA]) and math.isfinite(y[S_PB])):
             return k
         if y[S_PA] <= 0.0 or y[S_PB] <= 0.0 or abs(y[S_V]) > 100.0:

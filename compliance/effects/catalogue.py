@@ -1,9 +1,11 @@
 """The effect library (names fixed by issue 6; equations in compliance/plant.py cite their sources).
 
-Bounds are physical ranges cut where the pinned RK4 step (0.5 ms for plant A) would go unstable:
+Bounds are physical ranges cut where the pinned RK4 step (1 ms for plant A) would go unstable:
 the fastest eigenvalue of each effect times the step stays below ~2 (RK4's limit is 2.8), e.g.
 a hose node relaxes at R*T*rho0*C*w'/V, so C/V <= 3e-4 (conductance <= 3e-8 m^3/(s*Pa) with
-volume >= 1e-4 m^3); linkage damping/(M/2) and regulator refill R*T*k/V_r likewise.
+volume >= 1e-4 m^3); linkage damping/(M/2) and regulator refill R*T*k/V_r likewise. A load
+stiffness beyond the pneumatic spring (~1.9e5 N/m) would make the plant statically unstable;
+the steepest segment of the sheet's load curve is 1.25e5 N/m.
 """
 
 from __future__ import annotations
@@ -83,7 +85,7 @@ VALVE_OFFSET = Effect(
 POSITION_DEPENDENT_LOAD = Effect(
     name="position_dependent_load",
     meaning="the load changes along the stroke (gate hydraulic torque stiffness)",
-    params=(Param("stiffness", "N/m", "added closing force per metre of opening about mid-stroke", 0.0, (-3e5, 3e5)),),
+    params=(Param("stiffness", "N/m", "added closing force per metre of opening about mid-stroke", 0.0, (-1.5e5, 1.5e5)),),
     states=(),
     signature="holding pressure difference changes with position more than the nominal load says",
     signals=("pressure_a", "pressure_b", "valve_command"),
@@ -118,7 +120,7 @@ LINKAGE_COMPLIANCE = Effect(
     meaning="the two cylinders are coupled through a flexible linkage; the sensor sits on 2A1",
     params=(
         Param("stiffness", "N/m", "linkage stiffness between the cylinders", 2e6, (1e4, 5e7), True),
-        Param("damping", "N*s/m", "linkage damping", 2000.0, (0.0, 2e4)),
+        Param("damping", "N*s/m", "linkage damping", 2000.0, (0.0, 1e4)),
     ),
     states=("position_2", "velocity_2"),
     signature="a resonance at the linkage frequency rings in command and pressures after steps",
