@@ -1,0 +1,194 @@
+"""``govcheck diagnose``: name the physics a model misses in a recording, model it, refit, show the gain.
+
+    govcheck diagnose RECORDING --plant models/plant-a.toml [--column-map MAP] [--json out.json]
+                      [--report diag.html] [--save-model fitted.toml] [--effects a,b,c] [--jobs N]
+    govcheck diagnose FILE1 FILE2 ... --column-map zillen-friction --friction-bore "25.7 mm"
+
+A servo recording (time, position, valve command; reference for a closed-loop test) gets the
+replay diagnosis (``compliance.diagnosis.engine``); friction-bench recordings (position,
+chamber pressure and drive force, no valve command) get the friction-model diagnosis
+(``compliance.diagnosis.friction_diagnosis``). Exit 0 when the diagnosis ran (whatever it
+found), 2 on bad input.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import tempfile
+from pathlib import Path
+
+from ..errors import InputError
+
+_SCALE = {"position": (1e3, "mm"), "valve_command": (1.0, "V"), "pressure_a": (1e-3, "kPa"), "pressure_b": (1e-3, "kPa"),
+          "supply_pressure": (1e-3, "kPa")}
+
+
+def register(sub):
+    """Add the ``diagnose`` command."""
+    p = sub.add_parser(
+        "diagnose",
+        help="find the physics a model misses in a recording (or which parameter is off), fit it, show the gain",
+        description=(
+            "Replay the recording through the model, locate where it disagrees, then fit every candidate "
+            "explanation - each declared effect (heat transfer, leakage, valve dynamics, supply droop, ...) and the "
+            "recalibration of base parameters - by bounded least squares, rank them by BIC on residuals normalised by "
+            "each signal's noise floor, and explain the winner. Friction-bench recordings (position, chamber pressure "
+            "and force; no valve command) get a friction-model diagnosis instead."
+        ),
+        epilog=(
+            "examples:\n"
+            "  govcheck diagnose run.csv.gz --plant models/plant-a.toml --json diag.json\n"
+            "  govcheck diagnose run.csv.gz --plant plant-a --effects heat_transfer,internal_leakage --save-model fitted.toml\n"
+            "  govcheck diagnose O-ring257_*bar.csv --column-map zillen-friction --friction-bore \"25.7 mm\" --report f.html"
+        ),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("recordings", nargs="+", metavar="RECORDING", help="recording file(s); several only for friction runs")
+    p.add_argument("--plant", help="plant configuration file or reference name (default: the sidecar's 'plant')")
+    p.add_argument("--column-map", help="column map (TOML path or shipped name) for a logger's own names and units")
+    p.add_argument("--effects", help="comma-separated candidate effects (default: every declared effect)")
+    p.add_argument("--no-recalibration", action="store_true", help="do not consider recalibrating base parameters")
+    p.add_argument("--jobs", type=int, help="worker processes (default: the available cores)")
+    p.add_argument("--friction-bore", help='friction bench: piston bore, e.g. "25.7 mm" (else the column map\'s metadata)')
+    p.add_argument("--json", dest="json_out", help="write the diagnosis (docs/diagnosis-schema.md) to this JSON file")
+    p.add_argument("--report", help="write an HTML report with the before/after figures")
+    p.add_argument("--save-model", help="write the fitted plant configuration here (never overwrites)")
+    p.add_argument("--quiet", action="store_true", help="print only the verdict line")
+    return p
+
+
+def _write_json(path: str, data: dict) -> None:
+    target = Path(path)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            json.dump(data, fh, indent=1, allow_nan=False)
+            fh.write("\n")
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, target)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def _is_friction(frame) -> bool:
+    return "valve_command" not in frame.columns and "force" in frame.columns
+
+
+def run(args) -> int:
+    """Run ``govcheck diagnose``; returns 0 when the diagnosis ran."""
+    from ..recordings import read_recording
+
+    if args.jobs is not None and args.jobs < 1:
+        raise InputError(f"--jobs {args.jobs}: expected a positive number of worker processes")
+    if args.save_model and Path(args.save_model).exists():
+        raise InputError(f"--save-model {args.save_model}: exists already; choose another name (nothing is overwritten)")
+    effects = None
+    if args.effects:
+        effects = [e.strip() for e in args.effects.split(",") if e.strip()]
+        if not effects:
+            raise InputError("--effects: expected a comma-separated list of effect names")
+    first, meta = read_recording(args.recordings[0], args.column_map, required=("time",))
+    if _is_friction(first):
+        return _run_friction(args, first, meta)
+    if len(args.recordings) > 1:
+        raise InputError(f"{args.recordings[1]}: one servo recording at a time (several files are for friction-bench runs)")
+    frame, meta = read_recording(args.recordings[0], args.column_map)
+    from ..config import load_plant
+    from ..diagnosis.engine import diagnose, save_fitted
+
+    plant = args.plant or meta.get("plant")
+    if not plant:
+        raise InputError(f"{args.recordings[0]}: no --plant given and the sidecar names no 'plant'")
+    cfg = load_plant(plant)
+    diag = diagnose(cfg, frame, meta, effects=effects, jobs=args.jobs, recalibrate=not args.no_recalibration)
+    if args.save_model:
+        save_fitted(diag, args.save_model)
+    data = diag.to_dict()
+    if args.json_out:
+        _write_json(args.json_out, data)
+    if args.report:
+        _render_servo_report(cfg, frame, meta, diag, data, args.report)
+    _print_servo(data, args.quiet)
+    return 0
+
+
+def _print_servo(d: dict, quiet: bool) -> None:
+    print(f"verdict: {d['verdict']}" + (f" ({d['winner']})" if d.get("winner") else "") + f" - {d['reason']}")
+    if quiet:
+        return
+    print()
+    print(d["explanation"])
+    print()
+    print(f"{'candidate':34s} {'k':>2s} {'chi2/N':>9s} {'dBIC':>10s} {'explained':>9s}  parameters")
+    for e in d["effects"][:8]:
+        params = ", ".join(f"{p['name'].split('.')[-1]}={p['value']:.4g} {p['unit']}".rstrip() for p in e["parameters"])
+        print(f"{e['name']:34s} {e['k']:2d} {e['chi2_per_residual']:9.3f} {e['delta_bic']:10.1f} {100*(e['explained_fraction'] or 0):8.0f}%  {params}")
+    print()
+    print(f"{'signal':16s} {'RMS before':>12s} {'RMS after':>12s} {'fit % before':>13s} {'fit % after':>12s}")
+    for s, b in (d["fit_before"] or {}).items():
+        sc, unit = _SCALE[s]
+        a = (d.get("fit_after") or {}).get(s)
+        after = f"{a['rms']*sc:9.3g} {unit:3s}" if a else f"{'-':>12s}"
+        fa = f"{a['fit_percent']:12.1f}" if a and a.get("fit_percent") is not None else f"{'-':>12s}"
+        fb = f"{b['fit_percent']:13.1f}" if b.get("fit_percent") is not None else f"{'-':>13s}"
+        print(f"{s:16s} {b['rms']*sc:9.3g} {unit:3s}{after}{fb}{fa}")
+    t = d["timing"]
+    print(f"\n{len(d['windows'])} located windows; {t['simulations']} simulations in {t['seconds']:.1f} s on {t['jobs']} worker(s)")
+    if d.get("saved_model"):
+        print(f"fitted model written to {d['saved_model']}")
+
+
+def _render_servo_report(cfg, frame, meta, diag, data: dict, html_path: str) -> None:
+    try:
+        from ..report.render import render_validation_report
+        from ..validation import ValidationSettings, validate
+    except ImportError as exc:  # pragma: no cover - depends on the report engineer's module
+        raise InputError(f"--report: the report renderer is not available yet ({exc}); use --json") from None
+    settings = ValidationSettings(modes=("closed_loop",)) if "reference" in frame.columns else ValidationSettings(modes=("plant_only",))
+    result = validate(cfg, frame, meta, settings)
+    diag_entry = {"explanation": data["explanation"], "verdict": data["verdict"], "added": [], "effects_ranked": data["effects"]}
+    if diag.fitted_cfg is not None:
+        diag_entry["after"] = validate(diag.fitted_cfg, frame, meta, settings)
+        winner = next(e for e in data["effects"] if e["name"] == data["winner"])
+        groups: dict[str, list] = {}
+        for p in winner["parameters"]:
+            group = p["name"].split(".")[0] if p["kind"] == "effect" else "base parameters (recalibrated)"
+            groups.setdefault(group, []).append({"name": p["name"].split(".", 1)[1] if p["kind"] == "effect" else p["name"],
+                                                 "value": p["value"], "unit": p["unit"]})
+        from ..effects import EFFECTS
+
+        for g, params in groups.items():
+            diag_entry["added"].append({"name": g, "meaning": EFFECTS[g].meaning if g in EFFECTS else "", "params": params})
+    result["diagnosis"] = diag_entry
+    render_validation_report(result, html_path)
+
+
+def _run_friction(args, first, meta) -> int:
+    from ..diagnosis.friction_diagnosis import diagnose_friction, format_friction
+    from ..recordings import read_recording
+    from ..units import parse_quantity
+
+    runs = [(first, meta)]
+    for path in args.recordings[1:]:
+        f, m = read_recording(path, args.column_map, required=("time",))
+        if not _is_friction(f):
+            raise InputError(f"{path}: not a friction-bench run like {args.recordings[0]} (needs force and no valve command)")
+        runs.append((f, m))
+    bore = parse_quantity(args.friction_bore, "m", "--friction-bore") if args.friction_bore else None
+    result = diagnose_friction(runs, bore=bore)
+    data = result.to_dict()
+    if args.save_model:
+        raise InputError("--save-model: a friction-bench diagnosis fits a friction law, not a plant configuration; use --json")
+    if args.json_out:
+        _write_json(args.json_out, data)
+    if args.report:
+        from ..diagnosis.friction_report import write_friction_report
+
+        write_friction_report(result, args.report)
+    print(format_friction(data, args.quiet))
+    return 0

@@ -1,0 +1,38 @@
+"""Diagnosis: name the physics a model misses in a recording, model it, refit, prove it.
+
+Public API:
+
+- ``diagnose(cfg, frame, meta, effects=None, jobs=None)`` -> ``Diagnosis`` (servo recordings:
+  replay, locate, fit every candidate, select by BIC, explain; ``to_dict()`` is the JSON of
+  docs/diagnosis-schema.md) and ``save_fitted(diagnosis, path)``;
+- ``diagnose_friction(runs, bore=None)`` -> ``FrictionDiagnosis`` (seal-friction bench runs);
+- ``run_benchmark(cfg, ...)`` and ``run_practice(directory, cfg)`` (the proof on generated
+  concealed-effect cases and on recordings with answers).
+
+Modules, one job each: ``replay_fit`` (fast re-synchronised replay with matched noise),
+``noise_floor`` / ``residuals`` (normalised residuals), ``candidates`` (what may be fitted),
+``fit`` (scan, simplex, least squares), ``select`` (information criteria, verdict),
+``located`` (where the model misses), ``explain`` (the paragraph), ``engine`` (the chain),
+``concealed`` / ``benchmark`` (the proof), ``friction_models`` / ``friction_diagnosis`` /
+``friction_report`` (the friction bench).
+"""
+
+from __future__ import annotations
+
+__all__ = ["diagnose", "save_fitted", "Diagnosis", "diagnose_friction", "run_benchmark", "run_practice"]
+
+
+def __getattr__(name):  # lazy: importing the package does not compile the simulator
+    if name in ("diagnose", "save_fitted", "Diagnosis"):
+        from . import engine
+
+        return getattr(engine, name)
+    if name == "diagnose_friction":
+        from .friction_diagnosis import diagnose_friction
+
+        return diagnose_friction
+    if name in ("run_benchmark", "run_practice"):
+        from . import benchmark
+
+        return getattr(benchmark, name)
+    raise AttributeError(name)

@@ -1,0 +1,158 @@
+"""One paragraph a plant engineer understands: where the model missed, why, what was fitted, what it gained."""
+
+from __future__ import annotations
+
+from ..effects import EFFECTS
+from .candidates import FRICTION_LEVEL
+
+# how each effect reads in words, with its main fitted value ({v} is filled in)
+PHYSICS = {
+    "heat_transfer": "the chamber air exchanges heat with the cylinder walls instead of staying at supply temperature (wall conductance hA {v} per side)",
+    "internal_leakage": "air leaks across the piston seals from side A to side B (laminar leak {v})",
+    "external_leakage": "both chambers leak to atmosphere through fittings or rod seals (laminar leak {v} per side)",
+    "valve_dynamics": "the servo valve does not open instantly: its spool follows the command with a delay and a second-order lag (natural frequency {v})",
+    "supply_droop": "the supply pressure sags while the valve draws air: the reservoir is finite and the regulator refills it slowly (reservoir {v})",
+    "pressure_dependent_friction": "the seal friction grows with the chamber pressure ({v} of extra friction per cylinder)",
+    "valve_offset": "the servo valve's null is shifted: the valve sees the command plus an offset of {v}",
+    "position_dependent_load": "the load changes along the stroke more than the nominal load says (stiffness {v})",
+    "sensor_lag": "the position transducer reports a delayed, low-passed position (time constant {v})",
+    "line_dynamics": "the hoses between valve and cylinders add volume and a restriction (hose volume {v} per side)",
+    "linkage_compliance": "the two cylinders are coupled through a flexible linkage (stiffness {v})",
+}
+SIGNAL_WORDS = {"position": "position", "pressure_a": "side-A pressure", "pressure_b": "side-B pressure",
+                "valve_command": "valve command", "supply_pressure": "supply pressure"}
+ALMOST_AS_WELL = 1.5  # a runner-up within this chi-square ratio of the winner is named as an alternative
+REGIME_WORDS = {"step": "after the set-point steps", "hold": "while the position holds", "tracking": "during the sinusoidal tracking",
+                "open_loop": "over the run"}
+
+
+def format_value(value: float, unit: str) -> str:
+    """A value with the unit an engineer would use ("12 ms", "1.5e-10 kg/(s*Pa)", "6.1 W/K")."""
+    v = float(value)
+    if unit == "s":
+        return f"{v*1e3:.3g} ms" if abs(v) < 1 else f"{v:.3g} s"
+    if unit == "m^3":
+        return f"{v*1e3:.3g} L"
+    if unit == "m":
+        return f"{v*1e3:.3g} mm"
+    if unit == "Pa":
+        return f"{v/1e3:.3g} kPa"
+    if unit == "N/m":
+        return f"{v/1e3:.3g} kN/m"
+    if unit == "N/Pa":
+        return f"{v*1e5:.3g} N/bar"
+    if unit == "m^3/(s*Pa)":
+        return f"{v*1e8:.3g} dm^3/(s*bar)"
+    if unit in ("kg/(s*Pa)",):
+        return f"{v:.2g} {unit}"
+    if unit == "":
+        return f"{v:.3g}"
+    return f"{v:.3g} {unit}"
+
+
+def _pm(value, err, unit) -> str:
+    """Value with its statistical standard error (which does not cover model-structure error)."""
+    if err is None or not (err == err) or err <= 0 or err > 10 * abs(value):
+        return format_value(value, unit)
+    return f"{format_value(value, unit)} (standard error {format_value(err, unit)})"
+
+
+def _signal_change(d, signals) -> str:
+    """'cuts the side-A pressure residual from 8.7 kPa to 0.4 kPa' for the signal that gained most."""
+    if not d.fit_after:
+        return ""
+    best = None
+    for s in signals:
+        if s not in d.fit_before or s not in d.fit_after:
+            continue
+        b = d.fit_before[s]["rms_normalised"]
+        a = d.fit_after[s]["rms_normalised"]
+        if best is None or (b - a) > best[0]:
+            best = (b - a, s)
+    if best is None:
+        return ""
+    s = best[1]
+    b, a = d.fit_before[s], d.fit_after[s]
+    unit = {"position": "m", "valve_command": "V"}.get(s, "Pa")
+    txt = f"the {SIGNAL_WORDS[s]} residual falls from {format_value(b['rms'], unit)} to {format_value(a['rms'], unit)}"
+    if b.get("nrmse") == b.get("nrmse") and a.get("nrmse") == a.get("nrmse"):
+        txt += f" (NRMSE {100*b['nrmse']:.2g} % -> {100*a['nrmse']:.2g} %)"
+    return txt
+
+
+def _where(d) -> str:
+    regs = [REGIME_WORDS.get(r, r) for r in getattr(d, "located_regimes", [])]
+    if not regs:
+        return "across the recording"
+    return ", ".join(regs[:-1]) + (" and " if len(regs) > 1 else "") + regs[-1]
+
+
+def _worst(d, objective: bool = False) -> tuple[str, float]:
+    """Signal with the largest normalised residual of the nominal replay (full closed loop, or the
+    re-synchronised one the verdict is taken on)."""
+    if objective:
+        s = max(d.objective_before, key=lambda k: d.objective_before[k])
+        return s, d.objective_before[s]
+    s = max(d.fit_before, key=lambda k: d.fit_before[k]["rms_normalised"])
+    return s, d.fit_before[s]["rms_normalised"]
+
+
+def _base_changes(d, fit) -> str:
+    parts = []
+    for fp, v, e in zip(fit.params, fit.values, fit.stderr):
+        if fp.kind != "base":
+            continue
+        if fp.key == FRICTION_LEVEL:
+            fs = d.cfg.p("friction.static_force")
+            fc = d.cfg.p("friction.coulomb_force")
+            parts.append(f"friction levels scaled by {v:.3g} (static {fs:.0f} -> {fs*v:.0f} N, Coulomb {fc:.0f} -> {fc*v:.0f} N)")
+        else:
+            parts.append(f"{fp.key} refitted from {format_value(fp.nominal, fp.unit)} to {_pm(v, e, fp.unit)}")
+    return "; ".join(parts)
+
+
+def explain(d) -> str:
+    """The paragraph for ``engine.Diagnosis`` ``d``."""
+    worst_sig, worst = _worst(d, objective=d.verdict == "no_mismatch")
+    if d.verdict == "no_mismatch":
+        return (f"Nothing is wrong: the nominal model reproduces the recording to within the sensor noise on every "
+                f"measured signal (the largest residual is {worst:.2f} times its noise floor, on the {SIGNAL_WORDS[worst_sig]}). "
+                f"No physics is missing and no parameter needs refitting.")
+    if d.verdict == "unexplained":
+        best = d.winner or (d.runner_up or "none")
+        share = d.scores[best].explained * 100 if best in d.scores else 0.0
+        return (f"The model misses the recording {_where(d)} (the {SIGNAL_WORDS[worst_sig]} residual is {worst:.1f} times its "
+                f"noise floor), and nothing in the library explains it: the best candidate, {best}, removes only "
+                f"{share:.0f} % of the excess. The physics behind it is outside the {len(EFFECTS)} declared effects and the "
+                f"recalibrated base parameters; look at the located windows.")
+    fit = d.fits[d.winner]
+    change = _signal_change(d, list(d.fit_before))
+    if d.verdict == "parameters_only":
+        return (f"No physics is missing. The model misses the recording {_where(d)} (the {SIGNAL_WORDS[worst_sig]} residual is "
+                f"{worst:.1f} times its noise floor) because base parameters are off: {_base_changes(d, fit)}. "
+                f"With them {change}." if change else f"No physics is missing: {_base_changes(d, fit)}.")
+    effect = d.winner.split("+")[0]
+    eff = EFFECTS[effect]
+    main = next(i for i, fp in enumerate(fit.params) if fp.kind == "effect")
+    fp = fit.params[main]
+    phys = PHYSICS.get(effect, eff.meaning + " ({v})").format(v=_pm(fit.values[main], fit.stderr[main], fp.unit))
+    others = [f"{q.name} {_pm(v, e, q.unit)}" for q, v, e in zip(fit.params, fit.values, fit.stderr) if q.kind == "effect" and q is not fp]
+    text = (f"The model misses the recording {_where(d)} (the {SIGNAL_WORDS[worst_sig]} residual is {worst:.1f} times its noise "
+            f"floor) the way {effect.replace('_', ' ')} does: {eff.signature}. The explanation: {phys}")
+    if others:
+        text += "; also fitted: " + ", ".join(others)
+    text += "."
+    base = _base_changes(d, fit)
+    if base:
+        text += f" Together with it, {base}."
+    if change:
+        text += f" Adding it, {change}."
+    if d.runner_up and d.runner_up in d.scores:
+        ru, w = d.scores[d.runner_up], d.scores[d.winner]
+        if ru.chi2 < ALMOST_AS_WELL * w.chi2:
+            alt = "recalibrating base parameters" if d.runner_up == "base" else d.runner_up.replace("_", " ")
+            text += (f" Caution: {alt} explains the recording almost as well (residual {ru.chi2 / w.chi2:.2f} times the "
+                     f"winner's); a test at another operating point (supply pressure, load) tells them apart.")
+        else:
+            text += f" The runner-up, {d.runner_up}, fits worse by {ru.bic - w.bic:.0f} in BIC."
+    return text

@@ -1,0 +1,98 @@
+"""The diagnosis as a JSON document (docs/diagnosis-schema.md): plain numbers, SI units named."""
+
+from __future__ import annotations
+
+import math
+
+from ..effects import EFFECTS
+from ..parameters import BASE_BY_KEY
+from .candidates import FRICTION_LEVEL
+from .residuals import UNITS
+
+
+def _num(x):
+    if x is None:
+        return None
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def _param_rows(cfg, fit) -> list[dict]:
+    rows = []
+    for fp, v, e in zip(fit.params, fit.values, fit.stderr):
+        if fp.kind == "effect":
+            rows.append({"name": fp.key, "kind": "effect", "value": _num(v), "stderr": _num(e), "unit": fp.unit,
+                         "meaning": EFFECTS[fp.effect].param(fp.name).meaning, "default": _num(fp.nominal)})
+        elif fp.key == FRICTION_LEVEL:
+            for key in ("friction.static_force", "friction.coulomb_force"):
+                a = cfg.p(key)
+                rows.append({"name": key, "kind": "base", "value": _num(a * v), "stderr": _num(a * e), "unit": "N",
+                             "meaning": BASE_BY_KEY[key].meaning, "nominal": _num(a)})
+        else:
+            rows.append({"name": fp.key, "kind": "base", "value": _num(v), "stderr": _num(e), "unit": fp.unit,
+                         "meaning": BASE_BY_KEY[fp.key].meaning, "nominal": _num(fp.nominal)})
+    return rows
+
+
+def _fit_table(fit: dict | None) -> dict | None:
+    if fit is None:
+        return None
+    return {s: {"rms": _num(v["rms"]), "unit": UNITS[s], "rms_normalised": _num(v["rms_normalised"]),
+                "nrmse": _num(v["nrmse"]), "fit_percent": _num(v["fit_percent"])} for s, v in fit.items()}
+
+
+def diagnosis_to_dict(d) -> dict:
+    """Serialise a ``engine.Diagnosis`` (see docs/diagnosis-schema.md)."""
+    from .engine import SCHEMA
+
+    ranked = d.ranked()
+    agreement = getattr(d, "agreement", {})
+    effects = []
+    for rank, name in enumerate(ranked, start=1):
+        f = d.fits[name]
+        s = d.scores[name]
+        kind = "nominal" if name == "nominal" else "base" if name == "base" else "effect"
+        effects.append({
+            "rank": rank,
+            "name": name,
+            "kind": kind,
+            "effects": [e for e in name.split("+") if e in EFFECTS],
+            "parameters": _param_rows(d.cfg, f),
+            "k": f.k,
+            "chi2": _num(s.chi2),
+            "chi2_per_residual": _num(s.chi2 / f.n) if f.n else None,
+            "aic": _num(s.aic),
+            "bic": _num(s.bic),
+            "delta_bic": _num(s.delta_bic),
+            "score": _num(-s.delta_bic),
+            "explained_fraction": _num(s.explained),
+            "window_agreement": _num(agreement.get(name)) if name != "nominal" else None,
+            "simulations": f.sims,
+            "seconds": _num(f.seconds),
+        })
+    return {
+        "schema": SCHEMA,
+        "kind": "servo_replay",
+        "recording": d.recording,
+        "plant": {"name": d.cfg.name, "path": d.cfg.path, "digest": d.cfg.digest},
+        "verdict": d.verdict,
+        "reason": d.reason,
+        "winner": d.winner,
+        "runner_up": d.runner_up,
+        "explanation": d.explanation,
+        "effects": effects,
+        "fit_before": _fit_table(d.fit_before),
+        "fit_after": _fit_table(d.fit_after),
+        "objective_before": {s: _num(v) for s, v in d.objective_before.items()},
+        "objective_after": {s: _num(v) for s, v in d.objective_after.items()} if d.objective_after else None,
+        "noise_floor": {s: {"value": _num(v), "unit": UNITS[s]} for s, v in d.floors.items()},
+        "windows": [
+            {k: (_num(v) if isinstance(v, float) else ({s: _num(x) for s, x in v.items()} if isinstance(v, dict) else v))
+             for k, v in w.items()}
+            for w in d.windows
+        ],
+        "located_regimes": list(getattr(d, "located_regimes", [])),
+        "saved_model": d.saved_model,
+        "notes": list(d.notes),
+        "timing": {"seconds": _num(d.seconds), "simulations": d.simulations, "jobs": d.jobs},
+    }

@@ -1,0 +1,209 @@
+"""Replay residuals: normalised by each signal's noise floor, subsampled, summarised per signal and window.
+
+The fitted residual vector stacks, for every measured signal s, (recorded - model)/floor_s at
+every ``stride``-th sample. A correct model leaves values of about one (noise_floor.py).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..config import PlantConfig
+from ..errors import InputError, SimulationError
+from .noise_floor import sensor_noise_std
+from .replay_fit import ReplaySetup, run_replay
+
+# lowest floors we accept (instrument resolution a logger rarely beats): keeps one signal from
+# dominating when its noise estimate comes out implausibly small
+MIN_FLOOR = {"position": 1e-6, "pressure_a": 50.0, "pressure_b": 50.0, "supply_pressure": 50.0, "valve_command": 0.005}
+UNITS = {"position": "m", "pressure_a": "Pa", "pressure_b": "Pa", "supply_pressure": "Pa", "valve_command": "V"}
+FAILED_RESIDUAL = 30.0  # normalised residual of every sample of a replay that diverged (at least; see with_fail_level)
+NULL_PRE_ROLL = 1.0  # s of hold the null recording settles in before its test starts
+
+
+@dataclass(frozen=True)
+class ResidualModel:
+    """How replays are compared with a recording.
+
+    Attributes
+    ----------
+    signals : tuple of str
+        Signals compared (measured, and not the replay's input).
+    floors : dict
+        Signal -> noise floor [SI unit of the signal].
+    sensor_noise : dict
+        Signal -> estimated sensor noise alone [SI].
+    index : ndarray
+        Sample indices used in the fit (every ``stride``-th).
+    """
+
+    signals: tuple[str, ...]
+    floors: dict
+    sensor_noise: dict
+    index: np.ndarray
+    recorded: dict
+    fail_level: float = FAILED_RESIDUAL
+
+    @property
+    def size(self) -> int:
+        """Length of the residual vector."""
+        return len(self.signals) * self.index.size
+
+    def vector(self, sim: dict | None) -> np.ndarray:
+        """Stacked normalised residuals; a failed replay (None) gives a large constant vector."""
+        if sim is None:
+            return np.full(self.size, self.fail_level)
+        parts = [(self.recorded[s][self.index] - sim[s][self.index]) / self.floors[s] for s in self.signals]
+        return np.concatenate(parts)
+
+    def split(self, vec: np.ndarray) -> dict:
+        """Signal -> its part of a residual vector."""
+        n = self.index.size
+        return {s: vec[i * n:(i + 1) * n] for i, s in enumerate(self.signals)}
+
+
+def with_fail_level(model: ResidualModel, nominal_vector: np.ndarray) -> ResidualModel:
+    """The model with failed replays scored ten times worse than the nominal model, so a fit never
+    prefers a diverging parameter set to a poor but physical one."""
+    rms = float(np.sqrt(np.mean(nominal_vector ** 2))) if nominal_vector.size else 0.0
+    return dataclasses.replace(model, fail_level=max(FAILED_RESIDUAL, 10.0 * rms))
+
+
+def compared_signals(setup: ReplaySetup) -> tuple[str, ...]:
+    """Measured signals a replay can be compared on (the command is the input of an open-loop replay)."""
+    out = [s for s in ("position", "pressure_a", "pressure_b", "supply_pressure", "valve_command") if s in setup.recorded]
+    if not setup.closed_loop and "valve_command" in out:
+        out.remove("valve_command")
+    return tuple(out)
+
+
+def _quantum(values: np.ndarray) -> float:
+    """Quantisation step of a recorded signal (0 when it is not on a grid); see compliance.replay."""
+    from ..replay import position_quantum
+
+    return position_quantum(values)
+
+
+def null_replay_floors(cfg: PlantConfig, setup: ReplaySetup, sensor: dict, seed: int = 7) -> dict:
+    """How far a *correct* model's replay stays from its recording, signal by signal [SI].
+
+    A parametric bootstrap of the null hypothesis: the nominal model records the same test
+    (set-point or command, load, start) with sensors like the recording's (noise and
+    quantisation estimated from it), and that synthetic recording is replayed exactly as the
+    real one is (matched noise, re-synchronised segments). The RMS residuals are the floors:
+    they contain the sensor noise, the error of the noise estimate, the state read at each
+    re-synchronisation and the stall points a dead zone decides on noise.
+    """
+    import pandas as pd
+
+    from ..profiles import Profile
+    from ..simulate import Scenario, SensorNoise, simulate
+    from .replay_fit import prepare_replay
+
+    rec = setup.recorded
+    noise = SensorNoise(
+        position_std=sensor.get("position", 0.0), position_quantum=_quantum(rec["position"]),
+        pressure_std=max(sensor.get("pressure_a", 0.0), sensor.get("pressure_b", 0.0)),
+        pressure_quantum=_quantum(rec["pressure_a"]) if "pressure_a" in rec else 0.0,
+    )
+    t = setup.time
+    ts = float(np.median(np.diff(t)))
+    pre = int(round(NULL_PRE_ROLL / ts))
+    # the null bench settles first (a hold before the test), like a real recording does
+    tt = np.concatenate([t[:pre] , t + pre * ts]) if pre else t
+    if setup.closed_loop:
+        ref = np.concatenate([np.full(pre, setup.reference[0]), setup.reference])
+        sc = Scenario(duration=float(tt[-1]), initial_position=setup.initial_position, reference=Profile(tt, ref),
+                      load=setup.load, noise=noise, seed=seed)
+    else:
+        cmd = np.concatenate([np.full(pre, setup.command[0]), setup.command])
+        sc = Scenario(duration=float(tt[-1]), initial_position=setup.initial_position, command=Profile(tt, cmd),
+                      load=setup.load, noise=noise, seed=seed)
+    syn = simulate(cfg, sc).iloc[pre:].reset_index(drop=True)
+    n = min(len(syn), t.size)
+    frame = pd.DataFrame({"time": t[:n], "position": syn["position"].to_numpy()[:n], "valve_command": syn["valve_command"].to_numpy()[:n]})
+    if setup.closed_loop:
+        frame["reference"] = setup.reference[:n]
+    for s_ in ("pressure_a", "pressure_b", "supply_pressure"):
+        if s_ in rec:
+            frame[s_] = syn[s_].to_numpy()[:n]
+    meta = {"conditions": {"load_force": setup.load}, "source_path": "<null replay>"}
+    syn_setup = prepare_replay(cfg, frame, meta)
+    out = run_replay(cfg, syn_setup)
+    return {s_: float(np.sqrt(np.mean((frame[s_].to_numpy() - out[s_][:n]) ** 2))) for s_ in frame.columns if s_ in rec}
+
+
+def build_residual_model(cfg: PlantConfig, setup: ReplaySetup, *, stride: int = 5, nominal: dict | None = None) -> ResidualModel:
+    """Estimate the noise floors and choose the samples of the fit.
+
+    Each floor is the larger of the signal's sensor noise and what a correct model's replay
+    leaves (``null_replay_floors``).
+
+    Parameters
+    ----------
+    cfg : PlantConfig
+        The nominal replay configuration (overrides applied).
+    setup : ReplaySetup
+    stride : int
+        Use every ``stride``-th sample (5 ms at 1 kHz keeps pressure noise independent).
+    nominal : dict, optional
+        Unused (kept for callers that already ran the nominal replay).
+    """
+    signals = compared_signals(setup)
+    sensor = {s: (0.0 if s == "valve_command" else sensor_noise_std(setup.recorded[s])) for s in signals}
+    try:
+        null = null_replay_floors(cfg, setup, sensor)
+    except (SimulationError, InputError):
+        null = {}
+    floors = {}
+    for s in signals:
+        f = max(null.get(s, 0.0), sensor[s] if s != "position" or not setup.closed_loop else 0.0)
+        if f <= 0.0:
+            f = sensor[s]
+        floors[s] = max(f, MIN_FLOOR[s])
+    index = np.arange(0, setup.time.size, max(1, int(stride)))
+    return ResidualModel(signals=signals, floors=floors, sensor_noise=sensor, index=index,
+                         recorded={s: setup.recorded[s] for s in signals})
+
+
+def evaluate(model: ResidualModel, cfg: PlantConfig, setup: ReplaySetup) -> tuple[np.ndarray, dict | None]:
+    """Run one replay and return (normalised residual vector, replay or None when it diverged)."""
+    try:
+        sim = run_replay(cfg, setup)
+    except SimulationError:
+        return model.vector(None), None
+    return model.vector(sim), sim
+
+
+def signal_fit(model: ResidualModel, sim: dict | None, mask: np.ndarray | None = None) -> dict:
+    """Per-signal agreement of a replay with the recording (all samples, or those in ``mask``).
+
+    Returns
+    -------
+    dict
+        signal -> {rms [SI], rms_normalised [-], nrmse [-] (rms / recorded range),
+        fit_percent (100 * (1 - |r| / |y - mean y|), the NRMSE fit of system identification)}.
+    """
+    out = {}
+    for s in model.signals:
+        y = model.recorded[s] if mask is None else model.recorded[s][mask]
+        if y.size == 0:
+            continue
+        if sim is None:
+            out[s] = {"rms": float("nan"), "rms_normalised": float("nan"), "nrmse": float("nan"), "fit_percent": float("nan")}
+            continue
+        m = sim[s] if mask is None else sim[s][mask]
+        r = y - m
+        rms = float(np.sqrt(np.mean(r * r)))
+        spread = float(np.linalg.norm(y - y.mean()))
+        rng = float(np.ptp(y))
+        out[s] = {
+            "rms": rms,
+            "rms_normalised": rms / model.floors[s],
+            "nrmse": rms / rng if rng > 0 else float("nan"),
+            "fit_percent": 100.0 * (1.0 - float(np.linalg.norm(r)) / spread) if spread > 0 else float("nan"),
+        }
+    return out

@@ -1,0 +1,175 @@
+"""The diagnosis: replay, fit recovery on generated data, null verdicts, CLI, friction bench, a small benchmark.
+
+Recordings are generated with the model (``recording_synth``) on a short steps-only practice
+profile (17 s) and diagnosed with a restricted candidate library so the file stays fast.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+
+import numpy as np
+import pytest
+
+from compliance.cli import main
+from compliance.config import load_plant
+from compliance.diagnosis.candidates import FitParam, effect_params
+from compliance.diagnosis.engine import diagnose, save_fitted
+from compliance.diagnosis.replay_fit import prepare_replay, replay_config, run_replay, segment_starts
+from compliance.errors import InputError
+from compliance.recording_synth import PRACTICE_NOISE, synthesise, write_recording
+
+DURATION = 17.0  # s: hold, +2 % / back, +5 % / back, +10 % / back (the practice steps)
+
+
+@pytest.fixture(scope="module")
+def cfg():
+    return load_plant("plant-a")
+
+
+def _recording(cfg, effects=None, noise=None, x0=0.06, load=7000.0, kd=20.0, seed=3):
+    truth = cfg.replace(effects=effects) if effects else cfg
+    return synthesise(truth, "steps", x0=x0, load=load, kd=kd, noise=noise, seed=seed, duration=DURATION)
+
+
+def test_segment_starts_sit_before_steps_and_cut_long_stretches():
+    t = np.arange(0, 20.0, 1e-3)
+    ref = np.where(t < 2.0, 0.06, 0.065)
+    ref = np.where(t < 12.0, ref, 0.06)
+    starts = segment_starts(t, ref, None, max_segment=3.0)
+    # 100 ms before each step (at 2 s and 12 s), and no stretch longer than 3 s
+    assert 1900 in starts and 11900 in starts
+    assert np.max(np.diff(np.append(starts, t.size - 1))) <= 3000 + 500  # the last stretch may keep a short tail
+
+
+def test_replay_of_the_model_reproduces_its_own_noise_free_recording(cfg):
+    """Resets read the recorded state; with the generating model the replay stays on the recording."""
+    frame, meta = _recording(cfg)
+    setup = prepare_replay(cfg, frame, meta)
+    assert len(setup.resets) > 3
+    sim = run_replay(replay_config(cfg, setup), setup)
+    # differences come from the smoothed states read at the resets (S-G on exact data) and the
+    # smoother's bias injected as "noise" during fast moves; a replay error below the practice
+    # sensor noise (20 um, 300 Pa) cannot move a diagnosis, so that is the bound
+    assert np.sqrt(np.mean((sim["position"] - frame.position.to_numpy()) ** 2)) < 20e-6
+    assert np.sqrt(np.mean((sim["pressure_a"] - frame.pressure_a.to_numpy()) ** 2)) < 300.0
+
+
+def test_fit_param_unit_cube_round_trips():
+    fp = FitParam("heat_transfer.conductance", "effect", "W/K", 0.01, 500.0, True, 10.0)
+    for v in (0.01, 3.0, 500.0):
+        assert fp.from_unit(fp.to_unit(v)) == pytest.approx(v, rel=1e-12)
+    lin = effect_params("valve_offset")[0]
+    assert lin.from_unit(0.5) == pytest.approx(0.0, abs=1e-12)  # symmetric bounds
+
+
+@pytest.mark.parametrize("effect, param, value", [
+    ("heat_transfer", "conductance", 12.0),
+    ("internal_leakage", "conductance", 1.5e-10),
+])
+def test_fit_recovers_a_known_parameter_on_noise_free_data(cfg, effect, param, value):
+    """Noise-free generated data: the right effect wins and its parameter comes back within 5 %.
+
+    5 %: the simplex stops at 0.2 % of the (log) range, i.e. ~2 % of the value for these ranges.
+    """
+    frame, meta = _recording(cfg, {effect: {param: value}})
+    d = diagnose(cfg, frame, meta, effects=["heat_transfer", "internal_leakage", "valve_offset"], jobs=1, recalibrate=False)
+    assert d.verdict == "missing_physics"
+    assert d.winner == effect
+    fitted = d.fits[effect].value(f"{effect}.{param}")
+    assert fitted == pytest.approx(value, rel=0.05)
+    # the fit improves the signal the effect shows in
+    sig = max(("pressure_a", "pressure_b", "valve_command"), key=lambda s: d.fit_before[s]["rms_normalised"])
+    assert d.fit_after[sig]["rms"] < 0.5 * d.fit_before[sig]["rms"]
+
+
+def test_null_recording_gives_no_mismatch(cfg):
+    frame, meta = _recording(cfg, noise=PRACTICE_NOISE, seed=11)
+    d = diagnose(cfg, frame, meta, effects=["heat_transfer", "internal_leakage"], jobs=1, recalibrate=False)
+    assert d.verdict == "no_mismatch"
+    assert d.winner is None
+    assert "Nothing is wrong" in d.explanation
+
+
+def test_cli_writes_json_and_a_fitted_model_with_provenance(cfg, tmp_path):
+    frame, meta = _recording(cfg, {"internal_leakage": {"conductance": 2e-10}}, noise=PRACTICE_NOISE, load=9000.0, seed=5)
+    rec, _ = write_recording(frame, meta, tmp_path / "run.csv.gz")
+    out = tmp_path / "diag.json"
+    model = tmp_path / "fitted.toml"
+    args = ["diagnose", str(rec), "--plant", "plant-a", "--effects", "internal_leakage,external_leakage",
+            "--no-recalibration", "--jobs", "1", "--json", str(out), "--save-model", str(model), "--quiet"]
+    assert main(args) == 0
+    data = json.loads(out.read_text())
+    for key in ("verdict", "effects", "fit_before", "fit_after", "windows", "explanation", "noise_floor"):
+        assert key in data
+    assert data["verdict"] == "missing_physics" and data["winner"] == "internal_leakage"
+    top = data["effects"][0]
+    assert top["name"] == "internal_leakage" and top["parameters"][0]["unit"] == "kg/(s*Pa)"
+    fitted = load_plant(model)
+    assert "internal_leakage" in fitted.effects
+    assert fitted.provenance["parent_digest"] == cfg.digest
+    assert fitted.provenance["recording"].endswith("run.csv.gz")
+    # nothing is overwritten
+    assert main(args) == 2
+
+
+def test_cli_rejects_unknown_effects_and_unusable_files(tmp_path, cfg):
+    frame, meta = _recording(cfg)
+    rec, _ = write_recording(frame, meta, tmp_path / "r.csv")
+    assert main(["diagnose", str(rec), "--plant", "plant-a", "--effects", "heat_transfr", "--jobs", "1"]) == 2
+    bad = tmp_path / "nothing.csv"
+    bad.write_text("time,position\n0,0.01\n0.001,0.01\n")
+    assert main(["diagnose", str(bad), "--plant", "plant-a"]) == 2
+
+
+def test_save_fitted_refuses_when_nothing_was_fitted(cfg, tmp_path):
+    frame, meta = _recording(cfg, noise=PRACTICE_NOISE, seed=11)
+    d = diagnose(cfg, frame, meta, effects=["valve_offset"], jobs=1, recalibrate=False)
+    with pytest.raises(InputError):
+        save_fitted(d, tmp_path / "x.toml")
+
+
+def test_friction_diagnosis_names_pressure_dependence_on_synthetic_runs():
+    """Static-map runs with k_p = 2e-6 N/Pa at 1, 4 and 7 bar: pressure dependence found, k_p back within 5 %,
+    and no pre-sliding claimed (parsimony: the data has none)."""
+    from compliance.characterise.friction_map import piston_area, synthetic_friction_run
+    from compliance.diagnosis.friction_diagnosis import diagnose_friction
+
+    area = piston_area(0.0257)
+    law = {"coulomb": 3.0, "static": 4.0, "stribeck_velocity": 0.003, "viscous": 80.0}
+    runs = []
+    for i, bar in enumerate((1.0, 4.0, 7.0)):
+        f = synthetic_friction_run([0.005, 0.015], law, area=area, pressure_gauge=bar * 1e5, force_noise=0.05,
+                                   position_noise=2e-6, seed=i, pressure_coefficient=2e-6)
+        runs.append((f, {"source_path": f"seal_{bar:.0f}bar.csv", "bore": 0.0257}))
+    d = diagnose_friction(runs)
+    (seal,) = d.seals
+    assert seal.seal == "seal"
+    assert seal.verdict == "missing_physics"
+    assert seal.winner == "pressure_dependent_friction"
+    assert seal.fits[seal.winner].params["pressure_coefficient"] == pytest.approx(2e-6, rel=0.05)
+    data = d.to_dict()
+    assert data["kind"] == "friction" and data["seals"][0]["fit_after"]
+
+
+def test_small_benchmark_runs_and_scores(cfg):
+    from compliance.diagnosis.benchmark import format_summary, run_benchmark
+
+    rep = run_benchmark(cfg, effects=["internal_leakage"], cases=1, seed=2, library=["internal_leakage", "heat_transfer"],
+                        jobs=1, null=True, miscalibrations=False)
+    s = rep["summary"]
+    assert s["n_cases"] == 2
+    assert s["top1_accuracy"] == 1.0 and s["null_accuracy"] == 1.0
+    assert s["median_main_error"] < 0.25
+    assert "confusion matrix" in format_summary(rep)
+    assert math.isfinite(rep["seconds"])
+
+
+def test_replay_setup_needs_the_controller_clock(cfg):
+    frame, meta = _recording(cfg)
+    thin = frame.iloc[::2].reset_index(drop=True)
+    with pytest.raises(InputError):
+        prepare_replay(cfg, thin, meta)
+    assert dataclasses.is_dataclass(prepare_replay(cfg, frame, meta))
