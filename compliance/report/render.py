@@ -39,6 +39,10 @@ def _draw(spec: dict, valve: dict | None = None) -> str:
     from . import figures, figures_linear
 
     k = spec["kind"]
+    if k == "trace" and spec["trace"].get("kind") == "path3d":
+        from ..tracking.figures import path_figure  # plant B's 3-D path overlay and per-axis errors
+
+        return path_figure(spec["trace"], spec["id"])
     if k == "trace":
         return figures.trace_figure(spec["trace"], spec["marks"], spec["run_kind"], spec["id"],
                                     tolerance=spec.get("tolerance"), valve=valve)
