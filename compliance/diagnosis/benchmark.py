@@ -45,6 +45,7 @@ class CaseResult:
     reduction: float | None = None  # after/before RMS of the full closed-loop replay on reduction_signal
     reduction_signal: str | None = None
     reduction_objective: float | None = None  # the same on the re-synchronised replay the fits minimise
+    effective_error: float | None = None  # EFFECTIVE combination's relative error (valley-prone effects)
     seconds: float = 0.0
     simulations: int = 0
     visibility: dict = field(default_factory=dict)
@@ -80,6 +81,27 @@ def _main_error(case: Case, diag) -> tuple[dict, float | None]:
     return fitted, None
 
 
+# effects whose parameters trade along a valley: the combination the data pin down (the total
+# lag a step sees: a sensor's delay + its time constant; a valve's delay + its spool's 2 zeta / w_n)
+EFFECTIVE = {
+    "sensor_lag": ("total lag [s]", lambda p: p["time_constant"] + p["delay"]),
+    "valve_dynamics": ("total lag [s]", lambda p: p["delay"] + 2.0 * p["damping"] / p["natural_frequency"]),
+}
+
+
+def effective_error(truth: str, true_params: dict, fitted: dict) -> float | None:
+    """Relative error of the identifiable combination of a valley-prone effect (None for others)."""
+    if truth not in EFFECTIVE:
+        return None
+    f = EFFECTIVE[truth][1]
+    got = {k.split(".", 1)[1]: v for k, v in fitted.items() if k.startswith(truth + ".")}
+    try:
+        t, g = f(true_params), f(got)
+    except KeyError:
+        return None
+    return abs(g - t) / abs(t)
+
+
 def _reduction(case: Case, diag) -> tuple[float | None, str | None, float | None]:
     """After/before RMS on the signal the effect shows in most (among its declared signals)."""
     if diag.fit_after is None:
@@ -111,7 +133,9 @@ def score_case(case: Case, diag) -> CaseResult:
         kind=case.kind, truth=case.truth, predicted=label, verdict=diag.verdict, correct=bool(correct),
         seed=int(case.operating_point.get("seed", 0)), operating_point=dict(case.operating_point),
         true_params={k: float(v) for k, v in case.params.items()}, fitted_params={k: float(v) for k, v in fitted.items()},
-        main_error=err, reduction=red, reduction_signal=sig, reduction_objective=red_obj, seconds=diag.seconds, simulations=diag.simulations,
+        main_error=err, reduction=red, reduction_signal=sig, reduction_objective=red_obj,
+        effective_error=effective_error(case.truth, case.params, fitted) if correct and case.kind == "effect" else None,
+        seconds=diag.seconds, simulations=diag.simulations,
         visibility=dict(case.visibility), runner_up=diag.runner_up, visible=case.visible,
     )
 
@@ -245,8 +269,10 @@ def summarise(results: list[CaseResult], effects) -> dict:
         rs = [r for r in eff if r.truth == e]
         if rs:
             errs = [r.main_error for r in rs if r.correct and r.main_error is not None]
+            eff_errs = [r.effective_error for r in rs if r.effective_error is not None]
             per_effect[e] = {"cases": len(rs), "correct": sum(r.correct for r in rs),
-                             "median_main_error": float(np.median(errs)) if errs else None}
+                             "median_main_error": float(np.median(errs)) if errs else None,
+                             "median_effective_error": float(np.median(eff_errs)) if eff_errs else None}
 
     def frac(rs):
         return sum(r.correct for r in rs) / len(rs) if rs else None

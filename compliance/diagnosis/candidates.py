@@ -256,8 +256,15 @@ class Candidate:
 
 
 def effect_candidate(name: str) -> Candidate:
-    """The candidate of one declared effect."""
-    return Candidate(name, effect_params(name), SCAN_GRIDS.get(name, ({},)))
+    """The candidate of one declared effect (grid points clipped into the declared bounds)."""
+    params = effect_params(name)
+    bounds = {fp.name: (fp.low, fp.high) for fp in params}
+    grid = []
+    for point in SCAN_GRIDS.get(name, ({},)):
+        clipped = {k: min(max(v, bounds[k][0]), bounds[k][1]) for k, v in point.items() if k in bounds}
+        if clipped not in grid:
+            grid.append(clipped)
+    return Candidate(name, params, tuple(grid) or ({},))
 
 
 def signature_order(names, excess: dict[str, float]) -> list[str]:

@@ -50,7 +50,7 @@ EFFECT_RANGES: dict[str, dict[str, tuple[float, float, bool]]] = {
     "valve_offset": {"offset": (0.05, 0.4, True)},  # sign drawn separately
     "position_dependent_load": {"stiffness": (2e4, 1e5, True)},  # sign drawn separately
     "sensor_lag": {"time_constant": (0.003, 0.03, True), "delay": (0.0, 0.004, False)},
-    "line_dynamics": {"volume": (1e-4, 6e-4, True), "conductance": (1e-8, 8e-8, True)},
+    "line_dynamics": {"volume": (1e-4, 6e-4, True), "conductance": (5e-9, 3e-8, True)},
     "linkage_compliance": {"stiffness": (1.2e5, 3e5, True), "damping": (100.0, 2000.0, True)},
 }
 SIGNED = ("valve_offset", "position_dependent_load")
@@ -106,9 +106,11 @@ def draw_operating_point(rng, stroke: float) -> dict:
 
 
 def draw_effect_params(rng, name: str) -> dict:
-    """Random parameters of an effect within ``EFFECT_RANGES``."""
+    """Random parameters of an effect within ``EFFECT_RANGES`` (and the effect's declared bounds)."""
     out = {}
     for p, (lo, hi, log) in EFFECT_RANGES[name].items():
+        blo, bhi = EFFECTS[name].param(p).bounds
+        lo, hi = max(lo, blo), min(hi, bhi)
         v = _draw(rng, lo, hi, log) if hi > lo else lo
         if name in SIGNED and p == EFFECTS[name].params[0].name and rng.uniform() < 0.5:
             v = -v

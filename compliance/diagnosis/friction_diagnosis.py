@@ -317,8 +317,9 @@ def explain_friction(d: SealDiagnosis) -> str:
     if d.verdict == "no_mismatch":
         return text + " The law already fits within the force noise: nothing is missing."
     if d.winner is None:
-        return text + (" None of the candidate physics (pressure-dependent friction, pre-sliding hysteresis) removes enough of it: "
-                       "unexplained.")
+        tested = "pressure-dependent friction, pre-sliding hysteresis" if PRESSURE_EFFECT in d.fits else (
+            "pre-sliding hysteresis; pressure dependence needs runs at two or more pressures")
+        return text + f" None of the candidate physics ({tested}) removes enough of it: unexplained."
     w = d.fits[d.winner]
     p = w.params
     parts = []
