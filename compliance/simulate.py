@@ -128,6 +128,28 @@ def _interp_uniform(hist, h, t):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def record_sample(out, k, ts, xm, ref_k, u, u_d, y, aux, P):
+    """Write the canonical columns of controller sample ``k`` (shared by every compiled loop)."""
+    out[k, O_T] = k * ts
+    out[k, O_XM] = xm
+    out[k, O_REF] = ref_k
+    out[k, O_U] = u
+    out[k, O_PA] = y[S_PA]
+    out[k, O_PB] = y[S_PB]
+    out[k, O_PS] = y[S_PSUP] if P[P_SD_ON] != 0.0 else P[P_PS]
+    out[k, O_X] = y[S_X]
+    out[k, O_V] = y[S_V]
+    out[k, O_LOAD] = aux[A_LOAD]
+    out[k, O_FRIC] = aux[A_FRIC]
+    out[k, O_QA] = aux[A_QA]
+    out[k, O_QB] = aux[A_QB]
+    out[k, O_OPEN] = aux[A_OPEN]
+    out[k, O_TA] = y[S_TA] if P[P_HT_ON] != 0.0 else P[P_TS]
+    out[k, O_TB] = y[S_TB] if P[P_HT_ON] != 0.0 else P[P_TS]
+    out[k, O_UD] = u_d
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def _rk4_step(y, P, u, lx, ly, h, k1, k2, k3, k4, tmp, aux, k1_ready=False):
     """One classical RK4 step in place; ``k1_ready`` reuses a slope already evaluated at (y, u)."""
     n = y.shape[0]
@@ -232,23 +254,7 @@ def simulate_core(P, y0, ref, cmd, closed_loop, pos_noise, pos_quantum, lx, ly, 
         # --- record the sample
         u_now = u if valve_delay <= 0.0 else _zoh_average(u_hist, ts, k * ts - valve_delay, k * ts - valve_delay)
         plant_rhs(y, P, u_now, lx, ly, k1, aux)  # also the first RK4 slope when there is no valve delay
-        out[k, O_T] = k * ts
-        out[k, O_XM] = xm
-        out[k, O_REF] = ref[k]
-        out[k, O_U] = u
-        out[k, O_PA] = y[S_PA]
-        out[k, O_PB] = y[S_PB]
-        out[k, O_PS] = y[S_PSUP] if P[P_SD_ON] != 0.0 else P[P_PS]
-        out[k, O_X] = y[S_X]
-        out[k, O_V] = y[S_V]
-        out[k, O_LOAD] = aux[A_LOAD]
-        out[k, O_FRIC] = aux[A_FRIC]
-        out[k, O_QA] = aux[A_QA]
-        out[k, O_QB] = aux[A_QB]
-        out[k, O_OPEN] = aux[A_OPEN]
-        out[k, O_TA] = y[S_TA] if P[P_HT_ON] != 0.0 else P[P_TS]
-        out[k, O_TB] = y[S_TB] if P[P_HT_ON] != 0.0 else P[P_TS]
-        out[k, O_UD] = u_d
+        record_sample(out, k, ts, xm, ref[k], u, u_d, y, aux, P)
         if k == n_samples:
             break
         # --- integrate to t_{k+1}

@@ -22,7 +22,7 @@ from ..errors import InputError, SimulationError
 from ..layout import A_FRIC, A_LOAD, A_OPEN, A_QA, A_QB, N_AUX, N_STATES, P_CDZN, P_CDZP, P_CSLN, P_CSLP, P_HT_ON, P_LC, P_PS, P_SD_ON
 from ..layout import P_TS, P_UCEN, P_ULIM, P_VD_ON, S_PA, S_PB, S_PSUP, S_SP, S_TA, S_TB, S_V, S_X
 from ..plant import initial_state, load_curve_arrays, parameter_vector, plant_rhs
-from ..simulate import OUTPUT_COLUMNS, _rk4_step
+from ..simulate import OUTPUT_COLUMNS, _rk4_step, record_sample
 from .controller import (
     C_AO_IN, C_AO_LV, C_AO_LX, C_AO_POLE, C_AO_SV, C_AO_SX, C_AREA_RATIO, C_FO_IN, C_FO_L, C_FO_POLE, C_FO_SV, C_KD, C_KI,
     C_KP, C_LOAD_PRESSURE, C_RATE_ALPHA, C_MODE, C_PATM, C_VISCOUS, C_PID_ALPHA, C_TS, C_VEL_ALPHA, ControllerDesign, controller_vector, state_feedback_command,
@@ -146,23 +146,7 @@ def tracking_core(P, C, y0, ref, dref, ddref, pos_noise, pos_quantum, pa_noise, 
         u = u_rel + P[P_UCEN]
         # --- record
         plant_rhs(y, P, u, lx, ly, dy, aux)
-        out[k, O_T] = k * ts
-        out[k, O_XM] = xm
-        out[k, O_REF] = ref[k]
-        out[k, O_U] = u
-        out[k, O_PA] = y[S_PA]
-        out[k, O_PB] = y[S_PB]
-        out[k, O_PS] = y[S_PSUP] if P[P_SD_ON] != 0.0 else P[P_PS]
-        out[k, O_X] = y[S_X]
-        out[k, O_V] = y[S_V]
-        out[k, O_LOAD] = aux[A_LOAD]
-        out[k, O_FRIC] = aux[A_FRIC]
-        out[k, O_QA] = aux[A_QA]
-        out[k, O_QB] = aux[A_QB]
-        out[k, O_OPEN] = aux[A_OPEN]
-        out[k, O_TA] = y[S_TA] if P[P_HT_ON] != 0.0 else P[P_TS]
-        out[k, O_TB] = y[S_TB] if P[P_HT_ON] != 0.0 else P[P_TS]
-        out[k, O_UD] = u_d
+        record_sample(out, k, ts, xm, ref[k], u, u_d, y, aux, P)
         out[k, O_RV] = dref[k]
         out[k, O_RA] = ddref[k]
         out[k, O_ACC] = dy[S_V]
