@@ -24,7 +24,7 @@ from .config import PlantConfig
 from .errors import InputError
 from .layout import *  # noqa: F403 - index constants
 from .layout import N_AUX, N_STATES, STATE_NAMES
-from .plant import initial_state, load_curve_arrays, parameter_vector, plant_rhs
+from .plant import initial_state, load_curve_arrays, load_force, parameter_vector, plant_rhs
 
 GAIN_CHOICES = ("mean", "opening", "closing")
 REL_STEP = 1e-6  # central-difference step relative to each state's scale (truncation ~1e-12, rounding ~1e-10)
@@ -77,10 +77,7 @@ class OperatingPoint:
 def load_force_at(cfg: PlantConfig, P: np.ndarray, position: float) -> float:
     """Closing force on the gate at ``position`` [N]: constant or load curve, plus load stiffness."""
     lx, ly = load_curve_arrays(cfg)
-    f = float(np.interp(position, lx, ly)) if P[P_LOADMODE] == 1.0 else float(P[P_LOAD])
-    if P[P_PL_ON]:
-        f += P[P_PL_K] * (position - 0.5 * P[P_STROKE])  # same law as plant_rhs
-    return f
+    return load_force(P, position, lx, ly)
 
 
 def _where(cfg: PlantConfig) -> str:

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from compliance.config import load_plant
-from compliance.layout import N_AUX, N_STATES, S_PA, S_PB, S_V, S_X
+from compliance.layout import N_AUX, N_STATES, S_PA, S_PB, S_V, S_V2, S_X, S_X2, S_Z1
 from compliance.plant import initial_state, load_curve_arrays, parameter_vector, plant_rhs
 from compliance.profiles import Profile, steps
 from compliance.simulate import Scenario, SensorNoise, simulate
@@ -79,6 +79,50 @@ def test_initial_state_is_balanced(cfg):
     plant_rhs(y, P, 0.0, lx, ly, dy, aux)
     assert dy[S_V] == pytest.approx(0.0, abs=1e-9)
     assert dy[S_PA] == pytest.approx(0.0, abs=1e-9)
+
+
+def _rhs(cfg, P, y):
+    lx, ly = load_curve_arrays(cfg)
+    dy = np.zeros(N_STATES)
+    plant_rhs(y, P, 0.0, lx, ly, dy, np.zeros(N_AUX))
+    return dy
+
+
+@pytest.mark.parametrize("share", [-0.9, 0.3, 0.9])
+def test_given_pressures_are_held_by_stiction(cfg, share):
+    """Pressures whose net force lies inside the static band (2 x F_S) start at rest: the
+    bristles carry it (LuGre, Canudas de Wit 1995), no slip at t = 0."""
+    load = 6000.0
+    P = parameter_vector(cfg, load=load)
+    at = cfg.piston_area + cfg.rod_side_area
+    net = share * 2 * cfg.p("friction.static_force")
+    mean = 4.5e5
+    y = initial_state(cfg, P, 0.08, (mean + 0.5 * (load + net) / at, mean - 0.5 * (load + net) / at))
+    assert y[S_Z1] * cfg.p("friction.bristle_stiffness") * 2 == pytest.approx(net, rel=1e-9)
+    assert _rhs(cfg, P, y)[S_V] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_given_pressures_beyond_stiction_slip(cfg):
+    """Beyond the static band the bristles saturate at F_S/sigma0 and the rest accelerates the mass."""
+    P = parameter_vector(cfg, load=0.0)
+    at = cfg.piston_area + cfg.rod_side_area
+    net = 3.0 * 2 * cfg.p("friction.static_force")
+    y = initial_state(cfg, P, 0.08, (4.5e5 + 0.5 * net / at, 4.5e5 - 0.5 * net / at))
+    acc = (net - 2 * cfg.p("friction.static_force")) / cfg.p("cylinder.moving_mass")
+    assert _rhs(cfg, P, y)[S_V] == pytest.approx(acc, rel=1e-9)
+
+
+def test_compliant_linkage_starts_deflected_and_at_rest(cfg):
+    """With linkage compliance the link carries 2A1's force to the loaded 2A2 from t = 0."""
+    k = 3e5
+    lc = cfg.replace(effects={"linkage_compliance": {"stiffness": k, "damping": 500.0}})
+    P = parameter_vector(lc, load=9000.0)
+    y = initial_state(lc, P, 0.08)
+    f1 = y[S_PA] * lc.piston_area - y[S_PB] * lc.rod_side_area  # decoded seed 000 eq. (6), cylinder 2A1
+    assert (y[S_X2] - y[S_X]) * k == pytest.approx(-f1, rel=1e-9)
+    dy = _rhs(lc, P, y)
+    assert dy[S_V] == pytest.approx(0.0, abs=1e-9)
+    assert dy[S_V2] == pytest.approx(0.0, abs=1e-9)
 
 
 def test_tandem_symmetry(cfg):

@@ -27,7 +27,6 @@ Two devices make the replay residual a good objective for fitting:
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -36,11 +35,8 @@ from scipy.signal import savgol_filter
 
 from ..config import PlantConfig
 from ..errors import InputError, SimulationError
-from ..layout import (
-    P_AREA_CAP, P_AREA_ROD, P_FC, P_FRM, P_FS, P_KI, P_KP, P_LOAD, P_LOADMODE, P_NFR, P_PATM, P_PF_COEF, P_PF_ON,
-    P_LK_K, P_LK_ON, P_PL_K, P_PL_ON, P_SD_ON, P_SIG0, P_STROKE, P_ARR, P_VS, P_BV, S_PSUP, S_TA, S_TB, S_V, S_V2, S_X2, S_Z1, S_Z2,
-)
-from ..plant import initial_state, load_curve_arrays, parameter_vector
+from ..layout import P_KI, P_KP, P_SD_ON, P_STROKE, S_PSUP, S_TA, S_TB, S_V, S_V2
+from ..plant import initial_state, load_curve_arrays, parameter_vector, set_rest_internal_states
 from ..simulate import N_OUT, OUTPUT_COLUMNS, simulate_core
 from .noise_floor import position_noise_estimate
 
@@ -240,50 +236,6 @@ def replay_config(cfg: PlantConfig, setup: ReplaySetup) -> PlantConfig:
     return cfg.replace(params=setup.overrides) if setup.overrides else cfg
 
 
-def _load_at(P, x, lx, ly) -> float:
-    f = float(np.interp(x, lx, ly)) if P[P_LOADMODE] == 1.0 else P[P_LOAD]
-    if P[P_PL_ON]:
-        f += P[P_PL_K] * (x - 0.5 * P[P_STROKE])  # same stiffness term as plant_rhs
-    return f
-
-
-def _link_deflection(P, y, lx, ly) -> float:
-    """Linkage deflection x2 - x at rest [m]: the link shares the load so both bodies balance.
-
-    With f1, f2 the cylinders' pneumatic forces (plant_rhs, decoded seed 000 eq. 6), body 1
-    f1 + f_link and body 2 f2 - f_link - f_load balance equal friction shares when
-    f_link = (f2 - f1 - f_load)/2 = K (x2 - x).
-    """
-    f1 = y[2] * P[P_AREA_CAP] - y[3] * P[P_AREA_ROD]
-    f2 = y[2] * P[P_AREA_ROD] - y[3] * P[P_AREA_CAP]
-    return 0.5 * (f2 - f1 - _load_at(P, y[0], lx, ly)) / P[P_LK_K]
-
-
-def _set_bristles(P, y, v: float, lx, ly) -> None:
-    """LuGre bristles at a reset: at rest they carry the net force, sliding they sit at g(v)/sigma0.
-
-    (Canudas de Wit et al. 1995.) Without this a servo held by stiction would start the
-    segment free of friction and slide to the force balance.
-    """
-    if not (P[P_FRM] == 0.0 and P[P_SIG0] > 0.0):
-        return
-    if P[P_ARR] == 0.0:
-        fp = (y[2] - y[3]) * (P[P_AREA_CAP] + P[P_AREA_ROD])
-    else:
-        fp = y[2] * P[P_AREA_CAP] - y[3] * P[P_AREA_ROD] - P[P_PATM] * (P[P_AREA_CAP] - P[P_AREA_ROD])
-    n = P[P_NFR]
-    fs, fc = P[P_FS], P[P_FC]
-    if P[P_PF_ON]:
-        d = P[P_PF_COEF] * max(0.5 * (y[2] + y[3]) - P[P_PATM], 0.0)
-        fs, fc = fs + d, fc + d
-    g = fc + (fs - fc) * math.exp(-abs(v) / P[P_VS])
-    z = ((fp - _load_at(P, y[0], lx, ly)) / n - P[P_BV] * v) / P[P_SIG0]
-    zmax = g / P[P_SIG0]
-    z = min(max(z, -zmax), zmax)
-    y[S_Z1] = z
-    y[S_Z2] = z
-
-
 def _reset_state(cfg, P, setup: ReplaySetup, k: int, previous: np.ndarray, lx, ly) -> np.ndarray:
     """State at sample ``k`` read from the recording (measured) and the previous segment (the rest)."""
     st = setup.states
@@ -298,9 +250,7 @@ def _reset_state(cfg, P, setup: ReplaySetup, k: int, previous: np.ndarray, lx, l
     y[S_TB] = previous[k, _OUT["temperature_b"]]
     if P[P_SD_ON]:
         y[S_PSUP] = float(st["supply_pressure"][k]) if "supply_pressure" in st else previous[k, _OUT["supply_pressure"]]
-    if P[P_LK_ON] and P[P_ARR] == 0.0:
-        y[S_X2] = y[0] + _link_deflection(P, y, lx, ly)
-    _set_bristles(P, y, v, lx, ly)
+    set_rest_internal_states(P, y, lx, ly, v)  # bristles carry the net force, the link its share
     return y
 
 
@@ -328,12 +278,7 @@ def run_replay(cfg: PlantConfig, setup: ReplaySetup, *, noise: np.ndarray | None
         if k1 <= k0:
             continue
         if i == 0:
-            y0 = initial_state(cfg, P, setup.initial_position, setup.initial_pressures)
-            if setup.initial_pressures is not None:
-                # a recording starts at rest: measured pressures are held by stiction and a deflected link
-                if P[P_LK_ON] and P[P_ARR] == 0.0:
-                    y0[S_X2] = y0[0] + _link_deflection(P, y0, lx, ly)
-                _set_bristles(P, y0, 0.0, lx, ly)
+            y0 = initial_state(cfg, P, setup.initial_position, setup.initial_pressures)  # held at rest
             ref = setup.reference[k0:k1 + 1]
         else:
             y0 = _reset_state(cfg, P, setup, k0, out, lx, ly)
