@@ -40,6 +40,8 @@ PARAM_NAMES = (
     "lc_on", "lc_stiff", "lc_damp",
     # piecewise Stribeck friction, seed 001 eq. (8) (appended: earlier indices unchanged)
     "f_breakaway", "kv_low", "v_critical", "kv_high",
+    # valve dynamics stage: 0 the spool filters the command (before the dead zone), 1 the lag acts on the opening
+    "vd_stage",
 )
 N_PARAMS = len(PARAM_NAMES)
 PI = {n: i for i, n in enumerate(PARAM_NAMES)}
@@ -130,6 +132,7 @@ P_FJ = PI["f_breakaway"]
 P_KV1 = PI["kv_low"]
 P_VD = PI["v_critical"]
 P_KV2 = PI["kv_high"]
+P_VD_STAGE = PI["vd_stage"]
 
 # effect name -> (flag index, {param name: index}) — the bridge from declarations to the core
 EFFECT_SLOTS = {

@@ -109,6 +109,9 @@ def trim(cfg: PlantConfig, position: float, load: float | str | None = None, *, 
     if load is not None and not isinstance(load, str) and not math.isfinite(float(load)):
         raise InputError(f"{_where(cfg)}: load must be a finite force in N, got {load!r}")
     P = parameter_vector(cfg, load=load, flow_control=flow_control)
+    # a linear valve gain commutes with the valve's lag: filtering the command (spool stage) or the
+    # opening it asks for (opening stage) is the same linear model, so both linearise as the spool
+    P[P_VD_STAGE] = 0.0
     linkage = bool(P[P_LK_ON]) and P[P_ARR] == 0.0
     x2 = position
     for _ in range(50 if linkage else 1):  # fixed point; contracts while the linkage is stiffer than the load curve

@@ -39,10 +39,11 @@ from .physics.valve_flow import (
     sanville_mass_flow,
     series_conductance,
 )
-from .physics.valve_opening import valve_openings
+from .physics.valve_opening import openings_from_signed, signed_opening, valve_openings
 
 FLOW_LAWS = {"iso6358": 0, "sanville": 1, "bobrow": 2, "power_law": 3}
 FRICTION_MODELS = {"lugre": 0, "variable_viscous": 1, "piecewise_stribeck": 2}
+VALVE_STAGES = {"spool": 0, "opening": 1}  # where valve_dynamics acts: on the spool (command) or on the opening
 STICK_TIME_CONSTANT = 1e-3  # s; variable-viscous model: how fast a stuck body's residual speed is removed
 
 
@@ -87,6 +88,7 @@ def parameter_vector(cfg: PlantConfig, *, load: float | str | None = None, flow_
     P[P_USAT] = p["valve.saturation_voltage"]
     P[P_UCEN] = p["valve.centre_voltage"]
     P[P_LAW] = FLOW_LAWS[cfg.options["valve.flow_law"]]
+    P[P_VD_STAGE] = VALVE_STAGES[cfg.options["valve.dynamics_stage"]]
     P[P_EFFA] = p["valve.effective_area"]
     P[P_BOB] = p["valve.bobrow_coefficient"]
     P[P_POW1] = p["valve.power_law_c1"]
@@ -193,6 +195,16 @@ def _body_friction(P, v, z, applied, fs, fc, n):
 
 
 @njit(cache=True, error_model="numpy")
+def valve_lag_input(P, u_valve):
+    """What the valve_dynamics filter acts on: the command [V] (spool stage) or, for
+    ``valve.dynamics_stage = "opening"``, the signed relative opening it asks for [-]."""
+    if P[P_VD_STAGE] != 1.0:
+        return u_valve
+    off = P[P_VO_OFF] if P[P_VO_ON] != 0.0 else 0.0
+    return signed_opening(u_valve + off - P[P_UCEN], P[P_DZP], P[P_DZN], P[P_SLP], P[P_SLN], P[P_USAT])
+
+
+@njit(cache=True, error_model="numpy")
 def plant_rhs(y, P, u_valve, load_xs, load_ys, dy, aux):
     """Right-hand side of the plant: dy/dt for state ``y`` with valve input ``u_valve``.
 
@@ -239,14 +251,19 @@ def plant_rhs(y, P, u_valve, load_xs, load_ys, dy, aux):
         dvb = -a_rod * v
     # --- valve input: spool dynamics, null offset, centre
     u = u_valve
+    lag_opening = P[P_VD_ON] != 0.0 and P[P_VD_STAGE] == 1.0
     if P[P_VD_ON] != 0.0:
         wn = P[P_VD_WN]
+        target = valve_lag_input(P, u_valve)
         dy[S_SP] = y[S_SV]
-        dy[S_SV] = wn * wn * (u_valve - y[S_SP]) - 2.0 * P[P_VD_Z] * wn * y[S_SV]  # second-order spool (Merritt 1967)
+        dy[S_SV] = wn * wn * (target - y[S_SP]) - 2.0 * P[P_VD_Z] * wn * y[S_SV]  # second-order spool (Merritt 1967)
         u = y[S_SP]
-    if P[P_VO_ON] != 0.0:
-        u = u + P[P_VO_OFF]  # valve null shift
-    a_pa, a_at, a_pb, a_bt = valve_openings(u - P[P_UCEN], P[P_DZP], P[P_DZN], P[P_SLP], P[P_SLN], P[P_USAT])
+    if lag_opening:
+        a_pa, a_at, a_pb, a_bt = openings_from_signed(u)  # the lagged opening drives the ports directly
+    else:
+        if P[P_VO_ON] != 0.0:
+            u = u + P[P_VO_OFF]  # valve null shift
+        a_pa, a_at, a_pb, a_bt = valve_openings(u - P[P_UCEN], P[P_DZP], P[P_DZN], P[P_SLP], P[P_SLN], P[P_USAT])
     # --- supply, port and chamber temperatures
     ps = y[S_PSUP] if P[P_SD_ON] != 0.0 else P[P_PS]
     port_a = y[S_PLA] if P[P_LD_ON] != 0.0 else pa
@@ -431,6 +448,7 @@ def set_rest_internal_states(P: np.ndarray, y: np.ndarray, lx: np.ndarray, ly: n
         # f_link = K (x2 - x); fixed point in x2 (contracts while K exceeds the load stiffness)
         for _ in range(50):
             x2_new = x + 0.5 * (f2 - f1 - load_force(P, x2, lx, ly)) / P[P_LK_K]
+            x2_new = min(max(x2_new, 0.0), P[P_STROKE])  # a link too soft to carry it leaves 2A2 on its end stop
             if abs(x2_new - x2) < 1e-12:
                 x2 = x2_new
                 break

@@ -41,6 +41,12 @@ def write_text_atomic(path, text: str) -> None:
         raise
 
 
+def write_json_atomic(path, data: dict) -> None:
+    """Write ``data`` as indented JSON (no NaN) to ``path`` atomically, creating its folder."""
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    write_text_atomic(path, json.dumps(data, indent=1, allow_nan=False) + "\n")
+
+
 def _plain(obj):
     """JSON default: numpy scalars/arrays to Python; non-finite floats to None."""
     import numpy as np

@@ -20,7 +20,7 @@ from .control import dead_zone_compensation, first_order_filter_gain, pid_step, 
 from .errors import InputError, SimulationError
 from .layout import *  # noqa: F403
 from .layout import N_AUX, N_STATES
-from .plant import initial_state, load_curve_arrays, parameter_vector, plant_rhs
+from .plant import initial_state, load_curve_arrays, parameter_vector, plant_rhs, valve_lag_input
 from .profiles import Profile
 
 
@@ -224,7 +224,7 @@ def simulate_core(P, y0, ref, cmd, closed_loop, pos_noise, pos_quantum, lx, ly, 
     valve_delay = P[P_VD_TD] if P[P_VD_ON] != 0.0 else 0.0
     sensor_delay = P[P_SL_TD] if sensor else 0.0
     if P[P_VD_ON] != 0.0:
-        y[S_SP] = cmd[0] if not closed_loop else P[P_UCEN]
+        y[S_SP] = valve_lag_input(P, cmd[0] if not closed_loop else P[P_UCEN])
     step_index = 0
     for k in range(n_samples + 1):
         # --- measurement at t_k
@@ -249,7 +249,7 @@ def simulate_core(P, y0, ref, cmd, closed_loop, pos_noise, pos_quantum, lx, ly, 
         else:
             u = cmd[k]
         if k == 0 and P[P_VD_ON] != 0.0 and closed_loop:
-            y[S_SP] = u
+            y[S_SP] = valve_lag_input(P, u)
         u_hist[k] = u
         # --- record the sample
         u_now = u if valve_delay <= 0.0 else _zoh_average(u_hist, ts, k * ts - valve_delay, k * ts - valve_delay)

@@ -65,6 +65,23 @@ def test_fit_param_unit_cube_round_trips():
     assert lin.from_unit(0.5) == pytest.approx(0.0, abs=1e-12)  # symmetric bounds
 
 
+def test_lumped_total_lag_propagates_the_full_covariance():
+    """Delay and time constant that trade one for one (correlation -1) leave their sum exact,
+    while each alone is uncertain; uncorrelated, the errors add in quadrature."""
+    from compliance.diagnosis.fit import FitResult
+
+    params = effect_params("sensor_lag")
+    sd = np.array([2e-3, 2e-3])
+    fit = FitResult("sensor_lag", params, [6e-3, 2e-3], list(sd))
+    fit.cov = np.array([[1.0, -1.0], [-1.0, 1.0]]) * np.outer(sd, sd)
+    value, err = fit.lumped("sensor_lag")
+    assert value == pytest.approx(8e-3, rel=1e-12)
+    assert err == pytest.approx(0.0, abs=1e-9)
+    fit.cov = np.diag(sd ** 2)
+    assert fit.lumped("sensor_lag")[1] == pytest.approx(math.hypot(*sd), rel=1e-5)
+    assert fit.lumped("heat_transfer") is None
+
+
 @pytest.mark.parametrize("effect, param, value", [
     ("heat_transfer", "conductance", 12.0),
     ("internal_leakage", "conductance", 1.5e-10),

@@ -175,6 +175,42 @@ def test_valve_dynamics_delay_the_pressure_response(cfg):
     assert first_rise(c) - first_rise(cfg) > td  # delay plus part of the spool's rise
 
 
+def test_valve_dynamics_stage_spool_moves_in_the_dead_band_opening_does_not(cfg):
+    """Spool stage: the filter follows the command even inside the dead band (the spool
+    travels through its overlap); opening stage: it follows the opening, which is zero there."""
+    from compliance.layout import S_SP, S_SV
+    from compliance.plant import valve_lag_input
+
+    vd = {"valve_dynamics": {"natural_frequency": 50.0, "damping": 0.7, "delay": 0.0}}
+    u = cfg.p("valve.centre_voltage") + 0.5 * cfg.p("valve.dead_zone_positive")  # inside the dead band
+    lx, ly = load_curve_arrays(cfg)
+    rates = {}
+    for stage in ("spool", "opening"):
+        c = cfg.replace(effects=vd, options={"valve.dynamics_stage": stage})
+        P = parameter_vector(c, load=0.0)
+        y = initial_state(c, P, 0.08)
+        y[S_SP] = valve_lag_input(P, cfg.p("valve.centre_voltage"))
+        dy = np.zeros(N_STATES)
+        plant_rhs(y, P, u, lx, ly, dy, np.zeros(N_AUX))
+        rates[stage] = dy[S_SV]
+    assert rates["spool"] == pytest.approx(50.0 ** 2 * 0.5 * cfg.p("valve.dead_zone_positive"), rel=1e-9)
+    assert rates["opening"] == 0.0
+
+
+def test_valve_dynamics_stages_linearise_alike(cfg):
+    """A linear valve gain commutes with the valve's lag, so both stages give one linear model."""
+    import control
+
+    from compliance.linear import analyse
+
+    vd = {"valve_dynamics": {"natural_frequency": 150.0, "damping": 0.7, "delay": 0.002}}
+    poles = []
+    for stage in ("spool", "opening"):
+        c = cfg.replace(effects=vd, options={"valve.dynamics_stage": stage})
+        poles.append(np.sort_complex(control.poles(analyse(c, 0.08, 5700.0).closed_loop)))
+    np.testing.assert_allclose(poles[0], poles[1], rtol=1e-9)
+
+
 def test_line_dynamics_delay_the_chamber_pressure(cfg):
     """A hose volume and restriction between valve and chamber slow the chamber's first rise."""
     c = cfg.replace(effects={"line_dynamics": {"volume": 1e-3, "conductance": 2e-8}})
@@ -234,7 +270,7 @@ def test_linkage_compliance_couples_the_bodies_through_its_spring(cfg):
     y = initial_state(c, P, 0.08, (4.5e5, 4.5e5))
     dy0, _, _ = _rhs(c, y)
     y2 = y.copy()
-    y2[S_X2] = y[S_X] + 1e-3
+    y2[S_X2] = y[S_X2] + 1e-3  # 1 mm beyond the rest deflection initial_state gives the link
     dy1, _, _ = _rhs(c, y2)
     m1 = 0.5 * cfg.p("cylinder.moving_mass")
     assert dy1[S_V] - dy0[S_V] == pytest.approx(kst * 1e-3 / m1, rel=1e-6)

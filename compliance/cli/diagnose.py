@@ -14,12 +14,10 @@ found), 2 on bad input.
 from __future__ import annotations
 
 import argparse
-import json
-import os
-import tempfile
 from pathlib import Path
 
 from ..errors import InputError
+from ..results_io import write_json_atomic
 
 _SCALE = {"position": (1e3, "mm"), "valve_command": (1.0, "V"), "pressure_a": (1e-3, "kPa"), "pressure_b": (1e-3, "kPa"),
           "supply_pressure": (1e-3, "kPa")}
@@ -59,22 +57,6 @@ def register(sub):
     return p
 
 
-def _write_json(path: str, data: dict) -> None:
-    target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            json.dump(data, fh, indent=1, allow_nan=False)
-            fh.write("\n")
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, target)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-
-
 def _is_friction(frame) -> bool:
     return "valve_command" not in frame.columns and "force" in frame.columns
 
@@ -110,7 +92,7 @@ def run(args) -> int:
         save_fitted(diag, args.save_model)
     data = diag.to_dict()
     if args.json_out:
-        _write_json(args.json_out, data)
+        write_json_atomic(args.json_out, data)
     if args.report:
         _render_servo_report(cfg, frame, meta, diag, data, args.report)
     _print_servo(data, args.quiet)
@@ -185,7 +167,7 @@ def _run_friction(args, first, meta) -> int:
     if args.save_model:
         raise InputError("--save-model: a friction-bench diagnosis fits a friction law, not a plant configuration; use --json")
     if args.json_out:
-        _write_json(args.json_out, data)
+        write_json_atomic(args.json_out, data)
     if args.report:
         from ..diagnosis.friction_report import write_friction_report
 

@@ -3,12 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import json
-import os
-import tempfile
 from pathlib import Path
 
 from ..errors import InputError
+from ..results_io import write_json_atomic
 
 # the replay modes of compliance.replay.MODES; the library is imported in run() only, so that
 # building the dispatcher's parser for other commands does not pay for scipy.signal
@@ -66,19 +64,6 @@ def _params(items) -> dict:
         except ValueError:
             raise InputError(f"--param {k}: '{v}' is not a number (give SI units)") from None
     return out
-
-
-def _write_json(result: dict, path: str) -> None:
-    out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            json.dump(result, fh, indent=1, allow_nan=False)
-        os.replace(tmp, out)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
 
 
 def _render(result: dict, html: str, pdf: str | None) -> None:
@@ -191,7 +176,7 @@ def run(args) -> int:
         cfg = cfg.replace(params=params)
     result = validate(cfg, df, meta, settings)
     if args.json_out:
-        _write_json(result, args.json_out)
+        write_json_atomic(args.json_out, result)
     print(format_summary(result, args.max_windows))
     if args.json_out:
         print(f"results: {args.json_out}")

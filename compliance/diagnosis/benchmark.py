@@ -45,7 +45,7 @@ class CaseResult:
     reduction: float | None = None  # after/before RMS of the full closed-loop replay on reduction_signal
     reduction_signal: str | None = None
     reduction_objective: float | None = None  # the same on the re-synchronised replay the fits minimise
-    effective_error: float | None = None  # EFFECTIVE combination's relative error (valley-prone effects)
+    effective_error: float | None = None  # the effect's declared lumped combination (e.g. total lag): relative error
     seconds: float = 0.0
     simulations: int = 0
     visibility: dict = field(default_factory=dict)
@@ -81,19 +81,12 @@ def _main_error(case: Case, diag) -> tuple[dict, float | None]:
     return fitted, None
 
 
-# effects whose parameters trade along a valley: the combination the data pin down (the total
-# lag a step sees: a sensor's delay + its time constant; a valve's delay + its spool's 2 zeta / w_n)
-EFFECTIVE = {
-    "sensor_lag": ("total lag [s]", lambda p: p["time_constant"] + p["delay"]),
-    "valve_dynamics": ("total lag [s]", lambda p: p["delay"] + 2.0 * p["damping"] / p["natural_frequency"]),
-}
-
-
 def effective_error(truth: str, true_params: dict, fitted: dict) -> float | None:
     """Relative error of the identifiable combination of a valley-prone effect (None for others)."""
-    if truth not in EFFECTIVE:
+    lumped = EFFECTS[truth].lumped if truth in EFFECTS else None
+    if lumped is None:
         return None
-    f = EFFECTIVE[truth][1]
+    f = lumped.of
     got = {k.split(".", 1)[1]: v for k, v in fitted.items() if k.startswith(truth + ".")}
     try:
         t, g = f(true_params), f(got)

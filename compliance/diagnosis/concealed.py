@@ -51,7 +51,8 @@ EFFECT_RANGES: dict[str, dict[str, tuple[float, float, bool]]] = {
     "position_dependent_load": {"stiffness": (2e4, 1e5, True)},  # sign drawn separately
     "sensor_lag": {"time_constant": (0.003, 0.03, True), "delay": (0.0, 0.004, False)},
     "line_dynamics": {"volume": (1e-4, 6e-4, True), "conductance": (5e-9, 3e-8, True)},
-    "linkage_compliance": {"stiffness": (1.2e5, 3e5, True), "damping": (100.0, 2000.0, True)},
+    # only a link soft enough for 2A2 to trail 2A1 by centimetres shows in the pressures (docs/diagnosis.md)
+    "linkage_compliance": {"stiffness": (2e4, 1e5, True), "damping": (100.0, 2000.0, True)},
 }
 SIGNED = ("valve_offset", "position_dependent_load")
 # base parameter -> multiplicative factors drawn from (low, high) or its reciprocal range

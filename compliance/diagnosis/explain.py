@@ -142,6 +142,11 @@ def explain(d) -> str:
     if others:
         text += "; also fitted: " + ", ".join(others)
     text += "."
+    lumped = fit.lumped(effect)
+    if lumped is not None and eff.lumped is not None:
+        text += (f" The test pins down their combination best: {eff.lumped.meaning} = "
+                 f"{_pm(lumped[0], lumped[1], eff.lumped.unit)}; how it splits between the parameters is less certain"
+                 f" than their own errors suggest (they trade along a valley of the fit).")
     base = _base_changes(d, fit)
     if base:
         text += f" Together with it, {base}."

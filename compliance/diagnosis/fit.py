@@ -106,11 +106,38 @@ class FitResult:
     seconds: float = 0.0
     message: str = ""
     scan: list = field(default_factory=list)
+    cov: np.ndarray | None = None  # covariance of the fitted values [SI], from the final Jacobian
 
     @property
     def k(self) -> int:
         """Number of fitted parameters."""
         return len(self.params)
+
+    def lumped(self, effect: str) -> tuple[float, float] | None:
+        """(value, standard error) of ``effect``'s declared lumped combination, or None.
+
+        The error propagates the full covariance (delta method): parameters that trade along a
+        valley are strongly anti-correlated, so their sum is much sharper than either.
+        """
+        from ..effects import EFFECTS
+
+        decl = EFFECTS.get(effect)
+        if decl is None or decl.lumped is None:
+            return None
+        idx = [i for i, fp in enumerate(self.params) if fp.kind == "effect" and fp.effect == effect]
+        vals = {self.params[i].name: self.values[i] for i in idx}
+        if len(vals) != len(decl.params):
+            return None
+        f0 = float(decl.lumped.of(vals))
+        if self.cov is None or not np.all(np.isfinite(self.cov)):
+            return f0, float("nan")
+        grad = np.zeros(len(self.params))
+        for i in idx:
+            h = 1e-6 * max(abs(self.values[i]), 1e-9)
+            bumped = dict(vals)
+            bumped[self.params[i].name] += h
+            grad[i] = (float(decl.lumped.of(bumped)) - f0) / h
+        return f0, float(math.sqrt(max(float(grad @ self.cov @ grad), 0.0)))
 
     def value(self, key: str) -> float:
         """Fitted value of parameter ``key``."""
@@ -195,9 +222,11 @@ def least_squares_fit(ctx: FitContext, name: str, params: tuple[FitParam, ...], 
     values = [fp.from_unit(x) for fp, x in zip(params, u)]
     vec = fun(u)[:n]
     chi2, parts = chi2_parts(ctx.model, vec)
-    stderr = _stderr(params, values, res.jac, chi2, n, ctx.model, vec)
-    return FitResult(name, tuple(params), values, stderr, chi2, parts, n, ctx.sims - sims0,
-                     time.perf_counter() - t0, str(res.message))
+    stderr, cov = _stderr(params, values, res.jac, chi2, n, ctx.model, vec)
+    out = FitResult(name, tuple(params), values, stderr, chi2, parts, n, ctx.sims - sims0,
+                    time.perf_counter() - t0, str(res.message))
+    out.cov = cov
+    return out
 
 
 def autocorrelation_factor(model: ResidualModel, vec: np.ndarray) -> float:
@@ -212,15 +241,17 @@ def autocorrelation_factor(model: ResidualModel, vec: np.ndarray) -> float:
     return (1.0 + rho) / (1.0 - rho)
 
 
-def _stderr(params, values, jac, chi2, n, model, vec) -> list[float]:
+def _stderr(params, values, jac, chi2, n, model, vec) -> tuple[list[float], np.ndarray]:
+    """Standard errors [SI] and the covariance [SI] of the fitted values."""
     k = len(params)
     s2 = max(1.0, chi2 / max(n - k, 1)) * autocorrelation_factor(model, vec)
     try:
         cov = np.linalg.pinv(jac.T @ jac) * s2
-        su = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     except np.linalg.LinAlgError:
-        su = np.full(k, np.inf)
-    return [fp.stderr(v, float(s)) for fp, v, s in zip(params, values, su)]
+        cov = np.full((k, k), np.inf)
+    su = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    d = np.array([fp.stderr(v, 1.0) for fp, v in zip(params, values)])  # dvalue/du (linear in sigma_u)
+    return [fp.stderr(v, float(s)) for fp, v, s in zip(params, values, su)], cov * np.outer(d, d)
 
 
 def scan_points(ctx: FitContext, params, points: list[list[float]]) -> list[float]:
@@ -266,6 +297,7 @@ def fit_candidate(ctx: FitContext, cand: Candidate, base_fit: FitResult | None, 
     res.seconds = time.perf_counter() - t0
     res.scan = [(dict(zip([fp.key for fp in all_params], p)), c) for p, c in zip(points, chis)]
     return res
+
 
 
 def forward_select_base(ctx: FitContext, params: tuple[FitParam, ...], *, penalty: float, max_params: int = 2,

@@ -34,6 +34,18 @@ def _param_rows(cfg, fit) -> list[dict]:
     return rows
 
 
+def _lumped_rows(fit, name: str) -> list[dict]:
+    """The declared lumped combinations (e.g. a total lag) of the effects in a fit, with errors."""
+    rows = []
+    for e in name.split("+"):
+        got = fit.lumped(e) if e in EFFECTS else None
+        if got is not None:
+            decl = EFFECTS[e].lumped
+            rows.append({"name": f"{e}.{decl.name}", "value": _num(got[0]), "stderr": _num(got[1]), "unit": decl.unit,
+                         "meaning": decl.meaning})
+    return rows
+
+
 def _fit_table(fit: dict | None) -> dict | None:
     if fit is None:
         return None
@@ -58,6 +70,7 @@ def diagnosis_to_dict(d) -> dict:
             "kind": kind,
             "effects": [e for e in name.split("+") if e in EFFECTS],
             "parameters": _param_rows(d.cfg, f),
+            "lumped": _lumped_rows(f, name),
             "k": f.k,
             "chi2": _num(s.chi2),
             "chi2_per_residual": _num(s.chi2 / f.n) if f.n else None,

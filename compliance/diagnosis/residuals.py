@@ -1,7 +1,11 @@
 """Replay residuals: normalised by each signal's noise floor, subsampled, summarised per signal and window.
 
-The fitted residual vector stacks, for every measured signal s, (recorded - model)/floor_s at
-every ``stride``-th sample. A correct model leaves values of about one (noise_floor.py).
+The fitted residual vector stacks, for every measured signal s, (recorded - model)/floor_s(t) at
+every ``stride``-th sample. A correct model leaves values of about one (noise_floor.py). The
+floor varies along the test: where a correct model's replay cannot follow the recording (slow
+stick-slip, where noise decides when the servo breaks away) it is as large as that replay's
+local error, so such stretches weigh in the fit by what they can tell (weighted least squares
+with a heteroscedastic error model from a parametric bootstrap).
 """
 
 from __future__ import annotations
@@ -22,6 +26,8 @@ MIN_FLOOR = {"position": 1e-6, "pressure_a": 50.0, "pressure_b": 50.0, "supply_p
 UNITS = {"position": "m", "pressure_a": "Pa", "pressure_b": "Pa", "supply_pressure": "Pa", "valve_command": "V"}
 FAILED_RESIDUAL = 30.0  # normalised residual of every sample of a replay that diverged (at least; see with_fail_level)
 NULL_PRE_ROLL = 1.0  # s of hold the null recording settles in before its test starts
+NULL_SEEDS = (7, 8)  # noise draws of the null bootstrap (their squared errors are averaged)
+LOCAL_WINDOW = 1.0  # s; moving window of the local null error (about one stick-slip episode)
 
 
 @dataclass(frozen=True)
@@ -46,6 +52,7 @@ class ResidualModel:
     index: np.ndarray
     recorded: dict
     fail_level: float = FAILED_RESIDUAL
+    local: dict | None = None  # signal -> floor at each fitted sample (index) [SI]; None: the constant floor
 
     @property
     def size(self) -> int:
@@ -56,8 +63,14 @@ class ResidualModel:
         """Stacked normalised residuals; a failed replay (None) gives a large constant vector."""
         if sim is None:
             return np.full(self.size, self.fail_level)
-        parts = [(self.recorded[s][self.index] - sim[s][self.index]) / self.floors[s] for s in self.signals]
+        parts = [(self.recorded[s][self.index] - sim[s][self.index]) / self.scale(s) for s in self.signals]
         return np.concatenate(parts)
+
+    def scale(self, signal: str):
+        """Floor of ``signal`` at the fitted samples: an array (time-resolved) or the constant floor."""
+        if self.local is not None and signal in self.local:
+            return self.local[signal]
+        return self.floors[signal]
 
     def split(self, vec: np.ndarray) -> dict:
         """Signal -> its part of a residual vector."""
@@ -87,15 +100,20 @@ def _quantum(values: np.ndarray) -> float:
     return position_quantum(values)
 
 
-def null_replay_floors(cfg: PlantConfig, setup: ReplaySetup, sensor: dict, seed: int = 7) -> dict:
+def null_replay_errors(cfg: PlantConfig, setup: ReplaySetup, sensor: dict, seed: int = 7) -> dict:
     """How far a *correct* model's replay stays from its recording, signal by signal [SI].
 
     A parametric bootstrap of the null hypothesis: the nominal model records the same test
     (set-point or command, load, start) with sensors like the recording's (noise and
     quantisation estimated from it), and that synthetic recording is replayed exactly as the
-    real one is (matched noise, re-synchronised segments). The RMS residuals are the floors:
-    they contain the sensor noise, the error of the noise estimate, the state read at each
-    re-synchronisation and the stall points a dead zone decides on noise.
+    real one is (matched noise, re-synchronised segments). Its errors contain the sensor
+    noise, the error of the noise estimate, the state read at each re-synchronisation and the
+    stall points a dead zone decides on noise.
+
+    Returns
+    -------
+    dict
+        signal -> (recorded - replayed) of the null recording at every sample [SI].
     """
     import pandas as pd
 
@@ -133,14 +151,46 @@ def null_replay_floors(cfg: PlantConfig, setup: ReplaySetup, sensor: dict, seed:
     meta = {"conditions": {"load_force": setup.load}, "source_path": "<null replay>"}
     syn_setup = prepare_replay(cfg, frame, meta)
     out = run_replay(cfg, syn_setup)
-    return {s_: float(np.sqrt(np.mean((frame[s_].to_numpy() - out[s_][:n]) ** 2))) for s_ in frame.columns if s_ in rec}
+    return {s_: frame[s_].to_numpy() - out[s_][:n] for s_ in frame.columns if s_ in rec}
+
+
+def null_replay_floors(cfg: PlantConfig, setup: ReplaySetup, sensor: dict) -> tuple[dict, dict]:
+    """Constant and time-resolved floors from the null bootstrap (``null_replay_errors``).
+
+    Returns
+    -------
+    floors : dict
+        signal -> RMS error of the null replays [SI].
+    local : dict
+        signal -> local RMS error at every sample [SI]: the squared errors of the draws
+        averaged and smoothed over ``LOCAL_WINDOW``.
+    """
+    draws = [null_replay_errors(cfg, setup, sensor, seed) for seed in NULL_SEEDS]
+    t = setup.time
+    ts = float(np.median(np.diff(t))) if t.size > 1 else 1.0
+    w = max(1, int(round(LOCAL_WINDOW / ts)))
+    floors, local = {}, {}
+    for s_ in draws[0]:
+        n = min(d[s_].size for d in draws)
+        sq = np.mean([d[s_][:n] ** 2 for d in draws], axis=0)
+        floors[s_] = float(np.sqrt(np.mean(sq)))
+        kernel = np.ones(min(w, n)) / min(w, n)
+        loc = np.sqrt(np.convolve(sq, kernel, mode="same"))
+        full = np.full(t.size, floors[s_])
+        full[:n] = loc
+        local[s_] = full
+    return floors, local
+
+
+
 
 
 def build_residual_model(cfg: PlantConfig, setup: ReplaySetup, *, stride: int = 5, nominal: dict | None = None) -> ResidualModel:
     """Estimate the noise floors and choose the samples of the fit.
 
     Each floor is the larger of the signal's sensor noise and what a correct model's replay
-    leaves (``null_replay_floors``).
+    leaves (``null_replay_floors``): one constant per signal (reported, and the yardstick of
+    ``no_mismatch``) and one along the test (the weights of the fit).
 
     Parameters
     ----------
@@ -155,18 +205,21 @@ def build_residual_model(cfg: PlantConfig, setup: ReplaySetup, *, stride: int = 
     signals = compared_signals(setup)
     sensor = {s: (0.0 if s == "valve_command" else sensor_noise_std(setup.recorded[s])) for s in signals}
     try:
-        null = null_replay_floors(cfg, setup, sensor)
+        null, null_local = null_replay_floors(cfg, setup, sensor)
     except (SimulationError, InputError):
-        null = {}
-    floors = {}
+        null, null_local = {}, {}
+    index = np.arange(0, setup.time.size, max(1, int(stride)))
+    floors, local = {}, {}
     for s in signals:
-        f = max(null.get(s, 0.0), sensor[s] if s != "position" or not setup.closed_loop else 0.0)
+        own = sensor[s] if s != "position" or not setup.closed_loop else 0.0
+        f = max(null.get(s, 0.0), own)
         if f <= 0.0:
             f = sensor[s]
         floors[s] = max(f, MIN_FLOOR[s])
-    index = np.arange(0, setup.time.size, max(1, int(stride)))
+        if s in null_local:
+            local[s] = np.maximum(np.maximum(null_local[s][index], own), MIN_FLOOR[s])
     return ResidualModel(signals=signals, floors=floors, sensor_noise=sensor, index=index,
-                         recorded={s: setup.recorded[s] for s in signals})
+                         recorded={s: setup.recorded[s] for s in signals}, local=local or None)
 
 
 def evaluate(model: ResidualModel, cfg: PlantConfig, setup: ReplaySetup) -> tuple[np.ndarray, dict | None]:

@@ -7,9 +7,9 @@ switched on in a configuration with an ``[effects.NAME]`` table.
 
 from __future__ import annotations
 
-from .base import Effect, Param
+from .base import Effect, Lumped, Param
 from .catalogue import ALL_EFFECTS
 
 EFFECTS: dict[str, Effect] = {e.name: e for e in ALL_EFFECTS}
 
-__all__ = ["EFFECTS", "Effect", "Param"]
+__all__ = ["EFFECTS", "Effect", "Lumped", "Param"]

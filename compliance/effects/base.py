@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 
@@ -34,6 +35,29 @@ class Param:
 
 
 @dataclass(frozen=True)
+class Lumped:
+    """A combination of an effect's parameters that a loop test pins down better than each one.
+
+    Below a spool's or a transducer's own bandwidth a loop sees only their total lag; delay
+    and lag then trade along a valley of the fit (Ljung 1999, ch. 13: identifiability from a
+    finite-bandwidth experiment), while their sum stays sharp.
+
+    Attributes
+    ----------
+    name : str
+    unit : str
+    meaning : str
+    of : callable
+        dict of the effect's SI parameter values -> the combination [unit].
+    """
+
+    name: str
+    unit: str
+    meaning: str
+    of: Callable[[dict], float]
+
+
+@dataclass(frozen=True)
 class Effect:
     """An optional piece of physics.
 
@@ -49,6 +73,8 @@ class Effect:
         The trace it leaves in data (what a test engineer would look for).
     signals : tuple of str
         Canonical signals where it shows most (for ranking by located windows).
+    lumped : Lumped or None
+        The combination of its parameters a loop test identifies best, if they trade.
     """
 
     name: str
@@ -57,6 +83,7 @@ class Effect:
     states: tuple[str, ...]
     signature: str
     signals: tuple[str, ...]
+    lumped: Lumped | None = None
 
     def param(self, name: str) -> Param:
         """Return the declared parameter ``name``."""

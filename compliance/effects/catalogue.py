@@ -10,7 +10,7 @@ the steepest segment of the sheet's load curve is 1.25e5 N/m.
 
 from __future__ import annotations
 
-from .base import Effect, Param
+from .base import Effect, Lumped, Param
 
 HEAT_TRANSFER = Effect(
     name="heat_transfer",
@@ -50,6 +50,9 @@ VALVE_DYNAMICS = Effect(
     states=("spool_position", "spool_velocity"),
     signature="pressures lag the command after every command change; the loop rings more at steps",
     signals=("pressure_a", "pressure_b", "valve_command", "position"),
+    # phase lag of e^(-s t_d)/(s^2/w^2 + 2 zeta s/w + 1) at w << w_n: w (t_d + 2 zeta/w_n)
+    lumped=Lumped("total_lag", "s", "delay + 2 zeta / w_n: the spool's total lag as the loop sees it",
+                  lambda p: p["delay"] + 2.0 * p["damping"] / p["natural_frequency"]),
 )
 
 SUPPLY_DROOP = Effect(
@@ -101,6 +104,9 @@ SENSOR_LAG = Effect(
     states=("sensor_position",),
     signature="measured position lags the pressures' force; overshoot and ringing larger than modelled",
     signals=("position", "valve_command"),
+    # phase lag of e^(-s t_d)/(1 + s tau) at w << 1/tau: w (t_d + tau)
+    lumped=Lumped("total_lag", "s", "delay + time constant: the transducer's total lag as the loop sees it",
+                  lambda p: p["time_constant"] + p["delay"]),
 )
 
 LINE_DYNAMICS = Effect(

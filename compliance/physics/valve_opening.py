@@ -50,3 +50,25 @@ def valve_openings(u, dz_pos, dz_neg, slope_pos, slope_neg, saturation_voltage):
         return a, 0.0, 0.0, a
     a = path_opening(-u, dz_neg, slope_neg, saturation_voltage)
     return 0.0, a, a, 0.0
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def signed_opening(u, dz_pos, dz_neg, slope_pos, slope_neg, saturation_voltage):
+    """Relative opening for a command U [V] about the centre, signed: > 0 opens P->A and B->T [-].
+
+    The quantity a lag acts on when the valve's dynamics sit after its dead zone (a flow
+    response rather than a spool response; ``valve.dynamics_stage = "opening"``).
+    """
+    if u >= 0.0:
+        return path_opening(u, dz_pos, slope_pos, saturation_voltage)
+    return -path_opening(-u, dz_neg, slope_neg, saturation_voltage)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def openings_from_signed(o):
+    """Openings (a_pa, a_at, a_pb, a_bt) of a signed relative opening ``o``, clipped to +-1."""
+    if o >= 0.0:
+        a = o if o < 1.0 else 1.0
+        return a, 0.0, 0.0, a
+    a = -o if -o < 1.0 else 1.0
+    return 0.0, a, a, 0.0

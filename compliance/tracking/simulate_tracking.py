@@ -21,7 +21,7 @@ from ..control import dead_zone_compensation, pid_step, saturate
 from ..errors import InputError, SimulationError
 from ..layout import A_FRIC, A_LOAD, A_OPEN, A_QA, A_QB, N_AUX, N_STATES, P_CDZN, P_CDZP, P_CSLN, P_CSLP, P_HT_ON, P_LC, P_PS, P_SD_ON
 from ..layout import P_TS, P_UCEN, P_ULIM, P_VD_ON, S_PA, S_PB, S_PSUP, S_SP, S_TA, S_TB, S_V, S_X
-from ..plant import initial_state, load_curve_arrays, parameter_vector, plant_rhs
+from ..plant import initial_state, load_curve_arrays, parameter_vector, plant_rhs, valve_lag_input
 from ..simulate import OUTPUT_COLUMNS, _rk4_step, record_sample
 from .controller import (
     C_AO_IN, C_AO_LV, C_AO_LX, C_AO_POLE, C_AO_SV, C_AO_SX, C_AREA_RATIO, C_FO_IN, C_FO_L, C_FO_POLE, C_FO_SV, C_KD, C_KI,
@@ -93,7 +93,7 @@ def tracking_core(P, C, y0, ref, dref, ddref, pos_noise, pos_quantum, pa_noise, 
     up_prev = 0.0
     u_rel = 0.0
     if P[P_VD_ON] != 0.0:
-        y[S_SP] = P[P_UCEN]
+        y[S_SP] = valve_lag_input(P, P[P_UCEN])
     for k in range(n_samples + 1):
         # --- measurements at t_k
         xm = y[S_X] + pos_noise[k]
