@@ -82,6 +82,25 @@ def test_lumped_total_lag_propagates_the_full_covariance():
     assert fit.lumped("heat_transfer") is None
 
 
+def test_newey_west_information_counts_correlated_residuals_as_fewer():
+    """White residuals: S = J^T J var(r). AR(1) residuals with rho = 0.8: S approaches the long-run
+    variance (1 + rho)/(1 - rho) = 9 times larger, less the Bartlett truncation 2 rho/((L+1)(1-rho)^2)."""
+    from compliance.diagnosis.fit import hac_information
+    from compliance.diagnosis.residuals import ResidualModel
+
+    m, lag, rho = 40000, 50, 0.8
+    model = ResidualModel(signals=("position",), floors={}, sensor_noise={}, index=np.arange(m), recorded={})
+    rng = np.random.default_rng(11)
+    white = rng.normal(size=m)
+    jac = np.ones((m, 1))
+    assert hac_information(jac, white, model, lag)[0, 0] / m == pytest.approx(1.0, abs=0.25)
+    ar = np.zeros(m)
+    for t in range(1, m):
+        ar[t] = rho * ar[t - 1] + rng.normal() * math.sqrt(1 - rho * rho)
+    expected = (1 + rho) / (1 - rho) - 2 * rho / ((lag + 1) * (1 - rho) ** 2)
+    assert hac_information(jac, ar, model, lag)[0, 0] / m == pytest.approx(expected, rel=0.2)
+
+
 @pytest.mark.parametrize("effect, param, value", [
     ("heat_transfer", "conductance", 12.0),
     ("internal_leakage", "conductance", 1.5e-10),

@@ -14,9 +14,13 @@ which forward-difference Gauss-Newton steps stall at the first wrinkle (on the p
 valve-dynamics recording least squares alone stops at chi2/N = 14.5, the simplex reaches 4.1).
 The simplex' 5 % steps see the bowl, not the wrinkles.
 
-Standard errors come from the final Jacobian, cov = s^2 (J^T J)^-1 with s^2 the reduced
-chi-square (never below 1), inflated by the residuals' autocorrelation (AR(1) variance
-factor (1 + rho)/(1 - rho), as serially correlated residuals carry less information).
+Standard errors come from the final Jacobian J and the residuals r themselves: the
+heteroscedasticity-and-autocorrelation-consistent sandwich of Newey & West (1987),
+cov = (J^T J)^-1 S (J^T J)^-1 with S = sum over lags |l| <= L of (1 - |l|/(L+1)) sum_t g_t g_(t-l)^T,
+g_t = J_t r_t, L = ``HAC_SECONDS`` of residuals. A replay's misfit is not white noise: one
+breakaway the replay makes and the bench did not leaves a burst correlated over a second, and
+such bursts carry far less information than as many independent samples. S is never taken
+below J^T J (the floors' own noise level).
 """
 
 from __future__ import annotations
@@ -43,6 +47,7 @@ REFINE_SPAN = 0.15  # half-width of that refinement in the unit cube
 REFINE_EVALS = 8
 JOIN_GAIN = 0.25  # share of the excess chi-square a base parameter must remove to join the recalibration
 AT_FLOOR = 1.2  # chi2/N at which the recalibration stops: the fit is at the noise floor
+HAC_SECONDS = 1.0  # s; Newey-West bandwidth: residual correlation of about one stick-slip episode
 
 
 @dataclass
@@ -222,36 +227,57 @@ def least_squares_fit(ctx: FitContext, name: str, params: tuple[FitParam, ...], 
     values = [fp.from_unit(x) for fp, x in zip(params, u)]
     vec = fun(u)[:n]
     chi2, parts = chi2_parts(ctx.model, vec)
-    stderr, cov = _stderr(params, values, res.jac, chi2, n, ctx.model, vec)
+    t_res = ctx.setup.time[ctx.model.index]
+    dt_res = float(np.median(np.diff(t_res))) if t_res.size > 1 else 1.0
+    stderr, cov = _stderr(params, values, res.jac, n, ctx.model, vec, max(1, int(round(HAC_SECONDS / dt_res))))
     out = FitResult(name, tuple(params), values, stderr, chi2, parts, n, ctx.sims - sims0,
                     time.perf_counter() - t0, str(res.message))
     out.cov = cov
     return out
 
 
-def autocorrelation_factor(model: ResidualModel, vec: np.ndarray) -> float:
-    """Variance inflation (1 + rho)/(1 - rho) from the residuals' lag-1 autocorrelation (AR(1))."""
-    num = 0.0
-    den = 0.0
-    for r in model.split(vec).values():
-        if r.size > 2:
-            num += float(np.dot(r[1:], r[:-1]))
-            den += float(np.dot(r, r))
-    rho = min(max(num / den, 0.0), 0.99) if den > 0 else 0.0
-    return (1.0 + rho) / (1.0 - rho)
+def hac_information(jac_data: np.ndarray, vec: np.ndarray, model: ResidualModel, lag: int) -> np.ndarray:
+    """Newey-West (1987) estimate of the residual scores' covariance S, per signal block.
+
+    Parameters
+    ----------
+    jac_data : ndarray (n, k)
+        Jacobian rows of the data residuals.
+    vec : ndarray (n,)
+        Data residuals (normalised).
+    model : ResidualModel
+        Gives the per-signal blocks (each a time series).
+    lag : int
+        Bandwidth L in residual samples (Bartlett weights 1 - l/(L + 1)).
+    """
+    k = jac_data.shape[1]
+    s = np.zeros((k, k))
+    m = model.index.size
+    for b in range(len(model.signals)):
+        g = jac_data[b * m:(b + 1) * m] * vec[b * m:(b + 1) * m, None]
+        s += g.T @ g
+        for lg in range(1, min(lag, m - 1) + 1):
+            c = g[lg:].T @ g[:-lg]
+            s += (1.0 - lg / (lag + 1.0)) * (c + c.T)
+    return s
 
 
-def _stderr(params, values, jac, chi2, n, model, vec) -> tuple[list[float], np.ndarray]:
-    """Standard errors [SI] and the covariance [SI] of the fitted values."""
+def _stderr(params, values, jac, n, model, vec, lag: int) -> tuple[list[float], np.ndarray]:
+    """Standard errors [SI] and the covariance [SI] of the fitted values (Newey-West sandwich)."""
     k = len(params)
-    s2 = max(1.0, chi2 / max(n - k, 1)) * autocorrelation_factor(model, vec)
+    jd, jp = jac[:n], jac[n:]  # data rows, prior rows (independent, unit variance)
     try:
-        cov = np.linalg.pinv(jac.T @ jac) * s2
+        a_inv = np.linalg.pinv(jac.T @ jac)
+        s = hac_information(jd, vec, model, lag)
+        plain = jd.T @ jd
+        if np.trace(s) < np.trace(plain):
+            s = s * (np.trace(plain) / max(np.trace(s), 1e-300))  # never below the floors' noise
+        cov = a_inv @ (s + jp.T @ jp) @ a_inv
     except np.linalg.LinAlgError:
         cov = np.full((k, k), np.inf)
     su = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     d = np.array([fp.stderr(v, 1.0) for fp, v in zip(params, values)])  # dvalue/du (linear in sigma_u)
-    return [fp.stderr(v, float(s)) for fp, v, s in zip(params, values, su)], cov * np.outer(d, d)
+    return [fp.stderr(v, float(x)) for fp, v, x in zip(params, values, su)], cov * np.outer(d, d)
 
 
 def scan_points(ctx: FitContext, params, points: list[list[float]]) -> list[float]:
