@@ -70,6 +70,61 @@ def resample_uniform(time: np.ndarray, values: np.ndarray, step: float | None = 
     return grid, np.interp(grid, time, np.asarray(values, dtype=float))
 
 
+HELD_COLUMNS = ("reference", "valve_command")  # written by the controller: constant between its samples
+MAX_LOG_INTERVAL = 4.0  # controller periods; a coarser log cannot show the loop's transients
+
+
+def on_controller_clock(frame: pd.DataFrame, ts: float, where: str) -> tuple[pd.DataFrame, str | None]:
+    """The recording on the controller's clock t_0 + k*ts (a replay needs one sample per period).
+
+    Measured signals (position, pressures) are interpolated linearly at the controller's
+    instants; the set-point and the valve command, which the controller holds over its period,
+    take the last logged value at or before each instant. A recording already on the clock
+    is returned unchanged.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        Canonical recording (strictly increasing ``time`` [s]).
+    ts : float
+        Controller sample time [s].
+    where : str
+        File name for messages.
+
+    Returns
+    -------
+    (pandas.DataFrame, str or None)
+        The recording on the clock, and a note saying what was resampled (None if nothing).
+
+    Raises
+    ------
+    InputError
+        The log is coarser than ``MAX_LOG_INTERVAL`` controller periods.
+    """
+    t = frame["time"].to_numpy(dtype=float)
+    if is_uniform(t, ts):
+        return frame, None
+    dt = np.diff(t)
+    med = float(np.median(dt))
+    if med > MAX_LOG_INTERVAL * ts:
+        raise InputError(
+            f"{where}: time: logged every {med*1e3:.3g} ms (median); replaying the {ts*1e3:g} ms controller needs at "
+            f"least one sample per {MAX_LOG_INTERVAL:g} controller periods"
+        )
+    n = int(math.floor((t[-1] - t[0]) / ts + 1e-9)) + 1
+    grid = t[0] + ts * np.arange(n)
+    held = np.clip(np.searchsorted(t, grid + 1e-6 * ts, side="right") - 1, 0, t.size - 1)
+    out = {"time": grid}
+    for col in frame.columns:
+        if col == "time":
+            continue
+        v = frame[col].to_numpy(dtype=float)
+        out[col] = v[held] if col in HELD_COLUMNS else np.interp(grid, t, v)
+    note = (f"resampled onto the {ts*1e3:g} ms controller clock: {t.size} samples at {dt.min()*1e3:.3g}..{dt.max()*1e3:.3g} ms "
+            f"-> {n}; measured signals interpolated, set-point and command held")
+    return pd.DataFrame(out), note
+
+
 def zoh_interval_average(time: np.ndarray, values: np.ndarray, edges: np.ndarray) -> np.ndarray:
     """Average of a zero-order-hold signal over each interval [edges[k], edges[k+1]).
 

@@ -11,6 +11,7 @@ import json
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from compliance.cli import main
@@ -203,9 +204,35 @@ def test_small_benchmark_runs_and_scores(cfg):
     assert math.isfinite(rep["seconds"])
 
 
-def test_replay_setup_needs_the_controller_clock(cfg):
+def test_replay_setup_puts_a_recording_on_the_controller_clock(cfg):
+    """A log at 2 ms is resampled onto the 1 ms clock (noted); one coarser than 4 periods is refused."""
     frame, meta = _recording(cfg)
     thin = frame.iloc[::2].reset_index(drop=True)
-    with pytest.raises(InputError):
-        prepare_replay(cfg, thin, meta)
+    setup = prepare_replay(cfg, thin, meta)
+    assert np.allclose(np.diff(setup.time), 1e-3)
+    assert any("resampled" in n for n in setup.notes)
+    k = 2 * 4321  # a logged sample: interpolation returns it exactly, the set-point is held
+    assert setup.recorded["position"][k] == pytest.approx(frame["position"].iloc[k], abs=1e-12)
+    assert setup.reference[k + 1] == frame["reference"].iloc[k]
+    with pytest.raises(InputError, match="logged every 5 ms"):
+        prepare_replay(cfg, frame.iloc[::5].reset_index(drop=True), meta)
     assert dataclasses.is_dataclass(prepare_replay(cfg, frame, meta))
+
+
+def test_diagnosis_of_a_recording_with_jittered_time_stamps(cfg):
+    """Non-uniform time (the exchange format allows it): logged instants jittered by up to
+    0.3 ms; the diagnosis resamples onto the controller clock and still finds the heat transfer."""
+    frame, meta = _recording(cfg, {"heat_transfer": {"conductance": 12.0}})
+    t = frame["time"].to_numpy()
+    rng = np.random.default_rng(4)
+    tj = t + rng.uniform(-3e-4, 3e-4, t.size)
+    tj[0], tj[-1] = t[0], t[-1]
+    held = np.clip(np.searchsorted(t, tj, side="right") - 1, 0, t.size - 1)
+    jit = {"time": tj}
+    for col in frame.columns.drop("time"):
+        v = frame[col].to_numpy()
+        jit[col] = v[held] if col in ("reference", "valve_command") else np.interp(tj, t, v)
+    d = diagnose(cfg, pd.DataFrame(jit), meta, effects=["heat_transfer", "internal_leakage"], jobs=1, recalibrate=False)
+    assert d.winner == "heat_transfer"
+    assert d.fits["heat_transfer"].value("heat_transfer.conductance") == pytest.approx(12.0, rel=0.25)
+    assert any("resampled" in n for n in d.notes)

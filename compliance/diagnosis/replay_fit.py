@@ -176,7 +176,7 @@ def prepare_replay(cfg: PlantConfig, frame: pd.DataFrame, meta: dict, *, inject_
     InputError
         Missing columns, a time base the controller clock cannot follow.
     """
-    from ..replay import initial_conditions, load_from_metadata, replay_config as _overrides_of
+    from ..replay import initial_conditions, load_from_metadata, on_controller_clock, replay_config as _overrides_of
 
     src = str(meta.get("source_path", "<recording>"))
     for col in ("time", "position", "valve_command"):
@@ -188,12 +188,10 @@ def prepare_replay(cfg: PlantConfig, frame: pd.DataFrame, meta: dict, *, inject_
     run_cfg, overrides = _overrides_of(cfg, meta)
     notes: list[str] = []
     ts = run_cfg.p("controller.sample_time")
-    dt = np.diff(t)
-    if np.max(np.abs(dt - ts)) > 1e-3 * ts:
-        raise InputError(
-            f"{src}: time: the diagnosis replays one sample per controller period ({ts*1e3:g} ms); the recording's "
-            f"intervals are {dt.min()*1e3:.3g}..{dt.max()*1e3:.3g} ms (resample it or set [controller] sample_time)"
-        )
+    frame, note = on_controller_clock(frame, ts, src)  # one sample per controller period
+    if note:
+        notes.append(note)
+        t = frame["time"].to_numpy(dtype=float)
     closed = "reference" in frame.columns
     rec = {s: frame[s].to_numpy(dtype=float) for s in SIGNALS if s in frame.columns}
     init = initial_conditions(frame, run_cfg, src)
