@@ -130,6 +130,17 @@ def test_null_recording_gives_no_mismatch(cfg):
     assert "Nothing is wrong" in d.explanation
 
 
+def test_physics_outside_the_library_is_called_unexplained(cfg):
+    """Heat transfer diagnosed with a library that lacks it: the model misses (windows located),
+    nothing tried explains half the excess, and the verdict says so instead of naming a winner."""
+    frame, meta = _recording(cfg, {"heat_transfer": {"conductance": 12.0}}, noise=PRACTICE_NOISE)
+    d = diagnose(cfg, frame, meta, effects=["valve_offset", "external_leakage"], jobs=1, recalibrate=False)
+    assert d.verdict == "unexplained"
+    assert d.winner is None
+    assert d.windows
+    assert "outside the 2 effects tried (" in d.explanation
+
+
 def test_cli_writes_json_and_a_fitted_model_with_provenance(cfg, tmp_path):
     frame, meta = _recording(cfg, {"internal_leakage": {"conductance": 2e-10}}, noise=PRACTICE_NOISE, load=9000.0, seed=5)
     rec, _ = write_recording(frame, meta, tmp_path / "run.csv.gz")

@@ -111,6 +111,14 @@ def _base_changes(d, fit) -> str:
     return "; ".join(parts)
 
 
+def _library(d) -> str:
+    """What was tried: the whole effect library or the --effects subset, and the recalibration."""
+    tried = [k for k in d.fits if k in EFFECTS]
+    what = (f"the {len(EFFECTS)} declared effects" if len(tried) == len(EFFECTS)
+            else f"the {len(tried)} effects tried ({', '.join(tried)})")
+    return what + (" and the recalibrated base parameters" if "base" in d.fits else "")
+
+
 def explain(d) -> str:
     """The paragraph for ``engine.Diagnosis`` ``d``."""
     worst_sig, worst = _worst(d, objective=d.verdict == "no_mismatch")
@@ -123,8 +131,7 @@ def explain(d) -> str:
         share = d.scores[best].explained * 100 if best in d.scores else 0.0
         return (f"The model misses the recording {_where(d)} (the {SIGNAL_WORDS[worst_sig]} residual is {worst:.1f} times its "
                 f"noise floor), and nothing in the library explains it: the best candidate, {best}, removes only "
-                f"{share:.0f} % of the excess. The physics behind it is outside the {len(EFFECTS)} declared effects and the "
-                f"recalibrated base parameters; look at the located windows.")
+                f"{share:.0f} % of the excess. The physics behind it is outside {_library(d)}; look at the located windows.")
     fit = d.fits[d.winner]
     change = _signal_change(d, list(d.fit_before))
     if d.verdict == "parameters_only":
