@@ -130,6 +130,19 @@ def test_null_recording_gives_no_mismatch(cfg):
     assert "Nothing is wrong" in d.explanation
 
 
+def test_a_miscalibrated_valve_is_called_parameters_only(cfg):
+    """Valve conductance 1.5 x the data sheet, no physics missing: the recalibration names it and
+    brings it back within 5 % (the simplex resolves 0.2 % of its log range, ~1 % of the value)."""
+    c0 = cfg.p("valve.sonic_conductance")
+    truth = cfg.replace(params={"valve.sonic_conductance": 1.5 * c0})
+    frame, meta = synthesise(truth, "steps", x0=0.06, load=7000.0, kd=20.0, noise=PRACTICE_NOISE, seed=3, duration=DURATION)
+    d = diagnose(cfg, frame, meta, effects=["heat_transfer", "valve_offset"], jobs=1)
+    assert d.verdict == "parameters_only"
+    assert d.winner == "base"
+    assert d.fits["base"].value("valve.sonic_conductance") == pytest.approx(1.5 * c0, rel=0.05)
+    assert "No physics is missing" in d.explanation
+
+
 def test_physics_outside_the_library_is_called_unexplained(cfg):
     """Heat transfer diagnosed with a library that lacks it: the model misses (windows located),
     nothing tried explains half the excess, and the verdict says so instead of naming a winner."""
