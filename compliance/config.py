@@ -5,7 +5,6 @@ from __future__ import annotations
 import hashlib
 import math
 import os
-import tempfile
 import tomllib
 from dataclasses import dataclass, field, replace as dc_replace
 from importlib import resources
@@ -19,6 +18,7 @@ from .close_match import did_you_mean
 from .effects import EFFECTS
 from .errors import InputError
 from .parameters import BASE_BY_KEY, BASE_PARAMS, OPTION_DEFAULTS, OPTIONS, SOURCES
+from .results_io import write_text_atomic
 from .units import parse_quantity
 
 _TOP_KEYS = {"name", "description", "provenance", "effects"}
@@ -426,16 +426,5 @@ def save_plant(cfg: PlantConfig, path: str | os.PathLike, *, overwrite: bool = F
     text = plant_to_toml(cfg)
     plant_from_dict(tomllib.loads(text), str(path))  # prove it round-trips before writing
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; a saved model is an ordinary file
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    write_text_atomic(path, text)
     return path

@@ -33,6 +33,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..config import PlantConfig
+from ..effects import EFFECTS
 from ..errors import InputError
 from .candidates import Candidate, FitParam, apply
 from .replay_fit import ReplaySetup
@@ -124,8 +125,6 @@ class FitResult:
         The error propagates the full covariance (delta method): parameters that trade along a
         valley are strongly anti-correlated, so their sum is much sharper than either.
         """
-        from ..effects import EFFECTS
-
         decl = EFFECTS.get(effect)
         if decl is None or decl.lumped is None:
             return None
