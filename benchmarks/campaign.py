@@ -35,15 +35,16 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
 
     t0 = time.perf_counter()
-    from compliance.config import load_plant
-    from compliance.harness import _warm_up, available_cores, run_campaign
-    from compliance.requirements import load_requirements
+    from compliance.model.config import load_plant
+    from compliance.campaign.executor import available_cores, warm_up
+    from compliance.campaign.run import run_campaign
+    from compliance.requirements.loading import load_requirements
 
     cfg = load_plant(args.plant)
     reqset = load_requirements(args.requirements)
     t_import = time.perf_counter() - t0
     t0 = time.perf_counter()
-    _warm_up(cfg)
+    warm_up(cfg)
     t_compile = time.perf_counter() - t0
 
     def timed(workers):

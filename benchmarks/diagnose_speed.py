@@ -31,8 +31,8 @@ def _recordings(tmp: Path) -> list[Path]:
     found = sorted(practice.glob("practice_*.csv.gz")) if practice.is_dir() else []
     if found:
         return found
-    from compliance.config import load_plant
-    from compliance.recording_synth import synthesise, write_recording
+    from compliance.model.config import load_plant
+    from compliance.recordings.synth import synthesise, write_recording
 
     cfg = load_plant("plant-a")
     out = []

@@ -29,9 +29,9 @@ BUDGET = 20.0  # [s] issue 8: full plant-A report, HTML + PDF, 2 cores
 def _results(args) -> dict:
     if args.results:
         return json.loads(Path(args.results).read_text(encoding="utf-8"))
-    from compliance.config import load_plant
-    from compliance.harness import run_campaign
-    from compliance.requirements import load_requirements
+    from compliance.model.config import load_plant
+    from compliance.campaign.run import run_campaign
+    from compliance.requirements.loading import load_requirements
 
     return json.loads(json.dumps(run_campaign(load_plant("plant-a"), load_requirements("shpp-400kw"), progress=False),
                                  default=float))

@@ -13,9 +13,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from compliance.config import load_plant  # noqa: E402
-from compliance.profiles import Profile, steps  # noqa: E402
-from compliance.simulate import Scenario, simulate  # noqa: E402
+from compliance.model.config import load_plant  # noqa: E402
+from compliance.simulation.profiles import Profile, steps  # noqa: E402
+from compliance.simulation import Scenario, simulate  # noqa: E402
 from tests import reference_model as ref  # noqa: E402
 
 

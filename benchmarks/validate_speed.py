@@ -30,8 +30,8 @@ def _recording(tmp: Path) -> Path:
     practice = ROOT.parent / "shared" / "practice-recordings" / "practice_no_effect.csv.gz"
     if practice.is_file():
         return practice
-    from compliance.config import load_plant
-    from compliance.recording_synth import synthesise, write_recording
+    from compliance.model.config import load_plant
+    from compliance.recordings.synth import synthesise, write_recording
 
     rec, meta = synthesise(load_plant("plant-a"), x0=0.06, load=7000.0, kd=6.0, seed=1)
     path = tmp / "synthetic_practice.csv.gz"
@@ -53,9 +53,9 @@ def main() -> None:
             cold.append(time.perf_counter() - t0)
             if p.returncode not in (0, 1):
                 raise SystemExit(f"validate failed ({p.returncode}): {p.stderr}")
-        from compliance.config import load_plant
-        from compliance.recordings import read_recording
-        from compliance.validation import validate
+        from compliance.model.config import load_plant
+        from compliance.recordings.reader import read_recording
+        from compliance.validation.validate import validate
 
         cfg = load_plant("plant-a")
         t0 = time.perf_counter()

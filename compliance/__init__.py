@@ -19,7 +19,7 @@ def _numba_cache_dir() -> str:
     for sub in ("physics",):
         for f in sorted((here / sub).glob("*.py")) if (here / sub).is_dir() else ():
             digest.update(f.read_bytes())
-    for name in ("plant.py", "simulate.py", "control.py", "layout.py"):
+    for name in ("model/assembly.py", "model/pid_controller.py", "model/vector_slots.py", "simulation/closed_loop.py", "simulation/state_feedback_loop.py"):
         f = here / name
         if f.is_file():
             digest.update(f.read_bytes())

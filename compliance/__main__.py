@@ -1,6 +1,6 @@
 """``python -m compliance`` runs the govcheck CLI."""
 import sys
 
-from .cli import main
+from compliance.cli import main
 
 sys.exit(main())

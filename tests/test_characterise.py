@@ -38,7 +38,7 @@ from compliance.cli import characterise as cli_characterise
 from compliance.errors import GovcheckError, InputError
 from compliance.physics import friction as phys_friction
 from compliance.physics import valve_flow as phys_flow
-from compliance.recordings import read_recording
+from compliance.recordings.reader import read_recording
 
 DATA = Path(__file__).parent / "data"
 ATM = 101325.0

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from compliance.cli import main
-from compliance.config import load_plant, save_plant
+from compliance.model.config import load_plant, save_plant
 from compliance.errors import InputError
 from compliance.units import parse_quantity
 

@@ -15,12 +15,12 @@ import pandas as pd
 import pytest
 
 from compliance.cli import main
-from compliance.config import load_plant
+from compliance.model.config import load_plant
 from compliance.diagnosis.candidates import FitParam, effect_params
 from compliance.diagnosis.engine import diagnose, save_fitted
 from compliance.diagnosis.replay_fit import prepare_replay, replay_config, run_replay, segment_starts
 from compliance.errors import InputError
-from compliance.recording_synth import PRACTICE_NOISE, synthesise, write_recording
+from compliance.recordings.synth import PRACTICE_NOISE, synthesise, write_recording
 
 DURATION = 17.0  # s: hold, +2 % / back, +5 % / back, +10 % / back (the practice steps)
 

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from compliance.config import load_plant
+from compliance.model.config import load_plant
 from compliance.effects import EFFECTS
-from compliance.layout import EFFECT_SLOTS, STATE_NAMES
-from compliance.plant import parameter_vector
+from compliance.model.vector_slots import EFFECT_SLOTS, STATE_NAMES
+from compliance.model.assembly import parameter_vector
 
 REQUIRED = {
     "heat_transfer", "internal_leakage", "external_leakage", "valve_dynamics", "supply_droop",
@@ -50,8 +50,8 @@ def test_declared_states_exist(name):
 
 def test_effect_off_costs_nothing_in_results():
     """A configuration with an effect at a neutral value gives the same trace as the base model."""
-    from compliance.profiles import steps
-    from compliance.simulate import Scenario, simulate
+    from compliance.simulation.profiles import steps
+    from compliance.simulation import Scenario, simulate
 
     cfg = load_plant("plant-a")
     sc = Scenario(duration=1.5, initial_position=0.08, reference=steps("5%@0.2s", 0.08, 0.16), load=5000.0)
@@ -71,8 +71,8 @@ def _corner_cases():
 def test_every_bound_simulates_stably(name, pname, value):
     """Each parameter at either end of its declared range stays finite at the pinned step: the
     diagnosis fits anywhere inside the bounds, so none of them may make RK4 blow up."""
-    from compliance.profiles import steps
-    from compliance.simulate import Scenario, simulate
+    from compliance.simulation.profiles import steps
+    from compliance.simulation import Scenario, simulate
 
     cfg = load_plant("plant-a").replace(effects={name: {pname: value}})
     df = simulate(cfg, Scenario(duration=1.5, initial_position=0.08, reference=steps("5%@0.2s,-10%@0.8s", 0.08, 0.16), load=6000.0))

@@ -14,11 +14,11 @@ import math
 import numpy as np
 import pytest
 
-from compliance.config import load_plant
-from compliance.layout import A_FRIC, A_LOAD, N_AUX, N_STATES, S_V, S_X, S_X2
-from compliance.plant import initial_state, load_curve_arrays, parameter_vector, plant_rhs
-from compliance.profiles import Profile, steps
-from compliance.simulate import Scenario, simulate
+from compliance.model.config import load_plant
+from compliance.model.vector_slots import A_FRIC, A_LOAD, N_AUX, N_STATES, S_V, S_X, S_X2
+from compliance.model.assembly import initial_state, load_curve_arrays, parameter_vector, plant_rhs
+from compliance.simulation.profiles import Profile, steps
+from compliance.simulation import Scenario, simulate
 
 R, GAMMA, TS = 287.0, 1.4, 293.15
 HOLD_LOAD = 30000.0  # N: more than (8 - 1.013) bar * 0.0237 m^2 = 16.6 kN, the piston stays on x = 0
@@ -178,8 +178,8 @@ def test_valve_dynamics_delay_the_pressure_response(cfg):
 def test_valve_dynamics_stage_spool_moves_in_the_dead_band_opening_does_not(cfg):
     """Spool stage: the filter follows the command even inside the dead band (the spool
     travels through its overlap); opening stage: it follows the opening, which is zero there."""
-    from compliance.layout import S_SP, S_SV
-    from compliance.plant import valve_lag_input
+    from compliance.model.vector_slots import S_SP, S_SV
+    from compliance.model.assembly import valve_lag_input
 
     vd = {"valve_dynamics": {"natural_frequency": 50.0, "damping": 0.7, "delay": 0.0}}
     u = cfg.p("valve.centre_voltage") + 0.5 * cfg.p("valve.dead_zone_positive")  # inside the dead band
@@ -201,7 +201,7 @@ def test_valve_dynamics_stages_linearise_alike(cfg):
     """A linear valve gain commutes with the valve's lag, so both stages give one linear model."""
     import control
 
-    from compliance.linear import analyse
+    from compliance.linear.analysis import analyse
 
     vd = {"valve_dynamics": {"natural_frequency": 150.0, "damping": 0.7, "delay": 0.002}}
     poles = []

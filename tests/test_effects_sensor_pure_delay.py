@@ -2,9 +2,9 @@
 
 import numpy as np
 
-from compliance.config import load_plant
-from compliance.profiles import Profile
-from compliance.simulate import Scenario, simulate
+from compliance.model.config import load_plant
+from compliance.simulation.profiles import Profile
+from compliance.simulation import Scenario, simulate
 
 
 def test_pure_delay_reads_the_delayed_position():

@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from compliance.cli import main
-from compliance.gate import compare, gate_markdown
+from compliance.campaign.regression_gate import compare, gate_markdown
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -9,10 +9,10 @@ from pathlib import Path
 import pytest
 
 from compliance.cli import main
-from compliance.config import load_plant
-from compliance.harness import plan, run_campaign
-from compliance.procedures import MAX_TRACE_POINTS
-from compliance.requirements import load_requirements
+from compliance.model.config import load_plant
+from compliance.campaign.run import plan, run_campaign
+from compliance.procedures.registry import MAX_TRACE_POINTS
+from compliance.requirements.loading import load_requirements
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -141,13 +141,13 @@ def test_results_hold_what_a_report_needs(plant, serial):
 
 def test_linear_hook_absent_then_present(plant, small_file, serial, monkeypatch):
     lin = {e["id"]: e for e in serial["requirements"]}["LIN"]
-    if "compliance.linear" not in sys.modules:
+    if "compliance.linear.analysis" not in sys.modules:
         try:
-            import compliance.linear  # noqa: F401
+            import compliance.linear.analysis  # noqa: F401
         except ImportError:
             assert lin["status"] == "not_evaluated"
             assert "not available" in lin["rows"][0]["reason"]
-    fake = types.ModuleType("compliance.linear")
+    fake = types.ModuleType("compliance.linear.analysis")
     calls = []
     answer = {"value": 0.2}
 
@@ -156,7 +156,7 @@ def test_linear_hook_absent_then_present(plant, small_file, serial, monkeypatch)
         return answer["value"]
 
     fake.evaluate_metric = evaluate_metric
-    monkeypatch.setitem(sys.modules, "compliance.linear", fake)
+    monkeypatch.setitem(sys.modules, "compliance.linear.analysis", fake)
     res = run_campaign(plant, load_requirements(small_file), workers=1, progress=False)
     lin = {e["id"]: e for e in res["requirements"]}["LIN"]
     assert lin["status"] == "pass" and lin["rows"][0]["value"] == 0.2

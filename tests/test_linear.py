@@ -10,12 +10,12 @@ import numpy as np
 import pytest
 
 from compliance.cli import main
-from compliance.config import load_plant
-from compliance.control import first_order_filter_gain, pid_step
+from compliance.model.config import load_plant
+from compliance.model.pid_controller import first_order_filter_gain, pid_step
 from compliance.errors import InputError
-from compliance.linear import analyse, close_loop, linear_metric, margins, pid_controller
-from compliance.linear_maps import nonlinear_step, operating_map, viscous_friction_variant
-from compliance.linear_trim import linearise_plant, trim
+from compliance.linear.analysis import analyse, close_loop, linear_metric, margins, pid_controller
+from compliance.linear.maps import nonlinear_step, operating_map, viscous_friction_variant
+from compliance.linear.trim import linearise_plant, trim
 
 
 @pytest.fixture(scope="module")
@@ -132,7 +132,7 @@ def test_discrete_controller_matches_the_simulator_pid(cfg):
     r, xm = rng.normal(0, 1e-3, 60), rng.normal(0, 1e-3, 60)
     xm[0] = 0.0  # the simulator starts its filter at the first measurement; the state space at 0
     u_sim, integ, xf = [], 0.0, xm[0]
-    for k in range(60):  # the loop of compliance.simulate.simulate_core
+    for k in range(60):  # the loop of compliance.simulation.pid_loop.simulate_core
         x_new = xf + al * (xm[k] - xf)
         rate = (x_new - xf) / ts
         xf = x_new
@@ -232,7 +232,7 @@ def test_cli_writes_json(tmp_path, capsys):
 
 
 def test_governor_rates_recover_the_flow_control_setting(cfg):
-    from compliance.governor_model import governor_parameters
+    from compliance.linear.governor_model import governor_parameters
 
     # plant-a.toml sets both meter-out throttles for 5 s full strokes at 5.7 kN (seed 000 section 5.2):
     # 0.2 pu/s; 10 % covers the 25-75 % extrapolation against the paper's end-to-end definition

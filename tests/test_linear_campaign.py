@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from compliance.config import load_plant
-from compliance.linear_campaign import linear_for_campaign
-from compliance.requirements import load_requirements
+from compliance.model.config import load_plant
+from compliance.linear.operating_points import linear_for_campaign
+from compliance.requirements.loading import load_requirements
 
 
 def test_linear_for_campaign_covers_the_operating_points():

@@ -1,4 +1,4 @@
-"""Residual windows (compliance.locate) and operating regimes (compliance.regimes)."""
+"""Residual windows (compliance.validation.locate) and operating regimes (compliance.validation.regimes)."""
 
 from __future__ import annotations
 
@@ -7,9 +7,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from compliance.config import load_plant
+from compliance.model.config import load_plant
 from compliance.errors import InputError
-from compliance.locate import (
+from compliance.validation.locate import (
     LocateSettings,
     hysteresis_windows,
     locate,
@@ -17,12 +17,12 @@ from compliance.locate import (
     noise_floor,
     smoothed_abs,
 )
-from compliance.profiles import Profile
-from compliance.recording_synth import PRACTICE_NOISE, synthesise
-from compliance.regimes import REVERSAL_SPAN, compute_regimes
-from compliance.replay import replay
-from compliance.simulate import Scenario, simulate
-from compliance.validation_metrics import per_unit_bases
+from compliance.simulation.profiles import Profile
+from compliance.recordings.synth import PRACTICE_NOISE, synthesise
+from compliance.validation.regimes import REVERSAL_SPAN, compute_regimes
+from compliance.validation.replay import replay
+from compliance.simulation import Scenario, simulate
+from compliance.validation.fit_metrics import per_unit_bases
 
 SMOOTHING = LocateSettings().smoothing
 

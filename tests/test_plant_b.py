@@ -9,14 +9,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from compliance.config import load_plant
+from compliance.model.config import load_plant
 from compliance.errors import InputError
-from compliance.layout import A_QA, N_AUX, N_STATES, P_FJ, P_FRM, P_KV1, P_KV2, P_VD, S_PA, S_PB, S_V
+from compliance.model.vector_slots import A_QA, N_AUX, N_STATES, P_FJ, P_FRM, P_KV1, P_KV2, P_VD, S_PA, S_PB, S_V
 from compliance.physics.friction import piecewise_stribeck_friction
 from compliance.physics.valve_flow import bobrow_mass_flow, iso6358_mass_flow, power_law_mass_flow, sanville_mass_flow
-from compliance.plant import initial_state, load_curve_arrays, parameter_vector, plant_rhs
-from compliance.tracking import design, flow_rating
-from compliance.tracking.flow_trend import flow_claim
+from compliance.model.assembly import initial_state, load_curve_arrays, parameter_vector, plant_rhs
+from compliance.model import axis_design as design
+from compliance.characterise import flow_rating
+from compliance.characterise.flow_trend import flow_claim
 
 ROOT = Path(__file__).resolve().parents[1]
 GAMMA, R, T = 1.4, 287.0, 293.15

@@ -15,9 +15,9 @@ import pandas as pd
 import pytest
 import scipy.io
 
-from compliance.column_map import load_column_map
+from compliance.recordings.column_map import load_column_map
 from compliance.errors import InputError
-from compliance.recordings import read_recording, sidecar_path
+from compliance.recordings.reader import read_recording, sidecar_path
 
 DATA = Path(__file__).parent / "data"
 ATM = 101325.0

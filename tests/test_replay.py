@@ -1,4 +1,4 @@
-"""Replay of recordings with the model (compliance.replay) and the synthetic recordings it is tested on."""
+"""Replay of recordings with the model (compliance.validation.replay) and the synthetic recordings it is tested on."""
 
 from __future__ import annotations
 
@@ -9,23 +9,23 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from compliance.config import load_plant
+from compliance.model.config import load_plant
 from compliance.errors import InputError
-from compliance.recording_synth import (
+from compliance.recordings.synth import (
     PRACTICE_NOISE,
     practice_profile,
     synthesise,
     write_recording,
 )
-from compliance.recordings import read_recording
-from compliance.replay import (
+from compliance.recordings.reader import read_recording
+from compliance.validation.replay import (
     estimate_position_noise,
     position_quantum,
     replay,
     robust_std,
     zoh_interval_average,
 )
-from compliance.validation_metrics import fit_percent
+from compliance.validation.fit_metrics import fit_percent
 
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "practice-recordings"
 OUTPUTS = ("position", "pressure_a", "pressure_b")

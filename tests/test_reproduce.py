@@ -5,9 +5,9 @@ from __future__ import annotations
 import pytest
 
 from compliance.cli import main
-from compliance.config import load_plant
-from compliance.dead_zone_stall import stall_error
-from compliance.reproduce import CASES, _step_metrics
+from compliance.model.config import load_plant
+from compliance.model.dead_zone_stall import stall_error
+from compliance.papers.plant_a import CASES, _step_metrics
 
 
 def test_stall_error_formula():

@@ -7,7 +7,7 @@ import pytest
 
 from compliance.cli import main
 from compliance.errors import InputError
-from compliance.requirements import check_tightening, load_requirements, reference_requirement_files
+from compliance.requirements.loading import check_tightening, load_requirements, reference_requirement_files
 
 ROOT = Path(__file__).resolve().parents[1]
 STROKE = 0.160

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from compliance.config import load_plant
+from compliance.model.config import load_plant
 from compliance.errors import InputError
-from compliance.profiles import steps
-from compliance.simulate import Scenario, simulate
+from compliance.simulation.profiles import steps
+from compliance.simulation import Scenario, simulate
 
 
 def test_plant_b_step_under_state_feedback():

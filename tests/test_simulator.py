@@ -7,11 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from compliance.config import load_plant
-from compliance.layout import N_AUX, N_STATES, S_PA, S_PB, S_V, S_V2, S_X, S_X2, S_Z1
-from compliance.plant import initial_state, load_curve_arrays, parameter_vector, plant_rhs
-from compliance.profiles import Profile, steps
-from compliance.simulate import Scenario, SensorNoise, simulate
+from compliance.model.config import load_plant
+from compliance.model.vector_slots import N_AUX, N_STATES, S_PA, S_PB, S_V, S_V2, S_X, S_X2, S_Z1
+from compliance.model.assembly import initial_state, load_curve_arrays, parameter_vector, plant_rhs
+from compliance.simulation.profiles import Profile, steps
+from compliance.simulation import Scenario, SensorNoise, simulate
 
 STROKE = 0.160
 

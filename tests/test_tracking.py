@@ -11,18 +11,18 @@ from scipy.linalg import expm
 
 from compliance import metrics as M
 from compliance import procedures
-from compliance.config import load_plant
+from compliance.model.config import load_plant
 from compliance.errors import InputError
-from compliance.layout import S_PA, S_PB
-from compliance.plant import initial_state, parameter_vector
-from compliance.simulate import Scenario, simulate
-from compliance.profiles import sine
-from compliance import tracking
-from compliance.tracking import design
-from compliance.tracking.metrics_tracking import path_deviation, stick_slip_episodes
-from compliance.tracking.observers import observe
+from compliance.model.vector_slots import S_PA, S_PB
+from compliance.model.assembly import initial_state, parameter_vector
+from compliance.simulation import Scenario, simulate
+from compliance.simulation.profiles import sine
+from compliance.procedures import path_tracking as tracking
+from compliance.model import axis_design as design
+from compliance.metrics.path_tracking import path_deviation, stick_slip_episodes
+from compliance.model.observers import observe
 from compliance.tracking.paths import circle, read_path_csv, stroke_path, time_parameterise
-from compliance.tracking.simulate_tracking import AxisReference, simulate_axis
+from compliance.simulation.state_feedback_loop import AxisReference, simulate_axis
 
 ROOT = Path(__file__).resolve().parents[1]
 TS = 1e-3
@@ -211,16 +211,14 @@ def test_stick_slip_episode_detection():
 
 
 # --------------------------------------------------------------------------- harness wiring
-def test_requirement_file_runs_through_the_harness_tables(cfg, monkeypatch):
+def test_requirement_file_runs_through_the_registry(cfg):
+    from compliance.metrics.catalogue import METRICS
+    from compliance.procedures.kinds import TRACKING
     from compliance.requirements import load_requirements
 
-    from compliance.tracking.tracking_procedures import harness_tables
-
-    for table, ours in harness_tables():  # what tracking.register() does, undone after the test
-        for k, v in ours.items():
-            monkeypatch.setitem(table, k, v)
     rs = load_requirements(ROOT / "requirements" / "tracking-robot.toml")
-    assert {r.metric for r in rs.requirements} <= set(tracking.METRICS)
+    assert {p.kind for p in rs.procedures.values()} <= set(TRACKING)
+    assert {r.metric for r in rs.requirements} <= {m for m, info in METRICS.items() if set(info.kinds) & set(TRACKING)}
     req = next(r for r in rs.requirements if r.id == "TR-AXIS-RMS")
     out = procedures.run(cfg, rs.procedures["axis-sine-50mm"], rs.operating_points["workspace-centre"], [(req.metric, {})])
     assert out.error is None

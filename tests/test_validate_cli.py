@@ -8,8 +8,8 @@ import json
 import pytest
 
 from compliance.cli import main
-from compliance.config import load_plant
-from compliance.recording_synth import PRACTICE_NOISE, synthesise, write_recording
+from compliance.model.config import load_plant
+from compliance.recordings.synth import PRACTICE_NOISE, synthesise, write_recording
 
 
 @pytest.fixture(scope="module")

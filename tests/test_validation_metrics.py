@@ -1,4 +1,4 @@
-"""Fit and windowed error measures (compliance.validation_metrics) and validation settings."""
+"""Fit and windowed error measures (compliance.validation.fit_metrics) and validation settings."""
 
 from __future__ import annotations
 
@@ -7,11 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from compliance.config import load_plant
+from compliance.model.config import load_plant
 from compliance.errors import InputError
-from compliance.recording_synth import practice_profile
-from compliance.validation import apply_overrides, decimation_indices, load_settings, settings_from_dict
-from compliance.validation_metrics import (
+from compliance.recordings.synth import practice_profile
+from compliance.validation.validate import apply_overrides, decimation_indices, load_settings, settings_from_dict
+from compliance.validation.fit_metrics import (
     DEFAULT_LIMITS,
     ErrorLimits,
     ErrorWindow,

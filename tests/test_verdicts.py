@@ -2,8 +2,8 @@
 
 import pytest
 
-from compliance.requirements import parse_amount
-from compliance.verdicts import (
+from compliance.requirements.loading import parse_amount
+from compliance.requirements.verdict import (
     FAIL,
     NOT_EVALUATED,
     PASS,

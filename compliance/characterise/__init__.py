@@ -8,9 +8,9 @@
 See docs/characterisation.md.
 """
 
-from .charging import ValveCharacterisation, characterise_valve, mass_flow_from_pressure, synthetic_charging
-from .derivative import smoothed_derivative
-from .flow_law import (
+from compliance.characterise.charging import ValveCharacterisation, characterise_valve, mass_flow_from_pressure, synthetic_charging
+from compliance.characterise.derivative import smoothed_derivative
+from compliance.characterise.flow_law import (
     LAWS,
     FlowFit,
     bobrow_mass_flow,
@@ -20,7 +20,7 @@ from .flow_law import (
     rank_flow_laws,
     sanville_mass_flow,
 )
-from .friction_map import (
+from compliance.characterise.friction_map import (
     FrictionCharacterisation,
     FrictionFit,
     FrictionRun,

@@ -20,10 +20,10 @@ import numpy as np
 import pandas as pd
 from scipy.integrate import solve_ivp
 
-from ..errors import InputError
-from ..units import ATMOSPHERE_PA
-from .derivative import noise_std, odd_window, savgol_weights, smoothed_derivative
-from .flow_law import GAMMA, LAWS, R_AIR, T0, FlowFit, rank_flow_laws
+from compliance.errors import InputError
+from compliance.units import ATMOSPHERE_PA
+from compliance.characterise.derivative import noise_std, odd_window, savgol_weights, smoothed_derivative
+from compliance.characterise.flow_law import GAMMA, LAWS, R_AIR, T0, FlowFit, rank_flow_laws
 
 DERIVATIVE_ORDER = 3  # cubic Savitzky-Golay: same centre-point noise as quadratic, smaller bias
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputError
+from compliance.errors import InputError
 
 
 def odd_window(samples: float, order: int) -> int:

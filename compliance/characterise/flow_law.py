@@ -27,8 +27,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from ..errors import InputError
-from ..physics import valve_flow as _vf
+from compliance.errors import InputError
+from compliance.physics import valve_flow as _vf
 
 GAMMA = 1.4  # heat capacity ratio of air (reference-plant.md)
 R_AIR = 287.0  # gas constant of air [J/(kg*K)] (reference-plant.md)

@@ -25,9 +25,9 @@ import numpy as np
 import pandas as pd
 from scipy.optimize import least_squares
 
-from ..errors import InputError
-from ..units import ATMOSPHERE_PA
-from .derivative import odd_window, smoothed_derivative
+from compliance.errors import InputError
+from compliance.units import ATMOSPHERE_PA
+from compliance.characterise.derivative import odd_window, smoothed_derivative
 
 VISCOUS_SPAN = 3.0  # populated speed range (max/min) needed to fit b
 STRIBECK_SPAN = 10.0  # ... and to fit the Stribeck decay

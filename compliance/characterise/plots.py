@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
+from compliance.errors import InputError
 
 
 def _figure(rows: int):

@@ -11,7 +11,7 @@ import argparse
 import importlib
 import sys
 
-from ..errors import GovcheckError
+from compliance.errors import GovcheckError
 
 # command name -> module; the order is the order shown by --help
 _COMMANDS = (
@@ -31,7 +31,7 @@ _COMMANDS = (
 
 def build_parser() -> argparse.ArgumentParser:
     """Build the argument parser with every available sub-command."""
-    from .. import __version__
+    from compliance import __version__
 
     parser = argparse.ArgumentParser(
         prog="govcheck",

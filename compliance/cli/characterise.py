@@ -10,8 +10,8 @@ import json
 import math
 from pathlib import Path
 
-from ..errors import InputError
-from ..units import parse_quantity
+from compliance.errors import InputError
+from compliance.units import parse_quantity
 
 
 def register(subparsers):
@@ -60,9 +60,9 @@ def run(args) -> int:
 
 
 def _run_valve(args) -> int:
-    from ..characterise.charging import characterise_valve
-    from ..characterise.flow_law import LAWS
-    from ..recordings import read_recording
+    from compliance.characterise.charging import characterise_valve
+    from compliance.characterise.flow_law import LAWS
+    from compliance.recordings.reader import read_recording
 
     volume = parse_quantity(args.volume, "m^3", "--volume")
     temperature = parse_quantity(args.temperature, "K", "--temperature")
@@ -89,7 +89,7 @@ def _run_valve(args) -> int:
     if args.json:
         _write_json(args.json, result.to_dict())
     if args.plot:
-        from ..characterise.plots import plot_valve
+        from compliance.characterise.plots import plot_valve
 
         plot_valve(result, args.plot)
     return 0
@@ -125,8 +125,8 @@ def _valve_table(r) -> str:
 
 
 def _run_friction(args) -> int:
-    from ..characterise.friction_map import characterise_friction, piston_area, prepare_run
-    from ..recordings import read_recording
+    from compliance.characterise.friction_map import characterise_friction, piston_area, prepare_run
+    from compliance.recordings.reader import read_recording
 
     window = parse_quantity(args.window, "s", "--window")
     v_min = parse_quantity(args.min_speed, "m/s", "--min-speed")
@@ -158,7 +158,7 @@ def _run_friction(args) -> int:
     if args.json:
         _write_json(args.json, result.to_dict())
     if args.plot:
-        from ..characterise.plots import plot_friction
+        from compliance.characterise.plots import plot_friction
 
         plot_friction(result, args.plot)
     return 0

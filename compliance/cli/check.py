@@ -6,7 +6,7 @@ import shlex
 import sys
 from pathlib import Path
 
-from ..errors import InputError
+from compliance.errors import InputError
 
 
 def register(subparsers):
@@ -49,7 +49,7 @@ def renderer(args):
     if not (args.report or args.pdf):
         return None
     try:
-        from ..report.render import render_report
+        from compliance.report.render import render_report
     except ImportError:
         raise InputError("report rendering not available") from None
     return render_report
@@ -71,10 +71,10 @@ def command_line(args, name: str = "check") -> str:
 
 def run(args) -> int:
     """Run the campaign, print the table, write the outputs; exit code from the verdict."""
-    from ..config import load_plant
-    from ..harness import run_campaign
-    from ..requirements import load_requirements
-    from ..results_io import summary_table, write_json, write_junit
+    from compliance.model.config import load_plant
+    from compliance.campaign.run import run_campaign
+    from compliance.requirements.loading import load_requirements
+    from compliance.campaign.results_files import summary_table, write_json, write_junit
 
     if args.jobs is not None and args.jobs < 1:
         raise InputError(f"--jobs {args.jobs}: expected a positive number of processes")
@@ -85,7 +85,7 @@ def run(args) -> int:
     reqset = load_requirements(args.requirements)
     results = run_campaign(cfg, reqset, workers=args.jobs, progress=not args.quiet, command_line=command_line(args))
     if args.linear:
-        from ..linear_campaign import linear_for_campaign
+        from compliance.linear.operating_points import linear_for_campaign
 
         results["linear"] = linear_for_campaign(cfg, reqset)
     table = summary_table(results)

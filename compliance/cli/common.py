@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from ..config import PlantConfig, load_plant
-from ..errors import InputError
-from ..units import parse_quantity
+from compliance.model.config import PlantConfig, load_plant
+from compliance.errors import InputError
+from compliance.units import parse_quantity
 
 
 def add_plant_argument(parser, positional: bool = True) -> None:

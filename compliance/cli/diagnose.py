@@ -16,8 +16,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..errors import InputError
-from ..results_io import write_json_atomic
+from compliance.errors import InputError
+from compliance.files.atomic import write_json_atomic
 
 _SCALE = {"position": (1e3, "mm"), "valve_command": (1.0, "V"), "pressure_a": (1e-3, "kPa"), "pressure_b": (1e-3, "kPa"),
           "supply_pressure": (1e-3, "kPa")}
@@ -63,7 +63,7 @@ def _is_friction(frame) -> bool:
 
 def run(args) -> int:
     """Run ``govcheck diagnose``; returns 0 when the diagnosis ran."""
-    from ..recordings import read_recording
+    from compliance.recordings.reader import read_recording
 
     if args.jobs is not None and args.jobs < 1:
         raise InputError(f"--jobs {args.jobs}: expected a positive number of worker processes")
@@ -80,8 +80,8 @@ def run(args) -> int:
     if len(args.recordings) > 1:
         raise InputError(f"{args.recordings[1]}: one servo recording at a time (several files are for friction-bench runs)")
     frame, meta = read_recording(args.recordings[0], args.column_map)
-    from ..config import load_plant
-    from ..diagnosis.engine import diagnose, save_fitted
+    from compliance.model.config import load_plant
+    from compliance.diagnosis.engine import diagnose, save_fitted
 
     plant = args.plant or meta.get("plant")
     if not plant:
@@ -127,8 +127,8 @@ def _print_servo(d: dict, quiet: bool) -> None:
 
 def _render_servo_report(cfg, frame, meta, diag, data: dict, html_path: str) -> None:
     try:
-        from ..report.render import render_validation_report
-        from ..validation import ValidationSettings, validate
+        from compliance.report.render import render_validation_report
+        from compliance.validation.validate import ValidationSettings, validate
     except ImportError as exc:  # pragma: no cover - depends on the report engineer's module
         raise InputError(f"--report: the report renderer is not available yet ({exc}); use --json") from None
     settings = ValidationSettings(modes=("closed_loop",)) if "reference" in frame.columns else ValidationSettings(modes=("plant_only",))
@@ -142,7 +142,7 @@ def _render_servo_report(cfg, frame, meta, diag, data: dict, html_path: str) -> 
             group = p["name"].split(".")[0] if p["kind"] == "effect" else "base parameters (recalibrated)"
             groups.setdefault(group, []).append({"name": p["name"].split(".", 1)[1] if p["kind"] == "effect" else p["name"],
                                                  "value": p["value"], "unit": p["unit"]})
-        from ..effects import EFFECTS
+        from compliance.effects import EFFECTS
 
         for g, params in groups.items():
             diag_entry["added"].append({"name": g, "meaning": EFFECTS[g].meaning if g in EFFECTS else "", "params": params})
@@ -151,9 +151,9 @@ def _render_servo_report(cfg, frame, meta, diag, data: dict, html_path: str) -> 
 
 
 def _run_friction(args, first, meta) -> int:
-    from ..diagnosis.friction_diagnosis import diagnose_friction, format_friction
-    from ..recordings import read_recording
-    from ..units import parse_quantity
+    from compliance.diagnosis.friction_diagnosis import diagnose_friction, format_friction
+    from compliance.recordings.reader import read_recording
+    from compliance.units import parse_quantity
 
     runs = [(first, meta)]
     for path in args.recordings[1:]:
@@ -169,7 +169,7 @@ def _run_friction(args, first, meta) -> int:
     if args.json_out:
         write_json_atomic(args.json_out, data)
     if args.report:
-        from ..diagnosis.friction_report import write_friction_report
+        from compliance.diagnosis.friction_report import write_friction_report
 
         write_friction_report(result, args.report)
     print(format_friction(data, args.quiet))

@@ -16,7 +16,7 @@ import argparse
 import json
 from pathlib import Path
 
-from ..errors import InputError
+from compliance.errors import InputError
 
 TOP1_TARGET = 0.9
 NULL_TARGET = 0.9
@@ -54,7 +54,7 @@ def register(sub):
 
 
 def _names(text: str | None, option: str):
-    from ..effects import EFFECTS
+    from compliance.effects import EFFECTS
 
     if not text:
         return None
@@ -80,9 +80,9 @@ def _plain(x):
 
 def run(args) -> int:
     """Run the benchmark; 0 when the targets are met, 1 when not."""
-    from ..config import load_plant
-    from ..diagnosis.benchmark import format_summary, run_benchmark, run_practice
-    from ..diagnosis.engine import default_jobs
+    from compliance.model.config import load_plant
+    from compliance.diagnosis.benchmark import format_summary, run_benchmark, run_practice
+    from compliance.diagnosis.engine import default_jobs
 
     if args.cases < 1:
         raise InputError(f"--cases {args.cases}: expected at least 1")

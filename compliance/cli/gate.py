@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from ..errors import InputError
+from compliance.errors import InputError
 
 
 def register(subparsers):
@@ -39,7 +39,7 @@ def _is_results(path: str) -> bool:
 
 def _requirements_for(args, baseline_results):
     """Requirement file to run configurations against."""
-    from ..requirements import load_requirements
+    from compliance.requirements.loading import load_requirements
 
     if args.requirements:
         return load_requirements(args.requirements)
@@ -59,10 +59,11 @@ def _requirements_for(args, baseline_results):
 
 def run(args) -> int:
     """Obtain both results, compare, print, write; exit 1 when the gate trips."""
-    from ..config import load_plant
-    from ..gate import compare, gate_markdown, gate_table
-    from ..harness import run_campaign
-    from ..results_io import read_results, results_json, write_text_atomic
+    from compliance.model.config import load_plant
+    from compliance.campaign.regression_gate import compare, gate_markdown, gate_table
+    from compliance.campaign.run import run_campaign
+    from compliance.campaign.results_files import read_results, results_json
+    from compliance.files.atomic import write_text_atomic
 
     if args.max_margin_loss is not None and not args.max_margin_loss >= 0:
         raise InputError(f"--max-margin-loss {args.max_margin_loss}: expected a number of percentage points >= 0")

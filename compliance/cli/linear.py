@@ -6,7 +6,7 @@ import argparse
 import json
 from pathlib import Path
 
-from ..errors import InputError
+from compliance.errors import InputError
 
 _PLOT_SUFFIXES = (".png", ".svg", ".pdf")
 
@@ -43,7 +43,7 @@ def register(subparsers):
 
 
 def _position(text: str, stroke: float) -> float:
-    from ..units import parse_quantity
+    from compliance.units import parse_quantity
 
     t = str(text).strip()
     if t.endswith("%"):
@@ -59,7 +59,7 @@ def _position(text: str, stroke: float) -> float:
 
 def parse_load(text, flag: str = "--load"):
     """'none' -> None, 'curve' -> 'curve', '11.4 kN' -> 11400.0, '11400' -> 11400.0 [N]."""
-    from ..units import parse_quantity
+    from compliance.units import parse_quantity
 
     t = str(text).strip()
     if t.lower() in ("none", "0", ""):
@@ -112,8 +112,8 @@ def _summary(cfg, a) -> str:
 
 def run(args) -> int:
     """Run the analysis, print a summary, write JSON / plots."""
-    from ..config import load_plant
-    from ..linear import analyse, jsonable
+    from compliance.model.config import load_plant
+    from compliance.linear.analysis import analyse, jsonable
 
     _check_out(args.json, "--json")
     _check_out(args.governor_json, "--governor-json")
@@ -127,7 +127,7 @@ def run(args) -> int:
     out = {"schema": "govcheck-linear/1", "plant": cfg.name, "path": cfg.path, "digest": cfg.digest, "analysis": a.to_dict()}
     omap = None
     if args.map:
-        from ..linear_maps import map_table, operating_map
+        from compliance.linear.maps import map_table, operating_map
 
         omap = operating_map(cfg, flow_control=args.flow_control, gain=args.gain)
         print("\ntime constant [ms] over stroke x load (* outside 100-250 ms):")
@@ -140,14 +140,14 @@ def run(args) -> int:
             print(f"  note: {n}")
         out["map"] = omap.to_dict()
     if args.crosscheck:
-        from ..linear_maps import crosscheck, crosscheck_table
+        from compliance.linear.maps import crosscheck, crosscheck_table
 
         rows = crosscheck(cfg, flow_control=args.flow_control)
         print("\ncross-check, linear vs nonlinear time constant (metric: dead time to 63.2 % of the commanded step):")
         print(crosscheck_table(rows))
         out["crosscheck"] = jsonable(rows)
     if args.governor or args.governor_json:
-        from ..governor_model import governor_parameters
+        from compliance.linear.governor_model import governor_parameters
 
         sl = "default" if args.stroke_load == "default" else parse_load(args.stroke_load, "--stroke-load")
         gov = governor_parameters(cfg, stroke_load=sl)
@@ -155,11 +155,11 @@ def run(args) -> int:
         print(gov.table())
         out["governor"] = gov.to_dict()
         if args.governor_json:
-            from ..results_io import write_text_atomic
+            from compliance.files.atomic import write_text_atomic
 
             write_text_atomic(args.governor_json, gov.to_json() + "\n")
     if args.json:
-        from ..results_io import write_text_atomic
+        from compliance.files.atomic import write_text_atomic
 
         write_text_atomic(args.json, json.dumps(jsonable(out), indent=1) + "\n")
         print(f"\nwrote {args.json}")

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ..config import load_plant, reference_plants
+from compliance.model.config import load_plant, reference_plants
 
 
 def register(sub):

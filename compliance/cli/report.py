@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from ..errors import InputError
+from compliance.errors import InputError
 
 
 def register(subparsers):
@@ -67,8 +67,8 @@ def merge_linear(docs) -> dict:
 
 def run(args) -> int:
     """Render the report(s); print where they were written."""
-    from ..report.content import check_results
-    from ..report.render import VALIDATION_SCHEMA, check_validation, render_report, render_validation_report
+    from compliance.report.content import check_results
+    from compliance.report.render import VALIDATION_SCHEMA, check_validation, render_report, render_validation_report
 
     if args.jobs is not None and args.jobs < 1:
         raise InputError(f"--jobs {args.jobs}: expected a positive number of processes")

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import json
 
-from ..config import load_plant
-from ..errors import InputError
+from compliance.model.config import load_plant
+from compliance.errors import InputError
 
 
 def register(sub):
@@ -20,7 +20,7 @@ def register(sub):
 
 
 def run(args) -> int:
-    from ..reproduce import compare, format_table
+    from compliance.papers.plant_a import compare, format_table
 
     cfg = load_plant(args.plant)
     if cfg.options["cylinder.arrangement"] != "tandem":
@@ -28,7 +28,7 @@ def run(args) -> int:
     comp = compare(cfg, explain=not args.no_explain)
     print(format_table(comp))
     if args.json:
-        from ..results_io import write_json_atomic
+        from compliance.files.atomic import write_json_atomic
 
         write_json_atomic(args.json, {"plant": cfg.name, "stall_error_m": comp.stall_error, "notes": comp.notes,
                                       "rows": [r.__dict__ for r in comp.rows]})

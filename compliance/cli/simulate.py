@@ -6,10 +6,10 @@ import os
 import tempfile
 from pathlib import Path
 
-from ..errors import InputError
-from ..profiles import Profile, parse_sine, steps
-from ..simulate import Scenario, SensorNoise, simulate
-from .common import add_plant_argument, plant_from_args, quantity
+from compliance.errors import InputError
+from compliance.simulation.profiles import Profile, parse_sine, steps
+from compliance.simulation import Scenario, SensorNoise, simulate
+from compliance.cli.common import add_plant_argument, plant_from_args, quantity
 
 
 def register(sub):

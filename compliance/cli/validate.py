@@ -5,10 +5,10 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..errors import InputError
-from ..results_io import write_json_atomic
+from compliance.errors import InputError
+from compliance.files.atomic import write_json_atomic
 
-# the replay modes of compliance.replay.MODES; the library is imported in run() only, so that
+# the replay modes of compliance.validation.replay.MODES; the library is imported in run() only, so that
 # building the dispatcher's parser for other commands does not pay for scipy.signal
 MODES = ("closed_loop", "plant_only")
 
@@ -68,7 +68,7 @@ def _params(items) -> dict:
 
 def _render(result: dict, html: str, pdf: str | None) -> None:
     try:
-        from ..report.render import render_validation_report
+        from compliance.report.render import render_validation_report
     except ImportError:
         raise InputError("report rendering not available yet") from None
     render_validation_report(result, html, pdf_path=pdf)
@@ -143,9 +143,9 @@ def format_summary(result: dict, max_windows: int = 30) -> str:
 
 
 def run(args) -> int:
-    from ..config import load_plant
-    from ..recordings import read_recording
-    from ..validation import apply_overrides, read_settings_table, settings_from_dict, validate
+    from compliance.model.config import load_plant
+    from compliance.recordings.reader import read_recording
+    from compliance.validation.validate import apply_overrides, read_settings_table, settings_from_dict, validate
 
     mode = args.mode.strip().replace("-", "_")
     if mode not in MODES + ("both",):

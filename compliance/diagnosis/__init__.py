@@ -24,15 +24,15 @@ __all__ = ["diagnose", "save_fitted", "Diagnosis", "diagnose_friction", "run_ben
 
 def __getattr__(name):  # lazy: importing the package does not compile the simulator
     if name in ("diagnose", "save_fitted", "Diagnosis"):
-        from . import engine
+        from compliance.diagnosis import engine
 
         return getattr(engine, name)
     if name == "diagnose_friction":
-        from .friction_diagnosis import diagnose_friction
+        from compliance.diagnosis.friction_diagnosis import diagnose_friction
 
         return diagnose_friction
     if name in ("run_benchmark", "run_practice"):
-        from . import benchmark
+        from compliance.diagnosis import benchmark
 
         return getattr(benchmark, name)
     raise AttributeError(name)

@@ -22,10 +22,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..config import PlantConfig
-from ..effects import EFFECTS
-from .candidates import FRICTION_LEVEL
-from .concealed import MISCALIBRATIONS, Case, effect_case, miscalibration_case, null_case
+from compliance.model.config import PlantConfig
+from compliance.effects import EFFECTS
+from compliance.diagnosis.candidates import FRICTION_LEVEL
+from compliance.diagnosis.concealed import MISCALIBRATIONS, Case, effect_case, miscalibration_case, null_case
 
 
 @dataclass
@@ -168,7 +168,7 @@ _BENCH: dict = {}
 def _init(cfg_text: str, library, diag_jobs: int) -> None:
     import tomllib
 
-    from ..config import plant_from_dict
+    from compliance.model.config import plant_from_dict
 
     _BENCH["cfg"] = plant_from_dict(tomllib.loads(cfg_text), "<benchmark plant>")
     _BENCH["library"] = library
@@ -176,9 +176,9 @@ def _init(cfg_text: str, library, diag_jobs: int) -> None:
 
 
 def _run_one(item) -> CaseResult:
-    from .engine import diagnose
+    from compliance.diagnosis.engine import diagnose
 
-    from ..errors import GovcheckError
+    from compliance.errors import GovcheckError
 
     kind, truth, seed = item
     cfg = _BENCH["cfg"]
@@ -213,7 +213,7 @@ def run_benchmark(cfg: PlantConfig, *, effects=None, cases: int = 3, seed: int =
     progress : callable, optional
         Called with each CaseResult as it completes.
     """
-    from ..config import plant_to_toml
+    from compliance.model.config import plant_to_toml
 
     effects = list(EFFECTS) if effects is None else list(effects)
     plan = case_plan(effects, cases, seed, null=null, miscalibrations=miscalibrations)
@@ -351,9 +351,9 @@ def run_practice(directory, cfg: PlantConfig, *, library=None, jobs: int = 1) ->
     import json
     from pathlib import Path
 
-    from ..errors import InputError
-    from ..recordings import read_recording
-    from .engine import diagnose
+    from compliance.errors import InputError
+    from compliance.recordings.reader import read_recording
+    from compliance.diagnosis.engine import diagnose
 
     folder = Path(directory)
     answers_path = folder / "ANSWERS.json"

@@ -2,7 +2,7 @@
 
 Every fitted quantity is a ``FitParam`` read from the one declaration it belongs to: effect
 parameters from ``compliance.effects`` (unit, bounds, log scale), base parameters from
-``compliance.parameters.BASE_PARAMS`` (``fit_bounds``). The diagnosis fits in a unit cube
+``compliance.model.parameters.BASE_PARAMS`` (``fit_bounds``). The diagnosis fits in a unit cube
 u in [0, 1] per parameter (log10 of the value when declared log-scaled).
 
 The coarse grids are the starting points of each effect's fit: a few physically spread
@@ -15,9 +15,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from ..config import PlantConfig
-from ..effects import EFFECTS
-from ..parameters import BASE_BY_KEY
+from compliance.model.config import PlantConfig
+from compliance.effects import EFFECTS
+from compliance.model.parameters import BASE_BY_KEY
 
 FRICTION_LEVEL = "friction.level"  # pseudo-parameter: one factor on static and Coulomb friction together
 # LuGre pre-sliding parameters: BASE_PARAMS declares no fit_bounds for them (reported to the lead);

@@ -25,11 +25,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..config import PlantConfig
-from ..effects import EFFECTS
-from ..errors import SimulationError
-from ..recording_synth import PRACTICE_NOISE, practice_profile, synthesise
-from ..simulate import Scenario, simulate
+from compliance.model.config import PlantConfig
+from compliance.effects import EFFECTS
+from compliance.errors import SimulationError
+from compliance.recordings.synth import PRACTICE_NOISE, practice_profile, synthesise
+from compliance.simulation import Scenario, simulate
 
 MAX_POSITION_RMS = 0.5e-3  # m; concealed: the position moves less than this (practice cases: 0.13-0.50 mm)
 MIN_PRESSURE_RMS = 3.0e3  # Pa; visible: ten times the pressure sensor noise (practice cases: 4-13 kPa)
@@ -148,7 +148,7 @@ def _record(cfg_truth: PlantConfig, op: dict, seed: int, description: str):
     bench recording starts after the servo has settled. So the test is simulated with a
     ``PRE_ROLL`` hold in front and the recording starts after it.
     """
-    from ..profiles import Profile
+    from compliance.simulation.profiles import Profile
 
     ref = practice_profile(op["x0"], cfg_truth.p("cylinder.stroke"))
     shifted = Profile(ref.times + PRE_ROLL, ref.values)
@@ -166,8 +166,8 @@ def _record(cfg_truth: PlantConfig, op: dict, seed: int, description: str):
 def replay_visibility(cfg: PlantConfig, frame, meta, truth: PlantConfig | None = None) -> dict:
     """What the recording shows the nominal model: normalised RMS of its re-synchronised replay per
     signal, and (with ``truth``) the chi-square ratio truth / nominal (how much the true model explains)."""
-    from .replay_fit import prepare_replay, replay_config, run_replay
-    from .residuals import build_residual_model, signal_fit
+    from compliance.diagnosis.replay_fit import prepare_replay, replay_config, run_replay
+    from compliance.diagnosis.residuals import build_residual_model, signal_fit
 
     setup = prepare_replay(cfg, frame, meta)
     rc = replay_config(cfg, setup)

@@ -6,7 +6,7 @@ docs/diagnosis-schema.md. The friction bench has its own chain (``friction_diagn
 
 Stages:
 1. nominal replay (re-synchronised segments, matched noise) and noise floors;
-2. located windows of the nominal residual and their regimes (compliance.locate);
+2. located windows of the nominal residual and their regimes (compliance.validation.locate);
 3. in parallel: the recalibration of base parameters (greedy forward selection) and one fit
    per effect (coarse grid, then bounded least squares), likely effects first;
 4. if the best single explanation leaves a clear excess and the recalibration found
@@ -28,17 +28,17 @@ from pathlib import Path
 
 import numpy as np
 
-from ..config import PlantConfig, plant_from_dict, plant_to_toml, save_plant
-from ..effects import EFFECTS
-from ..errors import InputError, SimulationError
-from .candidates import Candidate, apply, base_params, effect_candidate, expand_base, signature_order
-from .fit import FitContext, FitResult, fit_candidate, forward_select_base, least_squares_fit
-from .replay_fit import ReplaySetup, prepare_replay, replay_config, run_replay
-from .residuals import UNITS, build_residual_model, signal_fit, with_fail_level
-from .select import NOISE_TOLERANCE, score_all, verdict
-from .located import event_rms, locate_mismatch, mask_agreement, where_words
+from compliance.model.config import PlantConfig, plant_from_dict, plant_to_toml, save_plant
+from compliance.effects import EFFECTS
+from compliance.errors import InputError, SimulationError
+from compliance.diagnosis.candidates import Candidate, apply, base_params, effect_candidate, expand_base, signature_order
+from compliance.diagnosis.fit import FitContext, FitResult, fit_candidate, forward_select_base, least_squares_fit
+from compliance.diagnosis.replay_fit import ReplaySetup, prepare_replay, replay_config, run_replay
+from compliance.diagnosis.residuals import UNITS, build_residual_model, signal_fit, with_fail_level
+from compliance.diagnosis.select import NOISE_TOLERANCE, score_all, verdict
+from compliance.diagnosis.report_data import SCHEMA, diagnosis_to_dict
+from compliance.diagnosis.located import event_rms, locate_mismatch, mask_agreement, where_words
 
-SCHEMA = "govcheck-diagnosis/1"
 COMBINE_LEVEL = 3.0  # chi2/N of the best single explanation above which effects are refitted with the recalibration
 COMBINE_TOP = 1  # how many effects are refitted with the recalibration
 
@@ -76,7 +76,6 @@ class Diagnosis:
 
     def to_dict(self) -> dict:
         """The JSON document of docs/diagnosis-schema.md."""
-        from .report_data import diagnosis_to_dict
 
         return diagnosis_to_dict(self)
 
@@ -142,7 +141,7 @@ def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | N
     cfg : PlantConfig
         The nominal plant (effects already switched on in it stay on and are not candidates).
     frame : pandas.DataFrame
-        Canonical recording (``compliance.recordings.read_recording``).
+        Canonical recording (``compliance.recordings.reader.read_recording``).
     meta : dict
         Its metadata.
     effects : iterable of str, optional
@@ -168,7 +167,7 @@ def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | N
     names = [e for e in EFFECTS if e not in cfg.effects] if effects is None else list(effects)
     for e in names:
         if e not in EFFECTS:
-            from ..config import _suggest
+            from compliance.model.config import _suggest
 
             raise InputError(f"--effects: '{e}' is not a declared effect{_suggest(e, EFFECTS)} (known: {', '.join(EFFECTS)})")
     setup = prepare_replay(cfg, frame, meta)
@@ -186,7 +185,7 @@ def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | N
     fits: dict[str, FitResult] = {}
     vecs: dict[str, np.ndarray] = {}
     nvec = model.vector(nominal_sim)
-    from .fit import chi2_parts
+    from compliance.diagnosis.fit import chi2_parts
 
     chi2, parts = chi2_parts(model, nvec)
     fits["nominal"] = FitResult("nominal", (), [], [], chi2, parts, n, 0, 0.0, "nominal model")
@@ -259,7 +258,7 @@ def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | N
     )
     diag.agreement = agreement  # type: ignore[attr-defined]
     diag.located_regimes = where_words(events)  # type: ignore[attr-defined]
-    from .explain import explain
+    from compliance.diagnosis.explain import explain
 
     diag.explanation = explain(diag)
     diag.seconds = time.perf_counter() - t0

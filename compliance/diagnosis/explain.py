@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from ..effects import EFFECTS
-from .candidates import FRICTION_LEVEL
+from compliance.effects import EFFECTS
+from compliance.diagnosis.candidates import FRICTION_LEVEL
 
 # how each effect reads in words, with its main fitted value ({v} is filled in)
 PHYSICS = {

@@ -32,12 +32,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..config import PlantConfig
-from ..effects import EFFECTS
-from ..errors import InputError
-from .candidates import Candidate, FitParam, apply
-from .replay_fit import ReplaySetup
-from .residuals import ResidualModel, evaluate
+from compliance.model.config import PlantConfig
+from compliance.effects import EFFECTS
+from compliance.errors import InputError
+from compliance.diagnosis.candidates import Candidate, FitParam, apply
+from compliance.diagnosis.replay_fit import ReplaySetup
+from compliance.diagnosis.residuals import ResidualModel, evaluate
 
 DIFF_STEP = 0.01  # forward-difference step, 1 % of each parameter's (log) range
 MAX_NFEV = 6  # least-squares polishing evaluations (besides the Jacobian's)
@@ -337,7 +337,7 @@ def forward_select_base(ctx: FitContext, params: tuple[FitParam, ...], *, penalt
     (FitResult, list of dict)
         The recalibration (possibly with no parameters) and the log of each round.
     """
-    from .candidates import base_scan_values
+    from compliance.diagnosis.candidates import base_scan_values
 
     map_fn = map_fn or default_map
     t0 = time.perf_counter()

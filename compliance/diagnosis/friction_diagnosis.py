@@ -29,11 +29,13 @@ from pathlib import Path
 import numpy as np
 from scipy.signal import savgol_filter
 
-from ..errors import InputError
-from ..units import ATMOSPHERE_PA
-from .friction_fit import LAWS, PRESLIDING, PRESSURE_EFFECT, LawFit, fit_law, predict  # noqa: F401 - predict re-exported
-from .noise_floor import sensor_noise_std
-from .select import EXPLAINED_ENOUGH, NOISE_TOLERANCE, score_all
+from compliance.errors import InputError
+from compliance.units import ATMOSPHERE_PA
+from compliance.diagnosis.friction_fit import LAWS, PRESLIDING, PRESSURE_EFFECT, LawFit, fit_law, predict
+from compliance.diagnosis.friction_runs import Run
+from compliance.diagnosis.noise_floor import sensor_noise_std
+from compliance.diagnosis.report_data import SCHEMA
+from compliance.diagnosis.select import EXPLAINED_ENOUGH, NOISE_TOLERANCE, score_all
 
 REVERSAL_TRAVEL = 2e-3  # m of travel after a change of direction counted as "after reversal"
 VELOCITY_WINDOW = 0.05  # s; Savitzky-Golay (quadratic) derivative window of the position
@@ -50,28 +52,6 @@ MEANING = {
     "pressure_coefficient": "rise of F_C and F_S per Pa of chamber gauge pressure, k_p",
     "bristle_stiffness": "LuGre bristle stiffness sigma0 (pre-sliding distance = F_C/sigma0)",
 }
-
-
-@dataclass
-class Run:
-    """One prepared bench run."""
-
-    name: str
-    seal: str
-    time: np.ndarray
-    position: np.ndarray
-    velocity: np.ndarray
-    pressure_gauge: np.ndarray
-    friction: np.ndarray  # measured F - p_g * A [N] (friction plus bench bias)
-    after_reversal: np.ndarray
-    sliding: np.ndarray
-    floor: float  # force noise [N]
-    valid: np.ndarray  # samples whose velocity estimate is not smeared across a reversal
-
-    @property
-    def pressure(self) -> float:
-        """Mean gauge pressure [Pa]."""
-        return float(np.mean(self.pressure_gauge))
 
 
 def seal_name(path: str) -> str:
@@ -264,7 +244,7 @@ def diagnose_seal(runs: list[Run]) -> SealDiagnosis:
     rms_norm = math.sqrt(fits["baseline"].chi2 / n)
     cands = [k for k in fits if k != "baseline"]
     best = min(cands, key=lambda k: scores[k].bic, default=None)
-    from .select import MIN_GAIN, SIGNIFICANCE
+    from compliance.diagnosis.select import MIN_GAIN, SIGNIFICANCE
 
     verdict, winner = "unexplained", None
     if rms_norm <= NOISE_TOLERANCE:
@@ -286,7 +266,7 @@ def diagnose_seal(runs: list[Run]) -> SealDiagnosis:
 
 
 def _as_fit(f: LawFit):
-    from .fit import FitResult
+    from compliance.diagnosis.fit import FitResult
 
     return FitResult(f.name, tuple(range(f.k)), [], [], f.chi2, {}, f.n)
 
@@ -352,8 +332,6 @@ class FrictionDiagnosis:
 
     def to_dict(self) -> dict:
         """JSON document (docs/diagnosis-schema.md, ``kind = "friction"``)."""
-        from .engine import SCHEMA
-
         verdicts = [s.verdict for s in self.seals]
         overall = "missing_physics" if "missing_physics" in verdicts else ("unexplained" if "unexplained" in verdicts else "no_mismatch")
         return {"schema": SCHEMA, "kind": "friction", "recordings": self.files, "verdict": overall,

@@ -12,15 +12,13 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.optimize import least_squares
 
-from .friction_models import bias_force, friction_force
+from compliance.diagnosis.friction_models import bias_force, friction_force
+from compliance.diagnosis.friction_runs import Run
 
-if TYPE_CHECKING:  # the runs are prepared in friction_diagnosis, which imports this module
-    from .friction_diagnosis import Run
 
 MAX_NFEV = 40  # least-squares evaluations per candidate law (besides the Jacobian's)
 PRESSURE_EFFECT = "pressure_dependent_friction"

@@ -13,8 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
-from ..results_io import write_text_atomic
+from compliance.errors import InputError
+from compliance.files.atomic import write_text_atomic
 
 
 def _svg(fig) -> str:
@@ -31,7 +31,7 @@ def seal_figures(seal) -> list[tuple[str, str]]:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from .friction_diagnosis import predict
+    from compliance.diagnosis.friction_diagnosis import predict
 
     runs = seal.runs
     base = seal.fits["baseline"]

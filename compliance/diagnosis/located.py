@@ -1,6 +1,6 @@
 """Where the nominal model misses: located windows and their operating regimes.
 
-A thin adapter over ``compliance.locate`` and ``compliance.regimes`` (the same windows
+A thin adapter over ``compliance.validation.locate`` and ``compliance.validation.regimes`` (the same windows
 ``govcheck validate`` shows), applied to the diagnosis' re-synchronised nominal replay. It
 returns the merged events (one per stretch of misfit, with the signals involved and the
 dominant regimes), a sample mask of where they are, and the before/after agreement per event.
@@ -11,10 +11,10 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..config import PlantConfig
-from ..locate import LocateSettings, locate, merge_across_signals
-from ..regimes import compute_regimes
-from ..validation_metrics import per_unit_bases
+from compliance.model.config import PlantConfig
+from compliance.validation.locate import LocateSettings, locate, merge_across_signals
+from compliance.validation.regimes import compute_regimes
+from compliance.validation.fit_metrics import per_unit_bases
 
 REGIME_WORDS = {
     "holding_under_load": "while the servo holds its load",

@@ -10,7 +10,7 @@ Two devices make the replay residual a good objective for fitting:
    recorded valve command carries the sensor noise through K_P and the filtered derivative
    K_D. The recording's position noise is estimated as what a Savitzky-Golay smoother leaves,
    n_hat = x_meas - S x_meas, and added to the model's measured position, so the replayed
-   controller sees the noise the real one saw (``compliance.replay`` does the same). On the
+   controller sees the noise the real one saw (``compliance.validation.replay`` does the same). On the
    practice no-effect recording the command residual falls from ~0.15 V to ~0.015 V.
 2. Re-synchronisation (multiple shooting, Bock & Plitt 1984). A servo with a dead zone and
    stiction decides where it stalls on tiny differences, so one long replay of a slightly
@@ -33,12 +33,13 @@ import numpy as np
 import pandas as pd
 from scipy.signal import savgol_filter
 
-from ..config import PlantConfig
-from ..errors import InputError, SimulationError
-from ..layout import P_KI, P_KP, P_SD_ON, P_STROKE, S_PSUP, S_TA, S_TB, S_V, S_V2
-from ..plant import initial_state, load_curve_arrays, parameter_vector, set_rest_internal_states
-from ..simulate import N_OUT, OUTPUT_COLUMNS, simulate_core
-from .noise_floor import position_noise_estimate
+from compliance.model.config import PlantConfig
+from compliance.errors import InputError, SimulationError
+from compliance.model.vector_slots import P_KI, P_KP, P_SD_ON, P_STROKE, S_PSUP, S_TA, S_TB, S_V, S_V2
+from compliance.model.assembly import initial_state, load_curve_arrays, parameter_vector, set_rest_internal_states
+from compliance.simulation.rk4 import N_OUT, OUTPUT_COLUMNS
+from compliance.simulation.pid_loop import simulate_core
+from compliance.diagnosis.noise_floor import position_noise_estimate
 
 SIGNALS = ("position", "pressure_a", "pressure_b", "valve_command", "supply_pressure")
 _OUT = {name: i for i, name in enumerate(OUTPUT_COLUMNS)}
@@ -152,7 +153,7 @@ def prepare_replay(cfg: PlantConfig, frame: pd.DataFrame, meta: dict, *, inject_
                    segmented: bool = True, max_segment: float = MAX_SEGMENT) -> ReplaySetup:
     """Build the replay of a recording on a plant configuration.
 
-    Conditions follow ``compliance.replay`` (sidecar controller gains and supply pressure
+    Conditions follow ``compliance.validation.replay`` (sidecar controller gains and supply pressure
     override the configuration; load from ``conditions.load_force``; initial position and
     pressures from the first 50 ms), so ``govcheck validate`` and the diagnosis replay the same test.
 
@@ -176,7 +177,7 @@ def prepare_replay(cfg: PlantConfig, frame: pd.DataFrame, meta: dict, *, inject_
     InputError
         Missing columns, a time base the controller clock cannot follow.
     """
-    from ..replay import initial_conditions, load_from_metadata, on_controller_clock, replay_config as _overrides_of
+    from compliance.validation.replay import initial_conditions, load_from_metadata, on_controller_clock, replay_config as _overrides_of
 
     src = str(meta.get("source_path", "<recording>"))
     for col in ("time", "position", "valve_command"):

@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import math
 
-from ..effects import EFFECTS
-from ..parameters import BASE_BY_KEY
-from .candidates import FRICTION_LEVEL
-from .residuals import UNITS
+from compliance.effects import EFFECTS
+from compliance.model.parameters import BASE_BY_KEY
+from compliance.diagnosis.candidates import FRICTION_LEVEL
+from compliance.diagnosis.residuals import UNITS
+
+SCHEMA = "govcheck-diagnosis/1"  # docs/diagnosis-schema.md
 
 
 def _num(x):
@@ -55,8 +57,6 @@ def _fit_table(fit: dict | None) -> dict | None:
 
 def diagnosis_to_dict(d) -> dict:
     """Serialise a ``engine.Diagnosis`` (see docs/diagnosis-schema.md)."""
-    from .engine import SCHEMA
-
     ranked = d.ranked()
     agreement = getattr(d, "agreement", {})
     effects = []

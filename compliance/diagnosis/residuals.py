@@ -15,10 +15,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..config import PlantConfig
-from ..errors import InputError, SimulationError
-from .noise_floor import sensor_noise_std
-from .replay_fit import ReplaySetup, run_replay
+from compliance.model.config import PlantConfig
+from compliance.errors import InputError, SimulationError
+from compliance.diagnosis.noise_floor import sensor_noise_std
+from compliance.diagnosis.replay_fit import ReplaySetup, run_replay
 
 # lowest floors we accept (instrument resolution a logger rarely beats): keeps one signal from
 # dominating when its noise estimate comes out implausibly small
@@ -94,8 +94,8 @@ def compared_signals(setup: ReplaySetup) -> tuple[str, ...]:
 
 
 def _quantum(values: np.ndarray) -> float:
-    """Quantisation step of a recorded signal (0 when it is not on a grid); see compliance.replay."""
-    from ..replay import position_quantum
+    """Quantisation step of a recorded signal (0 when it is not on a grid); see compliance.validation.replay."""
+    from compliance.validation.replay import position_quantum
 
     return position_quantum(values)
 
@@ -117,9 +117,9 @@ def null_replay_errors(cfg: PlantConfig, setup: ReplaySetup, sensor: dict, seed:
     """
     import pandas as pd
 
-    from ..profiles import Profile
-    from ..simulate import Scenario, SensorNoise, simulate
-    from .replay_fit import prepare_replay
+    from compliance.simulation.profiles import Profile
+    from compliance.simulation import Scenario, SensorNoise, simulate
+    from compliance.diagnosis.replay_fit import prepare_replay
 
     rec = setup.recorded
     noise = SensorNoise(

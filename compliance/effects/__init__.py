@@ -7,8 +7,8 @@ switched on in a configuration with an ``[effects.NAME]`` table.
 
 from __future__ import annotations
 
-from .base import Effect, Lumped, Param
-from .catalogue import ALL_EFFECTS
+from compliance.effects.base import Effect, Lumped, Param
+from compliance.effects.catalogue import ALL_EFFECTS
 
 EFFECTS: dict[str, Effect] = {e.name: e for e in ALL_EFFECTS}
 

@@ -1,4 +1,4 @@
-"""The effect library (names fixed by issue 6; equations in compliance/plant.py cite their sources).
+"""The effect library (names fixed by issue 6; equations in compliance/model/assembly.py cite their sources).
 
 Bounds are physical ranges cut where the pinned RK4 step (1 ms for plant A) would go unstable:
 the fastest eigenvalue of each effect times the step stays below ~2 (RK4's limit is 2.8), e.g.
@@ -10,7 +10,7 @@ the steepest segment of the sheet's load curve is 1.25e5 N/m.
 
 from __future__ import annotations
 
-from .base import Effect, Lumped, Param
+from compliance.effects.base import Effect, Lumped, Param
 
 HEAT_TRANSFER = Effect(
     name="heat_transfer",

@@ -4,6 +4,6 @@
 ``render_validation_report(result, html_path, pdf_path=None)``; see docs/report.md.
 """
 
-from .render import render_report, render_validation_report
+from compliance.report.render import render_report, render_validation_report
 
 __all__ = ["render_report", "render_validation_report"]

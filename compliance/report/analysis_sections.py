@@ -2,15 +2,15 @@
 
 Linear data is the document ``govcheck linear --json`` writes (schema ``govcheck-linear/1``:
 ``analysis`` or ``analyses``, ``map``, ``crosscheck``, ``governor``), found in a results dict
-under ``linear``. Validation data is ``compliance.validation.validate`` output (schema
+under ``linear``. Validation data is ``compliance.validation.validate.validate`` output (schema
 ``govcheck.validation/1``), optionally with a ``diagnosis`` entry (``after`` overlays and the
 physics added with its fitted parameters). Missing parts are reported as "not run".
 """
 
 from __future__ import annotations
 
-from .content import fmt_num, pretty_unit
-from .figures_linear import MAP_QUANTITIES
+from compliance.report.content import fmt_num, pretty_unit
+from compliance.report.figures_linear import MAP_QUANTITIES
 
 SIGNAL_DISPLAY = {  # signal -> (label, unit shown, scale from SI)
     "position": ("position", "mm", 1e3),

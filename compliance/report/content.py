@@ -13,8 +13,8 @@ import hashlib
 import math
 import shlex
 
-from ..errors import InputError
-from ..metrics import METRICS
+from compliance.errors import InputError
+from compliance.metrics import METRICS
 
 RESULTS_SCHEMA = "govcheck-results/1"
 STATUS_WORD = {"pass": "PASS", "fail": "FAIL", "not_evaluated": "NOT EVALUATED", "open": "OPEN",

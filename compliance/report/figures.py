@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from .svg import COLORS, message_axes, new_figure, styled, to_svg
+from compliance.report.svg import COLORS, message_axes, new_figure, styled, to_svg
 
 MM = 1e3  # [m] -> [mm] for display
 BAR = 1e-5  # [Pa] -> [bar] for display
@@ -82,7 +82,7 @@ def trace_figure(trace: dict, marks: list, kind: str, prefix: str, *, tolerance=
         ``time`` [s], ``position``/``reference`` [m], ``valve_command`` [V],
         ``pressure_a``/``pressure_b`` [Pa abs] lists (any but time may be missing).
     marks : list of dict
-        Marks of this run (``type`` and ``value`` as written by ``compliance.procedures``):
+        Marks of this run (``type`` and ``value`` as written by ``compliance.procedures.registry``):
         ``tau_632`` [t, x], ``settled`` [t, x], ``band`` [lo, hi], ``final_window`` [t0, t1],
         ``motion_start`` [t, x], ``tracking_window``/``hold_window`` [t0, t1],
         ``stroke_points`` [[t, x], [t, x]].

@@ -1,7 +1,7 @@
 """Report figures of the linear analysis: operating maps, Bode diagrams, pole maps.
 
-Inputs are the plain-JSON forms written by ``compliance.linear`` (``LinearAnalysis.to_dict``)
-and ``compliance.linear_maps`` (``OperatingMap.to_dict``), in SI units (s, Hz, dB, deg, m, N).
+Inputs are the plain-JSON forms written by ``compliance.linear.analysis`` (``LinearAnalysis.to_dict``)
+and ``compliance.linear.maps`` (``OperatingMap.to_dict``), in SI units (s, Hz, dB, deg, m, N).
 """
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.colors import ListedColormap
 
-from .svg import COLORS, message_axes, new_figure, plain, styled, to_svg
+from compliance.report.svg import COLORS, message_axes, new_figure, plain, styled, to_svg
 
 MAP_QUANTITIES = {  # name -> (label, unit, display scale, requirement-window key or None)
     "time_constant": ("time constant", "ms", 1e3, "window"),

@@ -24,10 +24,10 @@ from pathlib import Path
 
 import jinja2
 
-from .. import __version__
-from ..errors import InputError
-from . import content as C
-from .analysis_sections import linear_section, validation_section
+from compliance import __version__
+from compliance.errors import InputError
+from compliance.report import content as C
+from compliance.report.analysis_sections import linear_section, validation_section
 
 TEMPLATES = resources.files("compliance.report") / "templates"
 VALIDATION_SCHEMA = "govcheck.validation/1"
@@ -36,11 +36,11 @@ _FIG_CTX: dict = {}  # figure specs, set before worker processes fork (no pickli
 
 # --------------------------------------------------------------------------- figures
 def _draw(spec: dict, valve: dict | None = None) -> str:
-    from . import figures, figures_linear
+    from compliance.report import figures, figures_linear
 
     k = spec["kind"]
     if k == "trace" and spec["trace"].get("kind") == "path3d":
-        from ..tracking.figures import path_figure  # plant B's 3-D path overlay and per-axis errors
+        from compliance.report.figures_tracking import path_figure  # plant B's 3-D path overlay and per-axis errors
 
         return path_figure(spec["trace"], spec["id"])
     if k == "trace":
@@ -248,9 +248,9 @@ def render_report(results: dict, html_path=None, pdf_path=None, *, workers: int 
     Parameters
     ----------
     results : dict
-        Results of ``compliance.harness.run_campaign`` (schema ``govcheck-results/1``,
+        Results of ``compliance.campaign.run.run_campaign`` (schema ``govcheck-results/1``,
         docs/results-schema.md), optionally with ``linear`` (``govcheck linear --json``) and
-        ``validation`` (``compliance.validation.validate``) entries.
+        ``validation`` (``compliance.validation.validate.validate``) entries.
     html_path, pdf_path : path, optional
         Where to write the HTML and the PDF; at least one.
     workers : int, optional
@@ -293,7 +293,7 @@ def render_validation_report(result: dict, html_path, pdf_path=None, *, workers:
     Parameters
     ----------
     result : dict
-        ``compliance.validation.validate`` output (schema ``govcheck.validation/1``), optionally
+        ``compliance.validation.validate.validate`` output (schema ``govcheck.validation/1``), optionally
         with ``diagnosis`` (``after``: a validation result of the model with the physics added;
         ``added``: effects with fitted parameters; ``explanation``: text).
     html_path : path

@@ -25,7 +25,7 @@ from pathlib import Path as _FsPath
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from ..errors import InputError
+from compliance.errors import InputError
 
 GRID_SPACING = 2e-4  # m: arc-length grid of the time parameterisation (0.2 mm)
 CORNER_ANGLE = math.radians(20.0)  # a polyline turning more than this at a point stops there

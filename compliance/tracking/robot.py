@@ -19,11 +19,11 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from ..config import PlantConfig
-from ..errors import InputError
-from .controller import controller_vector
-from .paths import AXES, Trajectory
-from .simulate_tracking import AxisReference, simulate_axis
+from compliance.model.config import PlantConfig
+from compliance.errors import InputError
+from compliance.model.state_feedback import controller_vector
+from compliance.tracking.paths import AXES, Trajectory
+from compliance.simulation.state_feedback_loop import AxisReference, simulate_axis
 
 FRAME_MASS = 1.5  # kg, barrel + guide + brackets of one axis (assumed)
 GRAVITY = 9.81  # m/s^2

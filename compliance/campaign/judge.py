@@ -1,0 +1,160 @@
+"""Judging a campaign: every requirement x procedure x operating point becomes a verdict row.
+
+A run offers candidate values (``Sample``) of each metric; the row keeps the worst eligible
+one against the limit (``compliance.requirements.verdict``), or, for an open limit (the purchaser's
+data-sheet value), the least favourable value with no verdict. A requirement's status
+combines its rows. Values are also formatted in each metric's display unit for tables.
+"""
+
+from __future__ import annotations
+
+from compliance.campaign.plan import Job
+from compliance.requirements.tightening import check_tightening
+from compliance.linear.requirement_values import linear_value
+from compliance.metrics.catalogue import METRICS
+from compliance.requirements.requirement_set import RequirementSet
+from compliance.procedures.outcomes import Sample, request_key
+from compliance.requirements.verdict import DISABLED, NOT_EVALUATED, OPEN, Verdict, evaluate, requirement_status, worst_index
+
+__all__ = ["fmt", "judge", "sample_dict"]
+
+# keys of the worst row copied into a requirement's entry
+_WORST_KEYS = ("run", "procedure", "operating_point", "value", "margin", "margin_pct", "status", "which", "display")
+
+
+def fmt(value, metric: str, digits: int = 3) -> str:
+    """Display a SI value of ``metric`` in its display unit (``0.0016`` m -> ``'1.60 mm'``)."""
+    if value is None:
+        return "-"
+    info = METRICS[metric]
+    v = value * info.display_scale
+    if abs(v) < 1e-9:  # numerical zero (a body at rest in stiction), not a measurement
+        v = 0.0
+    text = f"{v:.0f}" if abs(v) >= 10 ** digits else f"{v:#.{digits}g}".rstrip(".")
+    return f"{text} {info.display_unit}"
+
+
+def sample_dict(s: Sample, metric: str) -> dict:
+    """Plain-JSON form of one candidate value, with its display text."""
+    return {"label": s.label, "value": s.value, "display": fmt(s.value, metric), "eligible": s.eligible,
+            "reason": s.reason, "detail": s.detail}
+
+
+def _least_favourable(comparator: str, items, value):
+    """The item whose value is worst under ``comparator``: the smallest for >= / >, else the largest."""
+    return (min if comparator in (">=", ">") else max)(items, key=value)
+
+
+def _open_pick(comparator: str, samples: list[Sample]):
+    vals = [s for s in samples if s.eligible and s.value is not None]
+    if not vals:
+        return None
+    return _least_favourable(comparator, vals, lambda s: s.value)
+
+
+def _row(req, proc: str, op: str, limit, samples, error: str | None) -> dict:
+    base = {"procedure": proc, "operating_point": op, "run": f"{proc}@{op}"}
+    if error:
+        v = Verdict(None, req.comparator, limit or (), None, None, NOT_EVALUATED, error)
+        return {**base, **v.as_dict(), "which": None, "samples": []}
+    samples = samples or []
+    shown = [sample_dict(s, req.metric) for s in samples]
+    usable = [s for s in samples if s.eligible and s.value is not None]
+    if req.limit is None:
+        pick = _open_pick(req.comparator, samples)
+        return {**base, "value": pick.value if pick else None, "comparator": req.comparator, "limit": None,
+                "margin": None, "margin_pct": None, "status": OPEN,
+                "reason": None if pick else _why(samples), "which": pick.label if pick else None,
+                "samples": shown}
+    if not usable:
+        v = Verdict(None, req.comparator, limit, None, None, NOT_EVALUATED, _why(samples))
+        return {**base, **v.as_dict(), "which": None, "samples": shown}
+    verdicts = [evaluate(s.value, req.comparator, limit) for s in usable]
+    w = worst_index(verdicts)
+    return {**base, **verdicts[w].as_dict(), "which": usable[w].label, "samples": shown}
+
+
+def _why(samples) -> str:
+    reasons = sorted({s.reason for s in samples if s.reason})
+    return "; ".join(reasons) if reasons else "no sample of this metric in the run"
+
+
+def _display_row(row: dict, metric: str) -> dict:
+    return {
+        "value": fmt(row.get("value"), metric),
+        "limit": None if not row.get("limit") else " .. ".join(fmt(v, metric) for v in row["limit"]),
+        "margin": fmt(row.get("margin"), metric),
+        "margin_pct": None if row.get("margin_pct") is None else f"{row['margin_pct']:+.1f} %",
+    }
+
+
+def _row_verdict(req, r: dict) -> Verdict:
+    return Verdict(r["value"], req.comparator, tuple(r["limit"] or ()), r["margin"], r["margin_pct"], r["status"], r["reason"])
+
+
+def _rows(cfg, reqset: RequirementSet, req, limit, by_key: dict) -> list[dict]:
+    """Verdict rows of an enabled requirement: one per operating point (linear) or per run."""
+    rows = []
+    if req.source == "linear":
+        for o in req.operating_points:
+            val, why = linear_value(cfg, req.metric, reqset.operating_points[o])
+            s = [Sample(val, "linearised model", why)]
+            rows.append(_row(req, "linear", o, limit, s, None))
+    else:
+        key = request_key(req.metric, req.options)
+        for p in req.procedures:
+            for o in req.operating_points:
+                out = by_key[f"{p}@{o}"]
+                rows.append(_row(req, p, o, limit, out.samples.get(key), out.error))
+    return rows
+
+
+def judge(cfg, reqset: RequirementSet, jobs: list[Job], outcomes) -> tuple[list[dict], list[str]]:
+    """Verdict entries per requirement (docs/results-schema.md, ``requirements_results``)."""
+    stroke = cfg.p("cylinder.stroke")
+    by_key = {j.key: o for j, o in zip(jobs, outcomes)}
+    entries, notes = [], []
+    for req in reqset.requirements:
+        loosen = check_tightening(req, stroke)
+        notes.extend(loosen)
+        limit = req.resolved_limit(stroke) if req.limit is not None else None
+        rows = _rows(cfg, reqset, req, limit, by_key) if req.enabled else []
+        for r in rows:
+            r["display"] = _display_row(r, req.metric)
+        verdicts = [_row_verdict(req, r) for r in rows] if req.limit is not None else []
+        if not req.enabled:
+            status = DISABLED
+        elif req.limit is None:
+            status = OPEN
+        else:
+            status = requirement_status(verdicts)
+        worst = None
+        if rows and req.limit is not None:
+            wi = worst_index(verdicts)
+            worst = None if wi is None else rows[wi]
+        elif rows:
+            vals = [r for r in rows if r["value"] is not None]
+            if vals:
+                worst = _least_favourable(req.comparator, vals, lambda r: r["value"])
+        entries.append({
+            "id": req.id,
+            "title": req.title,
+            "standard": req.standard,
+            "clause": req.clause,
+            "metric": req.metric,
+            "unit": METRICS[req.metric].si_unit,
+            "display_unit": METRICS[req.metric].display_unit,
+            "comparator": req.comparator,
+            "limit": list(limit) if limit is not None else None,
+            "limit_text": req.limit_text,
+            "limit_display": None if limit is None else (
+                ("within " if req.comparator == "within" else req.comparator + " ") + " .. ".join(fmt(v, req.metric) for v in limit)),
+            "severity": req.severity,
+            "source": req.source,
+            "status": status,
+            "worst": None if worst is None else {k: worst[k] for k in _WORST_KEYS},
+            "rows": rows,
+            "note": req.note,
+            "loosened": loosen,
+        })
+    return entries, notes

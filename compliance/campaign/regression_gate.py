@@ -1,0 +1,138 @@
+"""Regression gate: compare a candidate's results with a baseline's, requirement by requirement.
+
+The gate trips when
+- a requirement that passed in the baseline does not pass in the candidate (fail, or no
+  longer evaluated: a check that silently stops running must not look like a pass),
+- a requirement present in the baseline is missing from the candidate,
+- a requirement new in the candidate fails,
+- a requirement's worst-case margin shrinks by more than ``max_margin_loss`` percentage
+  points (margins in % of the binding limit, docs/metrics.md), when the user sets it.
+A requirement already failing in the baseline is reported, not counted as a regression.
+"""
+
+from __future__ import annotations
+
+from compliance.campaign.results_files import _STATUS_WORD
+
+
+def _worst(entry: dict | None):
+    if entry is None:
+        return None, None, "-"
+    w = entry.get("worst") or {}
+    return w.get("margin_pct"), w.get("value"), (w.get("display") or {}).get("value", "-")
+
+
+def compare(baseline: dict, candidate: dict, max_margin_loss: float | None = None) -> dict:
+    """Compare two results dicts.
+
+    Parameters
+    ----------
+    baseline, candidate : dict
+        Results of ``govcheck check`` (schema govcheck-results/1).
+    max_margin_loss : float, optional
+        Largest allowed loss of worst-case margin [percentage points]; None: not checked.
+
+    Returns
+    -------
+    dict
+        ``{"status": "pass"|"fail", "tripped": [...ids], "rows": [...], "notes": [...], ...}``
+    """
+    base = {e["id"]: e for e in baseline["requirements"]}
+    cand = {e["id"]: e for e in candidate["requirements"]}
+    rows, tripped, notes = [], [], []
+    bset, cset = baseline["requirement_set"], candidate["requirement_set"]
+    if bset.get("digest") != cset.get("digest"):
+        notes.append(f"requirement files differ: baseline {bset.get('name')} ({str(bset.get('digest'))[:12]}), "
+                     f"candidate {cset.get('name')} ({str(cset.get('digest'))[:12]})")
+    for rid in list(base) + [k for k in cand if k not in base]:
+        b, c = base.get(rid), cand.get(rid)
+        bm, bv, bd = _worst(b)
+        cm, cv, cd = _worst(c)
+        bs = b["status"] if b else "absent"
+        cs = c["status"] if c else "absent"
+        delta = None if bm is None or cm is None else cm - bm
+        reasons = []
+        if b is not None and c is None:
+            reasons.append("requirement removed in the candidate")
+        elif b is None and cs == "fail":
+            reasons.append("new requirement fails")
+        elif bs == "pass" and cs != "pass":
+            reasons.append(f"{bs} -> {cs}")
+        if max_margin_loss is not None and delta is not None and -delta > max_margin_loss:
+            reasons.append(f"margin lost {-delta:.1f} pp > {max_margin_loss:g} pp allowed")
+        if reasons:
+            tripped.append(rid)
+        ref = c or b
+        rows.append({
+            "id": rid,
+            "title": ref["title"],
+            "metric": ref["metric"],
+            "limit_text": ref["limit_text"],
+            "severity": ref["severity"],
+            "baseline": {"status": bs, "value": bv, "display": bd, "margin_pct": bm},
+            "candidate": {"status": cs, "value": cv, "display": cd, "margin_pct": cm},
+            "margin_change_pp": delta,
+            "tripped": bool(reasons),
+            "reasons": reasons,
+            "preexisting_failure": bs == "fail" and cs == "fail",
+        })
+    return {
+        "schema": "govcheck-gate/1",
+        "status": "fail" if tripped else "pass",
+        "tripped": tripped,
+        "max_margin_loss": max_margin_loss,
+        "baseline": {"plant": baseline["plant"]["name"], "digest": baseline["plant"].get("digest"),
+                     "path": baseline["plant"].get("path"), "verdict": baseline["summary"]["status"]},
+        "candidate": {"plant": candidate["plant"]["name"], "digest": candidate["plant"].get("digest"),
+                      "path": candidate["plant"].get("path"), "verdict": candidate["summary"]["status"]},
+        "requirements": {"name": cset.get("name"), "path": cset.get("path"), "digest": cset.get("digest")},
+        "rows": rows,
+        "notes": notes,
+    }
+
+
+def _cell(side: dict) -> str:
+    word = _STATUS_WORD.get(side["status"], side["status"].upper())
+    m = "" if side["margin_pct"] is None else f" ({side['margin_pct']:+.1f} %)"
+    return f"{word} {side['display']}{m}" if side["display"] not in (None, "-") else word
+
+
+def gate_table(result: dict) -> str:
+    """Side-by-side terminal table of a gate result."""
+    head = ("requirement", "limit", "baseline", "candidate", "margin change", "gate")
+    rows = []
+    for r in result["rows"]:
+        d = "-" if r["margin_change_pp"] is None else f"{r['margin_change_pp']:+.1f} pp"
+        g = "TRIPPED: " + "; ".join(r["reasons"]) if r["tripped"] else ("still failing" if r["preexisting_failure"] else "ok")
+        rows.append((r["id"], r["limit_text"], _cell(r["baseline"]), _cell(r["candidate"]), d, g))
+    widths = [max(len(str(x[i])) for x in rows + [head]) for i in range(len(head))]
+    line = lambda x: "  ".join(str(c).ljust(widths[i]) for i, c in enumerate(x)).rstrip()  # noqa: E731
+    out = [line(head), line(tuple("-" * w for w in widths))] + [line(x) for x in rows]
+    out += [""] + [f"note: {n}" for n in result["notes"]]
+    out.append(f"GATE: {result['status'].upper()}" + (f" ({len(result['tripped'])} regression(s): {', '.join(result['tripped'])})" if result["tripped"] else ""))
+    return "\n".join(out) + "\n"
+
+
+def gate_markdown(result: dict) -> str:
+    """Markdown summary fit for a pull-request comment."""
+    ok = result["status"] == "pass"
+    b, c = result["baseline"], result["candidate"]
+    lines = [
+        f"### govcheck gate: {'passed' if ok else 'FAILED'}"
+        + ("" if ok else f" - {len(result['tripped'])} regression(s)"),
+        "",
+        f"- baseline: `{b['plant']}` (`{str(b['digest'])[:12]}`), verdict **{b['verdict']}**",
+        f"- candidate: `{c['plant']}` (`{str(c['digest'])[:12]}`), verdict **{c['verdict']}**",
+        f"- requirements: `{result['requirements']['name']}` (`{str(result['requirements']['digest'])[:12]}`)",
+        "- margin-loss threshold: " + ("not set" if result["max_margin_loss"] is None else f"{result['max_margin_loss']:g} percentage points"),
+        "",
+        "| requirement | limit | baseline | candidate | margin change | gate |",
+        "|---|---|---|---|---|---|",
+    ]
+    for r in result["rows"]:
+        d = "-" if r["margin_change_pp"] is None else f"{r['margin_change_pp']:+.1f} pp"
+        g = "**tripped**: " + "; ".join(r["reasons"]) if r["tripped"] else ("still failing" if r["preexisting_failure"] else "ok")
+        lines.append(f"| `{r['id']}` {r['title']} | {r['limit_text']} | {_cell(r['baseline'])} | {_cell(r['candidate'])} | {d} | {g} |")
+    for n in result["notes"]:
+        lines += ["", f"> note: {n}"]
+    return "\n".join(lines).replace("|  |", "| - |") + "\n"

@@ -1,0 +1,180 @@
+"""Writers and readers of results: JSON (versioned schema), JUnit XML, terminal table, Markdown.
+
+Every file is written atomically (a temporary file in the target folder, then ``os.replace``)
+so a CI job never reads half a file.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from pathlib import Path
+from xml.sax.saxutils import escape, quoteattr
+
+from compliance.errors import InputError
+from compliance.files.atomic import write_text_atomic
+
+RESULTS_SCHEMA = "govcheck-results/1"
+_STATUS_WORD = {"pass": "PASS", "fail": "FAIL", "not_evaluated": "NOT EVALUATED", "open": "OPEN", "disabled": "DISABLED"}
+
+
+def _plain(obj):
+    """JSON default: numpy scalars/arrays to Python; non-finite floats to None."""
+    import numpy as np
+
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    raise TypeError(f"not JSON serialisable: {type(obj).__name__}")
+
+
+def _finite(obj):
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    if isinstance(obj, dict):
+        return {k: _finite(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_finite(v) for v in obj]
+    return obj
+
+
+def results_json(results: dict) -> str:
+    """Serialise a results dict (non-finite numbers become null)."""
+    # compact: the traces make up most of the file; tools, not people, read it
+    return json.dumps(_finite(json.loads(json.dumps(results, default=_plain))), separators=(",", ":"), allow_nan=False) + "\n"
+
+
+def write_json(results: dict, path) -> None:
+    """Write the results JSON atomically."""
+    write_text_atomic(path, results_json(results))
+
+
+def read_results(path) -> dict:
+    """Read a results JSON written by ``govcheck check``.
+
+    Raises
+    ------
+    InputError
+        Not JSON, or not a govcheck results file of a supported schema.
+    """
+    p = Path(path)
+    try:
+        data = json.loads(p.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise InputError(f"{p}: results file not found") from None
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise InputError(f"{p}: not a JSON results file ({exc.__class__.__name__}: {exc})") from None
+    if not isinstance(data, dict) or "schema" not in data:
+        raise InputError(f"{p}: schema: missing; expected a govcheck results file ('{RESULTS_SCHEMA}')")
+    if data["schema"] != RESULTS_SCHEMA:
+        raise InputError(f"{p}: schema: '{data['schema']}' is not supported (expected '{RESULTS_SCHEMA}')")
+    for key in ("requirements", "summary", "plant", "requirement_set"):
+        if key not in data:
+            raise InputError(f"{p}: {key}: missing from the results file")
+    return data
+
+
+# --------------------------------------------------------------------------- terminal
+def summary_table(results: dict) -> str:
+    """Fixed-width table: one line per requirement with its worst case, then the verdict."""
+    head = ("requirement", "metric", "limit", "worst value", "margin", "worst case", "severity", "status")
+    rows = []
+    for e in results["requirements"]:
+        w = e.get("worst") or {}
+        d = w.get("display") or {}
+        margin = "-"
+        if d.get("margin_pct"):
+            margin = d["margin_pct"]
+        elif w.get("margin") is not None:
+            margin = d.get("margin", "-")
+        where = w.get("run") or "-"
+        if w.get("which"):
+            where += f" ({w['which']})"
+        limit = e["limit_text"]
+        if "stroke" in limit and e.get("limit_display"):
+            limit += f" ({e['limit_display'].split(' ', 1)[1]})"
+        rows.append((e["id"], e["metric"], limit, d.get("value", "-"), margin, where, e["severity"],
+                     _STATUS_WORD.get(e["status"], e["status"])))
+    widths = [max(len(str(r[i])) for r in rows + [head]) for i in range(len(head))]
+    widths[5] = min(widths[5], 62)
+
+    def line(r):
+        cells = [str(c) if i != 5 else (str(c) if len(str(c)) <= widths[5] else str(c)[: widths[5] - 1] + "~") for i, c in enumerate(r)]
+        return "  ".join(c.ljust(widths[i]) for i, c in enumerate(cells)).rstrip()
+
+    out = [line(head), line(tuple("-" * w for w in widths))] + [line(r) for r in rows]
+    s = results["summary"]
+    out.append("")
+    out.append(f"plant {results['plant']['name']} ({results['plant'].get('path')}) against "
+               f"{results['requirement_set']['name']} ({results['requirement_set']['path']})")
+    c = s["counts"]
+    out.append(f"{c['pass']} pass, {c['fail']} fail, {c['not_evaluated']} not evaluated, {c['open']} open (no limit set), "
+               f"{c['disabled']} disabled")
+    for e in results["requirements"]:
+        if e["status"] == "not_evaluated":
+            reasons = sorted({r["reason"] for r in e["rows"] if r.get("reason")})
+            out.append(f"  not evaluated {e['id']}: {'; '.join(reasons)[:200]}")
+    for n in s.get("notes", []):
+        out.append(f"  {n}")
+    out.append(f"VERDICT: {s['status'].upper()}"
+               + (f" (mandatory failures: {', '.join(s['failed_mandatory'])})" if s.get("failed_mandatory") else ""))
+    return "\n".join(out) + "\n"
+
+
+# --------------------------------------------------------------------------- JUnit
+def junit_xml(results: dict) -> str:
+    """JUnit XML: one testsuite per requirement, one testcase per procedure x operating point.
+
+    fail -> <failure>, not evaluated -> <error> for a mandatory requirement (the check could not
+    be made) and <skipped> for an advisory one, open (no limit) -> <skipped>.
+    """
+    suites = []
+    tot = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0}
+    for e in results["requirements"]:
+        cases = []
+        cnt = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0}
+        rows = e["rows"] or [{"run": e["id"], "status": e["status"], "reason": e["status"], "display": {}}]
+        for r in rows:
+            cnt["tests"] += 1
+            d = r.get("display") or {}
+            msg = (f"{e['metric']} = {d.get('value', '-')} against {e['limit_text']}"
+                   + (f", margin {d['margin_pct']}" if d.get("margin_pct") else "")
+                   + (f" ({r['which']})" if r.get("which") else ""))
+            body = ""
+            st = r.get("status")
+            if st == "fail":
+                cnt["failures"] += 1
+                body = f"<failure message={quoteattr(msg)} type=\"requirement\">{escape(e['title'])}</failure>"
+            elif st == "not_evaluated":
+                reason = r.get("reason") or "not evaluated"
+                if e["severity"] == "mandatory":
+                    cnt["errors"] += 1
+                    body = f"<error message={quoteattr(reason)} type=\"not_evaluated\"/>"
+                else:
+                    cnt["skipped"] += 1
+                    body = f"<skipped message={quoteattr(reason)}/>"
+            elif st in ("open", "disabled"):
+                cnt["skipped"] += 1
+                body = f"<skipped message={quoteattr(('open: no limit set; measured ' + d.get('value', '-')) if st == 'open' else 'disabled')}/>"
+            out = f"<system-out>{escape(msg)}</system-out>"
+            cases.append(f'    <testcase classname={quoteattr(e["id"])} name={quoteattr(r.get("run") or e["id"])} time="0">{body}{out}</testcase>')
+        for k in tot:
+            tot[k] += cnt[k]
+        suites.append(
+            f'  <testsuite name={quoteattr(e["id"] + " " + e["title"])} tests="{cnt["tests"]}" failures="{cnt["failures"]}" '
+            f'errors="{cnt["errors"]}" skipped="{cnt["skipped"]}">\n' + "\n".join(cases) + "\n  </testsuite>"
+        )
+    name = f"govcheck {results['plant']['name']} vs {results['requirement_set']['name']}"
+    return (
+        '<?xml version="1.0" encoding="UTF-8"?>\n'
+        f'<testsuites name={quoteattr(name)} tests="{tot["tests"]}" failures="{tot["failures"]}" errors="{tot["errors"]}" '
+        f'skipped="{tot["skipped"]}" time="{results.get("timing", {}).get("wall", 0):.3f}">\n' + "\n".join(suites) + "\n</testsuites>\n"
+    )
+
+
+def write_junit(results: dict, path) -> None:
+    """Write the JUnit XML atomically."""
+    write_text_atomic(path, junit_xml(results))

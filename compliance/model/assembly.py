@@ -1,0 +1,508 @@
+"""Model assembly: base physics + switched-on effects -> one compiled right-hand side.
+
+This is the one place where the physics functions are composed. ``plant_rhs`` is the single
+source of truth used by the simulator, the linearisation (trim + Jacobian) and the
+diagnosis (through the simulator). ``parameter_vector`` maps a validated ``PlantConfig``
+onto the layout of ``compliance.model.vector_slots``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from compliance.model.config import PlantConfig
+from compliance.model.vector_slots import *  # noqa: F403 - index constants are the core's vocabulary
+from compliance.model.vector_slots import EFFECT_SLOTS, N_AUX, N_PARAMS, N_STATES
+from compliance.physics.chamber import chamber_pressure_rate, chamber_temperature_rate, wall_heat_flow
+from compliance.physics.friction import (
+    lugre_bristle_rate,
+    lugre_force,
+    piecewise_stribeck_friction,
+    pressure_friction_increment,
+    variable_viscous_friction,
+)
+from compliance.physics.leakage import laminar_leak, reservoir_pressure_rate
+from compliance.physics.mechanics import (
+    end_stop_force,
+    interp_curve,
+    single_force,
+    single_volumes,
+    tandem_volumes,
+)
+from compliance.physics.valve_flow import (
+    bobrow_mass_flow,
+    iso6358_mass_flow,
+    power_law_mass_flow,
+    sanville_mass_flow,
+    series_conductance,
+)
+from compliance.physics.valve_opening import openings_from_signed, signed_opening, valve_openings
+
+FLOW_LAWS = {"iso6358": 0, "sanville": 1, "bobrow": 2, "power_law": 3}
+FRICTION_MODELS = {"lugre": 0, "variable_viscous": 1, "piecewise_stribeck": 2}
+VALVE_STAGES = {"spool": 0, "opening": 1}  # where valve_dynamics acts: on the spool (command) or on the opening
+STICK_TIME_CONSTANT = 1e-3  # s; variable-viscous model: how fast a stuck body's residual speed is removed
+
+
+def parameter_vector(cfg: PlantConfig, *, load: float | str | None = None, flow_control: bool | None = None) -> np.ndarray:
+    """Flatten a configuration into the core's parameter vector (SI).
+
+    Parameters
+    ----------
+    cfg : PlantConfig
+    load : float, "curve" or None
+        Constant closing load [N], the configuration's load curve, or no load.
+    flow_control : bool or None
+        Override whether the meter-out flow-control valves are installed.
+    """
+    p = cfg.params
+    P = np.zeros(N_PARAMS)
+    d = p["cylinder.piston_diameter"]
+    dr = p["cylinder.rod_diameter"]
+    a_cap = math.pi * d * d / 4.0
+    a_rod = a_cap - math.pi * dr * dr / 4.0
+    tandem = cfg.options["cylinder.arrangement"] == "tandem"
+    P[P_STROKE] = p["cylinder.stroke"]
+    P[P_AREA_CAP] = a_cap
+    P[P_AREA_ROD] = a_rod
+    P[P_V0] = p["cylinder.dead_volume"]
+    P[P_MASS] = p["cylinder.moving_mass"]
+    P[P_ARR] = 0.0 if tandem else 1.0
+    P[P_NFR] = 2.0 if tandem else 1.0  # friction parameters are per cylinder
+    P[P_PS] = p["air.supply_pressure"]
+    P[P_PATM] = p["air.atmospheric_pressure"]
+    P[P_TS] = p["air.supply_temperature"]
+    P[P_R] = p["air.gas_constant"]
+    P[P_GAMMA] = p["air.heat_capacity_ratio"]
+    P[P_RHO0] = p["air.reference_density"]
+    P[P_T0] = p["air.reference_temperature"]
+    P[P_C] = p["valve.sonic_conductance"]
+    P[P_B] = p["valve.critical_pressure_ratio"]
+    P[P_DZP] = p["valve.dead_zone_positive"]
+    P[P_DZN] = p["valve.dead_zone_negative"]
+    P[P_SLP] = p["valve.slope_positive"]
+    P[P_SLN] = p["valve.slope_negative"]
+    P[P_USAT] = p["valve.saturation_voltage"]
+    P[P_UCEN] = p["valve.centre_voltage"]
+    P[P_LAW] = FLOW_LAWS[cfg.options["valve.flow_law"]]
+    P[P_VD_STAGE] = VALVE_STAGES[cfg.options["valve.dynamics_stage"]]
+    P[P_EFFA] = p["valve.effective_area"]
+    P[P_BOB] = p["valve.bobrow_coefficient"]
+    P[P_POW1] = p["valve.power_law_c1"]
+    P[P_POW2] = p["valve.power_law_c2"]
+    P[P_POWE] = p["valve.power_law_exponent"]
+    installed = cfg.flow_control_installed if flow_control is None else bool(flow_control)
+    P[P_FC_ON] = 1.0 if installed else 0.0
+    P[P_FC_OPEN] = p["flow_control.opening_conductance"]
+    P[P_FC_CLOSE] = p["flow_control.closing_conductance"]
+    P[P_FRM] = FRICTION_MODELS[cfg.options["friction.model"]]
+    P[P_FS] = p["friction.static_force"]
+    P[P_FC] = p["friction.coulomb_force"]
+    P[P_VS] = p["friction.stribeck_velocity"]
+    P[P_BV] = p["friction.viscous_coefficient"]
+    P[P_VLIM] = p["friction.limit_velocity"]
+    P[P_SIG0] = p["friction.bristle_stiffness"]
+    P[P_SIG1] = p["friction.bristle_damping"]
+    P[P_FJ] = p["friction.breakaway_force"]  # seed 001 eq. (8)
+    P[P_KV1] = p["friction.low_speed_coefficient"]
+    P[P_VD] = p["friction.critical_velocity"]
+    P[P_KV2] = p["friction.high_speed_coefficient"]
+    if P[P_FRM] == 2.0 and P[P_FJ] - P[P_KV1] * P[P_VD] < 0.0:
+        from compliance.errors import InputError
+
+        raise InputError(
+            f"{cfg.path or cfg.name}: friction.breakaway_force - friction.low_speed_coefficient * friction.critical_velocity "
+            f"= {P[P_FJ] - P[P_KV1] * P[P_VD]:g} N; seed 001 eq. (8) needs it >= 0 (friction never aids the motion)"
+        )
+    P[P_KSTOP] = p["end_stop.stiffness"]
+    P[P_CSTOP] = p["end_stop.damping"]
+    if isinstance(load, str):
+        if load != "curve":
+            raise ValueError(f"load must be a force, 'curve' or None, not {load!r}")
+        if cfg.load_curve is None:
+            from compliance.errors import InputError
+
+            raise InputError(f"{cfg.path or cfg.name}: the scenario asks for the load curve but [load.curve] is not defined")
+        P[P_LOADMODE] = 1.0
+    else:
+        P[P_LOAD] = 0.0 if load is None else float(load)
+    P[P_KP] = p["controller.kp"]
+    P[P_KI] = p["controller.ki"]
+    P[P_KD] = p["controller.kd"]
+    P[P_TSAMP] = p["controller.sample_time"]
+    P[P_FILT] = p["controller.filter_cutoff"]
+    P[P_LC] = p["controller.compensation_width"]
+    P[P_CDZP] = p["controller.compensation_dead_zone_positive"]
+    P[P_CDZN] = p["controller.compensation_dead_zone_negative"]
+    P[P_CSLP] = p["controller.compensation_slope_positive"]
+    P[P_CSLN] = p["controller.compensation_slope_negative"]
+    P[P_ULIM] = p["valve.command_limit"]
+    for name, values in cfg.effects.items():
+        flag, slots = EFFECT_SLOTS[name]
+        P[flag] = 1.0
+        for pname, idx in slots.items():
+            P[idx] = values[pname]
+    if P[P_LK_ON] and not tandem:
+        from compliance.errors import InputError
+
+        raise InputError(f"{cfg.path or cfg.name}: effect linkage_compliance needs cylinder.arrangement = 'tandem'")
+    return P
+
+
+def load_curve_arrays(cfg: PlantConfig) -> tuple[np.ndarray, np.ndarray]:
+    """Load-curve arrays for the core (a flat zero curve when none is configured)."""
+    if cfg.load_curve is None:
+        return np.array([0.0, 1.0]), np.array([0.0, 0.0])
+    return np.ascontiguousarray(cfg.load_curve[0], dtype=float), np.ascontiguousarray(cfg.load_curve[1], dtype=float)
+
+
+# ----------------------------------------------------------------------------------------------
+@njit(cache=True, error_model="numpy", inline="always")
+def _path_flow(P, opening, throttle, p_up, p_down, t_up):
+    """Signed mass flow of one valve port path under the configured flow law [kg/s]."""
+    law = P[P_LAW]
+    if opening <= 0.0:
+        return 0.0
+    if law == 0.0:
+        c = P[P_C] * opening
+        if throttle > 0.0:
+            c = series_conductance(c, throttle)  # meter-out throttle in series (seed 000 fig. 6, 2V2/2V3)
+        return iso6358_mass_flow(1.0, c, p_up, p_down, t_up, P[P_B], P[P_RHO0], P[P_T0])  # seed 000 eq. (1)
+    if law == 1.0:
+        return sanville_mass_flow(opening * P[P_EFFA], p_up, p_down, t_up, P[P_GAMMA], P[P_R])  # seed 001 eq. (5)
+    if law == 2.0:
+        return bobrow_mass_flow(P[P_BOB], opening, p_up, p_down)  # seed 001 eq. (6)
+    return power_law_mass_flow(P[P_POW1], P[P_POW2], P[P_POWE], opening, p_up, p_down)  # seed 001 eq. (7), fitted form
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _body_friction(P, v, z, applied, fs, fc, n):
+    """Friction force on one body [N] and bristle rate; ``applied`` is the net non-friction force."""
+    if P[P_FRM] == 0.0:
+        dz = lugre_bristle_rate(v, z, P[P_SIG0], fs, fc, P[P_VS])  # LuGre (Canudas de Wit 1995)
+        return n * lugre_force(v, z, dz, P[P_SIG0], P[P_SIG1], P[P_BV]), dz, False
+    if P[P_FRM] == 2.0:
+        fj = P[P_FJ] + (fs - P[P_FS])  # pressure-dependent friction raises F_j by the same increment
+        f = n * piecewise_stribeck_friction(v, applied / n, fj, P[P_KV1], P[P_VD], P[P_KV2], P[P_VLIM])  # seed 001 eq. (8)
+        stuck = abs(v) < P[P_VLIM] and abs(applied) <= n * fj
+        return f, 0.0, stuck
+    f = n * variable_viscous_friction(v, applied / n, fs, fc, P[P_VS], P[P_BV], P[P_VLIM])  # seed 000 eq. (7)
+    stuck = abs(v) < P[P_VLIM] and abs(applied) <= n * fs
+    return f, 0.0, stuck
+
+
+@njit(cache=True, error_model="numpy")
+def valve_lag_input(P, u_valve):
+    """What the valve_dynamics filter acts on: the command [V] (spool stage) or, for
+    ``valve.dynamics_stage = "opening"``, the signed relative opening it asks for [-]."""
+    if P[P_VD_STAGE] != 1.0:
+        return u_valve
+    off = P[P_VO_OFF] if P[P_VO_ON] != 0.0 else 0.0
+    return signed_opening(u_valve + off - P[P_UCEN], P[P_DZP], P[P_DZN], P[P_SLP], P[P_SLN], P[P_USAT])
+
+
+@njit(cache=True, error_model="numpy")
+def plant_rhs(y, P, u_valve, load_xs, load_ys, dy, aux):
+    """Right-hand side of the plant: dy/dt for state ``y`` with valve input ``u_valve``.
+
+    Parameters
+    ----------
+    y : ndarray
+        State vector (layout ``compliance.model.vector_slots.STATE_NAMES``).
+    P : ndarray
+        Parameter vector (``parameter_vector``).
+    u_valve : float
+        Command arriving at the valve [V] (after any delay; the spool lag is a state here).
+    load_xs, load_ys : ndarray
+        Load curve (position [m], closing force [N]) used when ``P[load_mode] == 1``.
+    dy : ndarray
+        Output: state derivatives.
+    aux : ndarray
+        Output: auxiliary signals (``compliance.model.vector_slots.AUX_NAMES``).
+    """
+    x = y[S_X]
+    v = y[S_V]
+    pa = y[S_PA]
+    pb = y[S_PB]
+    ts = P[P_TS]
+    patm = P[P_PATM]
+    gamma = P[P_GAMMA]
+    rg = P[P_R]
+    for i in range(dy.shape[0]):
+        dy[i] = 0.0
+    linkage = P[P_LK_ON] != 0.0 and P[P_ARR] == 0.0
+    x2 = y[S_X2] if linkage else x
+    v2 = y[S_V2] if linkage else v
+    a_cap = P[P_AREA_CAP]
+    a_rod = P[P_AREA_ROD]
+    # --- geometry: volumes and their rates
+    if P[P_ARR] == 0.0:
+        # tandem pair, reference-plant.md decoded eqs. (4)-(5); x2 differs from x only with linkage compliance
+        va = 2.0 * P[P_V0] + a_cap * x + a_rod * x2
+        vb = 2.0 * P[P_V0] + a_rod * (P[P_STROKE] - x) + a_cap * (P[P_STROKE] - x2)
+        dva = a_cap * v + a_rod * v2
+        dvb = -a_rod * v - a_cap * v2
+    else:
+        va, vb = single_volumes(x, P[P_STROKE], P[P_V0], a_cap, a_rod)  # seed 001 fig. 1
+        dva = a_cap * v
+        dvb = -a_rod * v
+    # --- valve input: spool dynamics, null offset, centre
+    u = u_valve
+    lag_opening = P[P_VD_ON] != 0.0 and P[P_VD_STAGE] == 1.0
+    if P[P_VD_ON] != 0.0:
+        wn = P[P_VD_WN]
+        target = valve_lag_input(P, u_valve)
+        dy[S_SP] = y[S_SV]
+        dy[S_SV] = wn * wn * (target - y[S_SP]) - 2.0 * P[P_VD_Z] * wn * y[S_SV]  # second-order spool (Merritt 1967)
+        u = y[S_SP]
+    if lag_opening:
+        a_pa, a_at, a_pb, a_bt = openings_from_signed(u)  # the lagged opening drives the ports directly
+    else:
+        if P[P_VO_ON] != 0.0:
+            u = u + P[P_VO_OFF]  # valve null shift
+        a_pa, a_at, a_pb, a_bt = valve_openings(u - P[P_UCEN], P[P_DZP], P[P_DZN], P[P_SLP], P[P_SLN], P[P_USAT])
+    # --- supply, port and chamber temperatures
+    ps = y[S_PSUP] if P[P_SD_ON] != 0.0 else P[P_PS]
+    port_a = y[S_PLA] if P[P_LD_ON] != 0.0 else pa
+    port_b = y[S_PLB] if P[P_LD_ON] != 0.0 else pb
+    heat = P[P_HT_ON] != 0.0
+    ta = y[S_TA] if heat else ts
+    tb = y[S_TB] if heat else ts
+    thr_close = P[P_FC_CLOSE] if P[P_FC_ON] != 0.0 else 0.0
+    thr_open = P[P_FC_OPEN] if P[P_FC_ON] != 0.0 else 0.0
+    # --- valve flows (signed, positive in the nominal direction); gas leaves a side at its temperature
+    q_pa = _path_flow(P, a_pa, 0.0, ps, port_a, ts if ps >= port_a else ta)
+    q_at = _path_flow(P, a_at, thr_close, port_a, patm, ta if port_a >= patm else ts)
+    q_pb = _path_flow(P, a_pb, 0.0, ps, port_b, ts if ps >= port_b else tb)
+    q_bt = _path_flow(P, a_bt, thr_open, port_b, patm, tb if port_b >= patm else ts)
+    qva = q_pa - q_at  # net valve flow towards side A
+    qvb = q_pb - q_bt
+    # enthalpy bookkeeping per chamber: inflow mass, inflow mass*temperature, outflow mass
+    qin_a = 0.0
+    hin_a = 0.0
+    qout_a = 0.0
+    qin_b = 0.0
+    hin_b = 0.0
+    qout_b = 0.0
+    if P[P_LD_ON] != 0.0:
+        # hose as a lumped volume (isothermal node at T_s) + ISO 6358 restriction to the chamber
+        cl = P[P_LD_COND]
+        q_la = iso6358_mass_flow(1.0, cl, port_a, pa, ts if port_a >= pa else ta, P[P_B], P[P_RHO0], P[P_T0])
+        q_lb = iso6358_mass_flow(1.0, cl, port_b, pb, ts if port_b >= pb else tb, P[P_B], P[P_RHO0], P[P_T0])
+        dy[S_PLA] = rg * ts / P[P_LD_VOL] * (qva - q_la)  # mass balance of the hose volume
+        dy[S_PLB] = rg * ts / P[P_LD_VOL] * (qvb - q_lb)
+        feeds_a = q_la
+        feeds_b = q_lb
+    else:
+        feeds_a = qva
+        feeds_b = qvb
+    if feeds_a >= 0.0:
+        qin_a += feeds_a
+        hin_a += feeds_a * ts
+    else:
+        qout_a -= feeds_a
+    if feeds_b >= 0.0:
+        qin_b += feeds_b
+        hin_b += feeds_b * ts
+    else:
+        qout_b -= feeds_b
+    if P[P_IL_ON] != 0.0:
+        q_il = laminar_leak(P[P_IL_K], pa, pb)  # A -> B across the piston seals
+        if q_il >= 0.0:
+            qout_a += q_il
+            qin_b += q_il
+            hin_b += q_il * ta
+        else:
+            qin_a -= q_il
+            hin_a -= q_il * tb
+            qout_b -= q_il
+    if P[P_EL_ON] != 0.0:
+        q_ea = laminar_leak(P[P_EL_K], pa, patm)  # to atmosphere
+        q_eb = laminar_leak(P[P_EL_K], pb, patm)
+        if q_ea >= 0.0:
+            qout_a += q_ea
+        else:
+            qin_a -= q_ea
+            hin_a -= q_ea * ts
+        if q_eb >= 0.0:
+            qout_b += q_eb
+        else:
+            qin_b -= q_eb
+            hin_b -= q_eb * ts
+    tin_a = hin_a / qin_a if qin_a > 0.0 else ts
+    tin_b = hin_b / qin_b if qin_b > 0.0 else ts
+    qh_a = wall_heat_flow(P[P_HT_HA], ts, ta) if heat else 0.0
+    qh_b = wall_heat_flow(P[P_HT_HA], ts, tb) if heat else 0.0
+    # seed 000 eqs. (4)-(5) decoded (energy equation; isentropic at T_s when heat transfer is off)
+    dpa = chamber_pressure_rate(qin_a, qout_a, tin_a, ta, pa, va, dva, qh_a, gamma, rg)
+    dpb = chamber_pressure_rate(qin_b, qout_b, tin_b, tb, pb, vb, dvb, qh_b, gamma, rg)
+    dy[S_PA] = dpa
+    dy[S_PB] = dpb
+    if heat:
+        dy[S_TA] = chamber_temperature_rate(ta, pa, va, dpa, dva, qin_a - qout_a, rg)
+        dy[S_TB] = chamber_temperature_rate(tb, pb, vb, dpb, dvb, qin_b - qout_b, rg)
+    if P[P_SD_ON] != 0.0:
+        dy[S_PSUP] = reservoir_pressure_rate(P[P_SD_COND], P[P_PS], ps, q_pa + q_pb, P[P_SD_VOL], rg, ts)
+    # --- forces
+    fs = P[P_FS]
+    fc = P[P_FC]
+    if P[P_PF_ON] != 0.0:
+        dfp = pressure_friction_increment(P[P_PF_COEF], 0.5 * (pa + pb), patm)
+        fs += dfp
+        fc += dfp
+    if P[P_LOADMODE] == 1.0:
+        f_load = interp_curve(x2, load_xs, load_ys)
+    else:
+        f_load = P[P_LOAD]
+    if P[P_PL_ON] != 0.0:
+        f_load += P[P_PL_K] * (x2 - 0.5 * P[P_STROKE])  # load stiffness about mid-stroke
+    if P[P_ARR] == 0.0:
+        f1 = pa * a_cap - pb * a_rod  # cylinder 2A1 (decoded seed 000 eq. 6)
+        f2 = pa * a_rod - pb * a_cap  # cylinder 2A2, mounted opposite
+    else:
+        f1 = single_force(pa, pb, a_cap, a_rod, patm)  # seed 001 eq. (9)
+        f2 = 0.0
+    mass = P[P_MASS]
+    if not linkage:
+        fp = f1 + f2
+        applied = fp - f_load + end_stop_force(x, v, P[P_STROKE], P[P_KSTOP], P[P_CSTOP])
+        ff, dz, stuck = _body_friction(P, v, y[S_Z1], applied, fs, fc, P[P_NFR])
+        acc = -v / STICK_TIME_CONSTANT if stuck else (applied - ff) / mass  # seed 000 eq. (6)
+        dy[S_X] = v
+        dy[S_V] = acc
+        dy[S_Z1] = dz
+        dy[S_Z2] = dz
+        dy[S_X2] = v
+        dy[S_V2] = acc
+    else:
+        # two bodies (2A1 with the sensor; 2A2 with the gate ring and load) joined by a spring-damper
+        fp = f1 + f2
+        f_link = P[P_LK_K] * (x2 - x) + P[P_LK_C] * (v2 - v)
+        m1 = 0.5 * mass
+        app1 = f1 + f_link + end_stop_force(x, v, P[P_STROKE], P[P_KSTOP], P[P_CSTOP])
+        app2 = f2 - f_link - f_load + end_stop_force(x2, v2, P[P_STROKE], P[P_KSTOP], P[P_CSTOP])
+        ff1, dz1, st1 = _body_friction(P, v, y[S_Z1], app1, fs, fc, 1.0)
+        ff2, dz2, st2 = _body_friction(P, v2, y[S_Z2], app2, fs, fc, 1.0)
+        dy[S_X] = v
+        dy[S_V] = -v / STICK_TIME_CONSTANT if st1 else (app1 - ff1) / m1
+        dy[S_X2] = v2
+        dy[S_V2] = -v2 / STICK_TIME_CONSTANT if st2 else (app2 - ff2) / m1
+        dy[S_Z1] = dz1
+        dy[S_Z2] = dz2
+        ff = ff1 + ff2
+    aux[A_FRIC] = ff
+    aux[A_LOAD] = f_load
+    aux[A_QA] = qin_a - qout_a
+    aux[A_QB] = qin_b - qout_b
+    aux[A_OPEN] = a_pa - a_pb
+    aux[A_FP] = fp
+    aux[A_QS] = q_pa + q_pb
+
+
+def load_force(P: np.ndarray, x: float, lx: np.ndarray, ly: np.ndarray) -> float:
+    """Closing force on the gate at position ``x`` [N]: constant or load curve, plus load stiffness.
+
+    The same law as ``plant_rhs`` (where it acts on body 2, the gate-ring side).
+    """
+    f = float(np.interp(x, lx, ly)) if P[P_LOADMODE] == 1.0 else float(P[P_LOAD])
+    if P[P_PL_ON]:
+        f += P[P_PL_K] * (x - 0.5 * P[P_STROKE])  # load stiffness about mid-stroke
+    return f
+
+
+def _pneumatic_forces(P: np.ndarray, pa: float, pb: float) -> tuple[float, float]:
+    """Piston forces (f1, f2) [N] of the two bodies, as in ``plant_rhs``."""
+    if P[P_ARR] == 0.0:
+        return pa * P[P_AREA_CAP] - pb * P[P_AREA_ROD], pa * P[P_AREA_ROD] - pb * P[P_AREA_CAP]  # decoded seed 000 eq. (6)
+    return single_force(pa, pb, P[P_AREA_CAP], P[P_AREA_ROD], P[P_PATM]), 0.0  # seed 001 eq. (9)
+
+
+def set_rest_internal_states(P: np.ndarray, y: np.ndarray, lx: np.ndarray, ly: np.ndarray, v: float = 0.0) -> None:
+    """Set the unmeasured mechanical states consistent with position, speed and pressures (in place).
+
+    A servo found at rest with given pressures is held there: the net force sits in the
+    static friction (LuGre bristles deflected, Canudas de Wit et al. 1995) and a compliant
+    linkage carries its share of the load. Without this a recording that starts from measured
+    pressures would slip at t = 0 and a relaxed linkage under load would jump.
+
+    Parameters
+    ----------
+    P : ndarray
+        Parameter vector.
+    y : ndarray
+        State; reads x, p_A, p_B; writes x2 (linkage compliance) and z1, z2 (LuGre).
+    lx, ly : ndarray
+        Load curve (``load_curve_arrays``).
+    v : float
+        Speed [m/s]; sliding bristles sit at the steady deflection g(v)/sigma0.
+    """
+    x = y[S_X]
+    f1, f2 = _pneumatic_forces(P, y[S_PA], y[S_PB])
+    linkage = P[P_LK_ON] != 0.0 and P[P_ARR] == 0.0
+    x2 = x
+    if linkage:
+        # both bodies rest with equal friction shares: f1 + f_link = f2 - f_link - F_load(x2),
+        # f_link = K (x2 - x); fixed point in x2 (contracts while K exceeds the load stiffness)
+        for _ in range(50):
+            x2_new = x + 0.5 * (f2 - f1 - load_force(P, x2, lx, ly)) / P[P_LK_K]
+            x2_new = min(max(x2_new, 0.0), P[P_STROKE])  # a link too soft to carry it leaves 2A2 on its end stop
+            if abs(x2_new - x2) < 1e-12:
+                x2 = x2_new
+                break
+            x2 = x2_new
+        y[S_X2] = x2
+    if not (P[P_FRM] == 0.0 and P[P_SIG0] > 0.0):
+        return
+    fs, fc = P[P_FS], P[P_FC]
+    if P[P_PF_ON]:
+        d = pressure_friction_increment(P[P_PF_COEF], 0.5 * (y[S_PA] + y[S_PB]), P[P_PATM])
+        fs, fc = fs + d, fc + d
+    net = f1 + f2 - load_force(P, x2, lx, ly) + end_stop_force(x, 0.0, P[P_STROKE], P[P_KSTOP], P[P_CSTOP])
+    n = P[P_NFR] if not linkage else 2.0
+    g = fc + (fs - fc) * math.exp(-abs(v) / P[P_VS])  # LuGre g(v), Canudas de Wit et al. 1995
+    z = (net / n - P[P_BV] * v) / P[P_SIG0]
+    zmax = g / P[P_SIG0]
+    z = min(max(z, -zmax), zmax)
+    y[S_Z1] = z
+    y[S_Z2] = z
+
+
+def initial_state(cfg: PlantConfig, P: np.ndarray, x0: float, pressures: tuple[float, float] | None = None) -> np.ndarray:
+    """State at rest at ``x0``: pressures balance the load with mean (p_s + p_atm)/2, T = T_s.
+
+    This is the practice emulator's convention (ANSWERS.md) and the trim a test bench
+    reaches after holding a position. Given ``pressures`` (p_A, p_B) [Pa abs] replace the
+    balance; either way the bristles and a compliant linkage start deflected so that the
+    servo is held where it is (``set_rest_internal_states``).
+    """
+    y = np.zeros(N_STATES)
+    y[S_X] = x0
+    y[S_X2] = x0
+    lx, ly = load_curve_arrays(cfg)
+    f_load = load_force(P, x0, lx, ly)
+    ps, patm = P[P_PS], P[P_PATM]
+    if pressures is not None:
+        pa, pb = pressures
+    elif P[P_ARR] == 0.0:
+        at = P[P_AREA_CAP] + P[P_AREA_ROD]
+        pa = 0.5 * (ps + patm) + 0.5 * f_load / at
+        pb = 0.5 * (ps + patm) - 0.5 * f_load / at
+    else:
+        ac, ar = P[P_AREA_CAP], P[P_AREA_ROD]
+        pa = (f_load + patm * (ac - ar) + (ps + patm) * ar) / (ac + ar)
+        pb = ps + patm - pa
+    lo = patm * 1.0001
+    pa = min(max(pa, lo), ps)
+    pb = min(max(pb, lo), ps)
+    y[S_PA] = pa
+    y[S_PB] = pb
+    y[S_TA] = P[P_TS]
+    y[S_TB] = P[P_TS]
+    y[S_PSUP] = ps
+    y[S_PLA] = pa
+    y[S_PLB] = pb
+    set_rest_internal_states(P, y, lx, ly)  # held at rest: bristles carry the net force, the link its share
+    return y

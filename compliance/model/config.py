@@ -1,0 +1,430 @@
+"""Plant configuration files: load, validate at the edge, freeze; save fitted variants with provenance."""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import os
+import tomllib
+from dataclasses import dataclass, field, replace as dc_replace
+from importlib import resources
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any, Mapping
+
+import numpy as np
+
+from compliance.errors import did_you_mean
+from compliance.effects import EFFECTS
+from compliance.errors import InputError
+from compliance.model.parameters import BASE_BY_KEY, BASE_PARAMS, OPTION_DEFAULTS, OPTIONS, SOURCES
+from compliance.files.atomic import write_text_atomic
+from compliance.units import parse_quantity
+
+_TOP_KEYS = {"name", "description", "provenance", "effects"}
+_SECTIONS = sorted({k.split(".")[0] for k in BASE_BY_KEY} | {k.split(".")[0] for k in OPTIONS})
+
+
+_suggest = did_you_mean
+
+
+@dataclass(frozen=True)
+class PlantConfig:
+    """A validated, frozen plant configuration (all values SI, pressures absolute).
+
+    Attributes
+    ----------
+    name, description : str
+    path : str or None
+        File it was read from.
+    digest : str
+        sha256 of the file bytes ("" for an in-memory configuration).
+    params : Mapping[str, float]
+        Dotted key -> SI value, every key of ``parameters.BASE_PARAMS``.
+    sources : Mapping[str, str]
+        Dotted key -> ``paper|assumed|derived|user``.
+    options : Mapping[str, str]
+        Dotted key -> option string.
+    load_curve : tuple of numpy arrays or None
+        (position [m], closing force [N]) over the stroke.
+    effects : Mapping[str, Mapping[str, float]]
+        Effects switched on and their SI parameters.
+    provenance : Mapping[str, str]
+        Where a fitted configuration came from (parent digest, recording, date).
+    """
+
+    name: str
+    description: str
+    path: str | None
+    digest: str
+    params: Mapping[str, float]
+    sources: Mapping[str, str]
+    options: Mapping[str, str]
+    load_curve: tuple[np.ndarray, np.ndarray] | None
+    effects: Mapping[str, Mapping[str, float]]
+    provenance: Mapping[str, str] = field(default_factory=dict)
+
+    def p(self, key: str) -> float:
+        """SI value of a base parameter."""
+        return self.params[key]
+
+    def option(self, key: str) -> str:
+        """Value of an option such as ``friction.model``."""
+        return self.options[key]
+
+    @property
+    def flow_control_installed(self) -> bool:
+        """Whether the meter-out flow-control valves 2V2/2V3 are in the circuit."""
+        return self.options["flow_control.installed"] == "true"
+
+    @property
+    def piston_area(self) -> float:
+        """Cap-side area A_cap [m^2]."""
+        d = self.params["cylinder.piston_diameter"]
+        return math.pi * d * d / 4.0
+
+    @property
+    def rod_side_area(self) -> float:
+        """Rod-side annulus area A_rod [m^2]."""
+        d = self.params["cylinder.rod_diameter"]
+        return self.piston_area - math.pi * d * d / 4.0
+
+    def replace(self, *, params=None, effects=None, options=None, name=None, provenance=None, sources=None):
+        """Return a new configuration with some values changed (validated the same way).
+
+        Parameters
+        ----------
+        params : dict, optional
+            Dotted key -> SI float to override.
+        effects : dict, optional
+            Effect name -> dict of SI params (merged with defaults), or None to switch it off.
+        options : dict, optional
+            Option key -> value.
+        """
+        new_params = dict(self.params)
+        new_sources = dict(self.sources)
+        for k, v in (params or {}).items():
+            if k not in BASE_BY_KEY:
+                raise InputError(f"parameter '{k}' is not known{_suggest(k, BASE_BY_KEY)}")
+            new_params[k] = float(v)
+            new_sources[k] = (sources or {}).get(k, "user")
+        new_effects = {k: dict(v) for k, v in self.effects.items()}
+        for k, v in (effects or {}).items():
+            if k not in EFFECTS:
+                raise InputError(f"effect '{k}' is not known{_suggest(k, EFFECTS)}")
+            if v is None:
+                new_effects.pop(k, None)
+            else:
+                merged = EFFECTS[k].defaults()
+                merged.update(new_effects.get(k, {}))
+                merged.update({pk: float(pv) for pk, pv in v.items()})
+                new_effects[k] = merged
+        new_options = dict(self.options)
+        for k, v in (options or {}).items():
+            if k not in OPTIONS:
+                raise InputError(f"option '{k}' is not known{_suggest(k, OPTIONS)}")
+            v = str(v).lower() if isinstance(v, bool) else str(v)
+            if v not in OPTIONS[k]:
+                raise InputError(f"option {k} = '{v}' is not one of {', '.join(OPTIONS[k])}{_suggest(v, OPTIONS[k])}")
+            new_options[k] = v
+        cfg = dc_replace(
+            self,
+            name=name or self.name,
+            params=MappingProxyType(new_params),
+            sources=MappingProxyType(new_sources),
+            effects=MappingProxyType({k: MappingProxyType(v) for k, v in new_effects.items()}),
+            options=MappingProxyType(new_options),
+            provenance=MappingProxyType(dict(provenance)) if provenance is not None else self.provenance,
+        )
+        _check_physical(cfg, self.path or "<configuration>")
+        return cfg
+
+
+# ----------------------------------------------------------------------------------------------
+def reference_plants() -> list[str]:
+    """Names of the reference configurations shipped with the package."""
+    folder = resources.files("compliance") / "data" / "plants"
+    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
+
+
+def resolve_plant_path(source: str | os.PathLike) -> Path:
+    """Path of a plant given as a file path or a reference name (``plant-a``)."""
+    s = str(source)
+    p = Path(s)
+    if p.suffix == ".toml" or os.sep in s or p.exists():
+        if not p.is_file():
+            raise InputError(f"{s}: plant configuration file not found")
+        return p
+    ref = resources.files("compliance") / "data" / "plants" / f"{s}.toml"
+    if not ref.is_file():
+        raise InputError(f"plant '{s}' is not a file nor a reference plant{_suggest(s, reference_plants())} "
+                         f"(reference plants: {', '.join(reference_plants())})")
+    return Path(str(ref))
+
+
+def load_plant(source: str | os.PathLike) -> PlantConfig:
+    """Load and validate a plant configuration (a TOML path or a reference plant name).
+
+    Raises
+    ------
+    InputError
+        With the file and key path of the first problem found.
+    """
+    path = resolve_plant_path(source)
+    raw_bytes = path.read_bytes()
+    try:
+        data = tomllib.loads(raw_bytes.decode("utf-8"))
+    except UnicodeDecodeError:
+        raise InputError(f"{path}: not a UTF-8 text file") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{path}: malformed TOML ({exc})") from None
+    return plant_from_dict(data, str(path), hashlib.sha256(raw_bytes).hexdigest())
+
+
+def _param_value(entry, key: str, where: str, atmosphere: float):
+    """Read ``key = "125 mm"`` or ``key = {value = "125 mm", source = "paper"}``."""
+    spec = BASE_BY_KEY[key]
+    source = "user"
+    if isinstance(entry, dict):
+        unknown = set(entry) - {"value", "source", "note"}
+        if unknown:
+            u = sorted(unknown)[0]
+            raise InputError(f"{where}.{u}: unknown field{_suggest(u, ['value', 'source', 'note'])} (expected value, source, note)")
+        if "value" not in entry:
+            raise InputError(f"{where}: missing 'value'")
+        source = entry.get("source", "user")
+        if source not in SOURCES:
+            raise InputError(f"{where}.source: '{source}' is not one of {', '.join(SOURCES)}")
+        entry = entry["value"]
+    if spec.unit == "number":
+        if isinstance(entry, bool) or not isinstance(entry, (int, float)):
+            raise InputError(f"{where}: expected a bare number in SI base units")
+        value = float(entry)
+    else:
+        value = parse_quantity(entry, spec.unit, where, pressure=spec.pressure, atmosphere=atmosphere)
+    if not math.isfinite(value):
+        raise InputError(f"{where}: value is not finite")
+    bad = value < spec.low or value > spec.high or (spec.low_open and value <= spec.low)
+    if bad:
+        lo = f"> {spec.low:g}" if spec.low_open else f">= {spec.low:g}"
+        raise InputError(f"{where}: {value:g} {spec.unit} is not physical; expected {lo} and <= {spec.high:g} ({spec.meaning})")
+    return value, source
+
+
+def _array_field(entry, where: str, si_unit: str, stroke: float | None = None):
+    if not isinstance(entry, dict) or "values" not in entry or "unit" not in entry:
+        raise InputError(f"{where}: expected {{ values = [...], unit = \"...\" }}")
+    vals = entry["values"]
+    if not isinstance(vals, list) or not vals or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in vals):
+        raise InputError(f"{where}.values: expected a non-empty list of numbers")
+    unit = entry["unit"]
+    if stroke is not None and unit in ("%", "percent", "% stroke", "fraction"):
+        scale = stroke / 100.0 if unit != "fraction" else stroke
+        return np.array(vals, dtype=float) * scale
+    from compliance.units import convert_array
+
+    return convert_array(np.array(vals, dtype=float), unit, si_unit, where)
+
+
+def plant_from_dict(data: dict[str, Any], where: str = "<configuration>", digest: str = "") -> PlantConfig:
+    """Validate a parsed configuration mapping and freeze it (see ``load_plant``)."""
+    if not isinstance(data, dict):
+        raise InputError(f"{where}: expected a TOML table at the top level")
+    for k in data:
+        if k not in _TOP_KEYS and k not in _SECTIONS:
+            raise InputError(f"{where}: unknown key '{k}'{_suggest(k, list(_TOP_KEYS) + _SECTIONS)}")
+    name = data.get("name")
+    if not isinstance(name, str) or not name.strip():
+        raise InputError(f"{where}: missing 'name' (a string naming the plant)")
+    description = data.get("description", "")
+    params: dict[str, float] = {}
+    sources: dict[str, str] = {}
+    options = dict(OPTION_DEFAULTS)
+    atmosphere = 101325.0
+    # atmosphere first: gauge pressures convert with it
+    air = data.get("air", {})
+    if isinstance(air, dict) and "atmospheric_pressure" in air:
+        atmosphere, _ = _param_value(air["atmospheric_pressure"], "air.atmospheric_pressure", f"{where}: air.atmospheric_pressure", 101325.0)
+    load_curve_raw = None
+    for section in _SECTIONS:
+        table = data.get(section)
+        if table is None:
+            continue
+        if not isinstance(table, dict):
+            raise InputError(f"{where}: [{section}] must be a table")
+        for k, entry in table.items():
+            key = f"{section}.{k}"
+            kw = f"{where}: {key}"
+            if key == "load.curve":
+                load_curve_raw = entry
+                continue
+            if key in OPTIONS:
+                val = str(entry).lower() if isinstance(entry, bool) else entry
+                if not isinstance(val, str) or val not in OPTIONS[key]:
+                    raise InputError(f"{kw}: '{entry}' is not one of {', '.join(OPTIONS[key])}{_suggest(str(entry), OPTIONS[key])}")
+                options[key] = val
+                continue
+            if key not in BASE_BY_KEY:
+                choices = [b.key.split(".", 1)[1] for b in BASE_PARAMS if b.key.startswith(section + ".")]
+                choices += [o.split(".", 1)[1] for o in OPTIONS if o.startswith(section + ".")]
+                raise InputError(f"{kw}: unknown key '{k}' in [{section}]{_suggest(k, choices)}")
+            params[key], sources[key] = _param_value(entry, key, kw, atmosphere)
+    for spec in BASE_PARAMS:
+        if spec.key not in params:
+            if spec.default is None:
+                raise InputError(f"{where}: missing value {spec.key} ({spec.meaning}, unit {spec.unit})")
+            params[spec.key] = float(spec.default)
+            sources[spec.key] = "assumed"
+    load_curve = None
+    if load_curve_raw is not None:
+        kw = f"{where}: load.curve"
+        if not isinstance(load_curve_raw, dict):
+            raise InputError(f"{kw}: expected a table with position and force")
+        unknown = set(load_curve_raw) - {"position", "force", "source", "note"}
+        if unknown:
+            raise InputError(f"{kw}: unknown field '{sorted(unknown)[0]}' (expected position, force, source, note)")
+        if "position" not in load_curve_raw or "force" not in load_curve_raw:
+            raise InputError(f"{kw}: needs both 'position' and 'force'")
+        xs = _array_field(load_curve_raw["position"], f"{kw}.position", "m", params["cylinder.stroke"])
+        fs = _array_field(load_curve_raw["force"], f"{kw}.force", "N")
+        if xs.shape != fs.shape:
+            raise InputError(f"{kw}: position has {xs.size} values but force has {fs.size}")
+        if np.any(np.diff(xs) <= 0):
+            raise InputError(f"{kw}.position: values must be strictly increasing")
+        load_curve = (xs, fs)
+        sources["load.curve"] = load_curve_raw.get("source", "user")
+    effects: dict[str, dict[str, float]] = {}
+    eff_raw = data.get("effects", {})
+    if not isinstance(eff_raw, dict):
+        raise InputError(f"{where}: [effects] must be a table of [effects.NAME] tables")
+    for ename, table in eff_raw.items():
+        kw = f"{where}: effects.{ename}"
+        if ename not in EFFECTS:
+            raise InputError(f"{kw}: effect '{ename}' is not known{_suggest(ename, EFFECTS)} (known: {', '.join(EFFECTS)})")
+        if not isinstance(table, dict):
+            raise InputError(f"{kw}: expected a table of parameters")
+        eff = EFFECTS[ename]
+        if table.get("enabled", True) is False:
+            continue
+        vals = eff.defaults()
+        for pk, pv in table.items():
+            if pk in ("enabled", "source", "note"):
+                continue
+            names = [p.name for p in eff.params]
+            if pk not in names:
+                raise InputError(f"{kw}.{pk}: unknown parameter{_suggest(pk, names)} (expected {', '.join(names)})")
+            spec = eff.param(pk)
+            v = parse_quantity(pv["value"] if isinstance(pv, dict) else pv, spec.unit, f"{kw}.{pk}")
+            lo, hi = spec.bounds
+            if v < lo or v > hi:
+                raise InputError(f"{kw}.{pk}: {v:g} {spec.unit} is outside the admissible range [{lo:g}, {hi:g}]")
+            vals[pk] = v
+        effects[ename] = vals
+    cfg = PlantConfig(
+        name=name.strip(),
+        description=str(description),
+        path=None if where.startswith("<") else where,
+        digest=digest,
+        params=MappingProxyType(params),
+        sources=MappingProxyType(sources),
+        options=MappingProxyType(options),
+        load_curve=load_curve,
+        effects=MappingProxyType({k: MappingProxyType(v) for k, v in effects.items()}),
+        provenance=MappingProxyType({str(k): str(v) for k, v in (data.get("provenance") or {}).items()}),
+    )
+    _check_physical(cfg, where)
+    return cfg
+
+
+def _check_physical(cfg: PlantConfig, where: str) -> None:
+    """Cross-parameter checks that a single bound cannot express."""
+    p = cfg.params
+    if p["cylinder.rod_diameter"] >= p["cylinder.piston_diameter"]:
+        raise InputError(f"{where}: cylinder.rod_diameter must be smaller than cylinder.piston_diameter")
+    if p["air.supply_pressure"] <= p["air.atmospheric_pressure"]:
+        raise InputError(
+            f"{where}: air.supply_pressure ({p['air.supply_pressure']:.0f} Pa abs) must be above "
+            f"air.atmospheric_pressure ({p['air.atmospheric_pressure']:.0f} Pa abs)"
+        )
+    for side in ("positive", "negative"):
+        if p[f"valve.saturation_voltage"] <= p[f"valve.dead_zone_{side}"]:
+            raise InputError(f"{where}: valve.saturation_voltage must exceed valve.dead_zone_{side}")
+    if p["friction.static_force"] < p["friction.coulomb_force"]:
+        raise InputError(f"{where}: friction.static_force must be >= friction.coulomb_force")
+    law = cfg.options["valve.flow_law"]
+    need = {"sanville": "valve.effective_area", "bobrow": "valve.bobrow_coefficient", "power_law": "valve.power_law_c1"}.get(law)
+    if need and p[need] <= 0.0:
+        raise InputError(f"{where}: valve.flow_law = '{law}' needs {need} > 0")
+    ts = p["controller.sample_time"]
+    h = p["simulation.step"]
+    if h > ts or abs(ts / h - round(ts / h)) > 1e-6:
+        raise InputError(f"{where}: simulation.step ({h:g} s) must divide controller.sample_time ({ts:g} s) exactly")
+
+
+# ----------------------------------------------------------------------------------------------
+def _fmt(v: float) -> str:
+    return repr(float(v))
+
+
+def plant_to_toml(cfg: PlantConfig) -> str:
+    """Serialise a configuration to TOML text (SI units written out, sources kept)."""
+    lines = [f'name = "{cfg.name}"', f"description = {_toml_str(cfg.description)}", ""]
+    if cfg.provenance:
+        lines.append("[provenance]")
+        for k, v in cfg.provenance.items():
+            lines.append(f"{k} = {_toml_str(v)}")
+        lines.append("")
+    sections: dict[str, list[str]] = {}
+    for k, v in cfg.options.items():
+        sec, name = k.split(".", 1)
+        val = v if v not in ("true", "false") else v
+        sections.setdefault(sec, []).append(f"{name} = {val}" if v in ("true", "false") else f'{name} = "{val}"')
+    for spec in BASE_PARAMS:
+        sec, name = spec.key.split(".", 1)
+        v = cfg.params[spec.key]
+        src = cfg.sources.get(spec.key, "user")
+        if spec.unit == "number":
+            val = _fmt(v)
+        else:
+            unit = spec.unit
+            val = f'"{_fmt(v)} {unit} abs"' if spec.pressure else (f'"{_fmt(v)} {unit}"' if unit else _fmt(v))
+        sections.setdefault(sec, []).append(f'{name} = {{ value = {val}, source = "{src}" }}')
+    for sec, rows in sections.items():
+        lines.append(f"[{sec}]")
+        lines.extend(rows)
+        lines.append("")
+    if cfg.load_curve is not None:
+        xs, fs = cfg.load_curve
+        lines.append("[load.curve]")
+        lines.append(f'source = "{cfg.sources.get("load.curve", "user")}"')
+        lines.append("position = { values = [" + ", ".join(_fmt(x) for x in xs) + '], unit = "m" }')
+        lines.append("force = { values = [" + ", ".join(_fmt(f) for f in fs) + '], unit = "N" }')
+        lines.append("")
+    for ename, vals in cfg.effects.items():
+        eff = EFFECTS[ename]
+        lines.append(f"[effects.{ename}]")
+        for p in eff.params:
+            v = vals[p.name]
+            lines.append(f'{p.name} = "{_fmt(v)} {p.unit}"' if p.unit else f"{p.name} = {_fmt(v)}")
+        lines.append("")
+    return "\n".join(lines)
+
+
+def _toml_str(s: str) -> str:
+    return '"' + str(s).replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
+
+
+def save_plant(cfg: PlantConfig, path: str | os.PathLike, *, overwrite: bool = False) -> Path:
+    """Write a configuration to ``path`` atomically; refuse to overwrite unless asked.
+
+    The text is written to a temporary file in the same folder and moved into place, so a
+    failure never leaves a half-written file. The written file is re-read to prove it loads.
+    """
+    path = Path(path)
+    if path.exists() and not overwrite:
+        raise InputError(f"{path}: exists already; choose another name (nothing was overwritten)")
+    text = plant_to_toml(cfg)
+    plant_from_dict(tomllib.loads(text), str(path))  # prove it round-trips before writing
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_text_atomic(path, text)
+    return path

@@ -1,0 +1,251 @@
+"""Paper comparison: run the tests of seed 000 section 5 and set the simulated figures beside the paper's.
+
+The table is ``reference-plant.md`` "Results the model must be compared with". Metric
+definitions (stated in the output and docs/physics.md):
+
+- settling time: from the step instant to the last time the position is outside a band of
+  +/- 5 % of the actual change around the settled position (settled = mean of the last
+  0.5 s before the next step); the paper does not define its band;
+- steady error: |set-point - settled position| (same window);
+- full-stroke times t_a / t_f: 25 % -> 75 % of the stroke at full command with the
+  flow-control valves installed, extrapolated to 100 % (the straight part of the trace);
+- maximum speed: peak |dx/dt| over the full-stroke runs (20 ms central difference).
+
+A figure off by more than 35 % (settling) or 0.3 mm (steady error) is flagged and the
+assumed parameters are perturbed by +/-20 % to show which one drives it: nothing is tuned.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from compliance.model.config import PlantConfig
+from compliance.model.dead_zone_stall import stall_error
+from compliance.metrics import find_steps, speed_extremes, step_response, stroke_time
+from compliance.simulation.profiles import Profile, steps
+from compliance.simulation import Scenario, simulate
+
+SETTLING_BAND = 0.05  # fraction of the actual change
+SETTLING_TOLERANCE = 0.35  # relative
+STEADY_TOLERANCE = 0.3e-3  # m
+SENSITIVITY_STEP = 0.2  # relative perturbation of assumed parameters
+SENSITIVITY_PARAMS = (
+    "friction.static_force",
+    "friction.coulomb_force",
+    "friction.stribeck_velocity",
+    "friction.viscous_coefficient",
+    "friction.bristle_stiffness",
+    "valve.saturation_voltage",
+    "controller.filter_cutoff",
+)
+
+
+@dataclass(frozen=True)
+class StepCase:
+    """A closed-loop step test of the paper."""
+
+    test: str
+    x0: float  # m
+    load: float  # N, > 0 closes
+    kd: float  # V*s/m
+    spec: str  # step sequence
+    duration: float  # s
+    flow_control: bool
+    paper: dict  # step index -> (settling [s] or None, steady error [m] or None)
+    note: str = ""
+
+
+CASES = (
+    StepCase("fig. 9, steps at 4 s and 9 s", 0.136, 11400.0, 6.0, "2%@4s,-2%@9s,2%@14s", 19.0, False,
+             {0: (1.18, 0.32e-3), 1: (1.18, 0.32e-3)}, "sequence assumed up/down/up (fig. 9 is lost)"),
+    StepCase("fig. 9, step at 14 s", 0.136, 11400.0, 6.0, "2%@4s,-2%@9s,2%@14s", 19.0, False, {2: (0.55, None)}),
+    StepCase("fig. 10, positive step", 0.128, 11200.0, 20.0, "5%@1s,-5%@4s", 7.0, True, {0: (0.33, 0.24e-3)},
+             "flow-control valves installed (section 5.2)"),
+    StepCase("fig. 10, negative step", 0.128, 11200.0, 20.0, "5%@1s,-5%@4s", 7.0, True, {1: (0.56, 0.24e-3)}),
+    StepCase("fig. 11 (+2.3 kN closing)", 0.016, 2300.0, 20.0, "5%@1s,-5%@4s", 7.0, True, {0: (1.4, 0.8e-3)}),
+    StepCase("fig. 12 (-2.3 kN opening)", 0.016, -2300.0, 20.0, "5%@1s,-5%@4s", 7.0, True, {0: (0.55, 0.27e-3)},
+             "paper: 0.5-0.6 s"),
+)
+
+
+@dataclass
+class Row:
+    """One line of the comparison."""
+
+    test: str
+    metric: str
+    simulated: float | None
+    paper: float | None
+    unit: str
+    flagged: bool = False
+    driver: str = ""
+    note: str = ""
+
+
+@dataclass
+class Comparison:
+    """The whole paper comparison."""
+
+    rows: list[Row] = field(default_factory=list)
+    stall_error: float = 0.0
+    notes: list[str] = field(default_factory=list)
+
+
+def _step_metrics(cfg: PlantConfig, case: StepCase):
+    c = cfg.replace(params={"controller.kd": case.kd})
+    stroke = c.p("cylinder.stroke")
+    ref = steps(case.spec, case.x0, stroke)
+    df = simulate(c, Scenario(duration=case.duration, initial_position=case.x0, reference=ref,
+                              load=case.load, flow_control=case.flow_control))
+    t = df.time.to_numpy()
+    events = find_steps(t, df.reference.to_numpy())
+    return [step_response(t, df.position_true.to_numpy(), ev, settling_band=SETTLING_BAND) for ev in events]
+
+
+def _case_rows(cfg: PlantConfig, case: StepCase) -> list[Row]:
+    metrics = _step_metrics(cfg, case)
+    rows = []
+    for idx, (p_settle, p_err) in case.paper.items():
+        m = metrics[idx]
+        label = f"{case.test} (step {idx + 1})" if len(case.paper) > 1 else case.test
+        rows.append(Row(label, "settling time", m.settling_time, p_settle, "s", note=case.note))
+        rows.append(Row(label, "steady error", m.steady_state_error, p_err, "mm"))
+    return rows
+
+
+def _flag(row: Row) -> bool:
+    if row.simulated is None or row.paper is None:
+        return row.paper is not None and row.simulated is None
+    if row.unit == "s":
+        return abs(row.simulated - row.paper) > SETTLING_TOLERANCE * row.paper
+    if row.unit == "mm":
+        return abs(row.simulated - row.paper) > STEADY_TOLERANCE
+    return False
+
+
+def _metric_of(cfg: PlantConfig, case: StepCase, idx: int, metric: str):
+    m = _step_metrics(cfg, case)[idx]
+    return m.settling_time if metric == "settling time" else m.steady_state_error
+
+
+def _driver(cfg: PlantConfig, case: StepCase, idx: int, row: Row) -> str:
+    """Which assumed parameter, perturbed by +/-20 %, moves the figure most towards the paper."""
+    base = row.simulated
+    best = None
+    for key in SENSITIVITY_PARAMS:
+        if cfg.sources.get(key) != "assumed":
+            continue
+        for sign in (+1, -1):
+            val = cfg.p(key) * (1 + sign * SENSITIVITY_STEP)
+            try:
+                got = _metric_of(cfg.replace(params={key: val}, sources={key: "assumed"}), case, idx, row.metric)
+            except Exception:  # a perturbed variant that fails to settle says nothing useful here
+                continue
+            if got is None or base is None:
+                continue
+            gain = abs(base - row.paper) - abs(got - row.paper)
+            if best is None or gain > best[0]:
+                best = (gain, key, sign, got)
+    if best is None or best[0] < 0.1 * abs(base - row.paper):
+        if row.metric == "steady error" and base is not None and base >= 0.9 * stall_error(cfg):
+            return (f"no assumed parameter moves it by +/-20 %: the valve shuts inside the stall band "
+                    f"{stall_error(cfg) * 1e3:.2f} mm set by the paper's lc and K_P (see note)")
+        return "no assumed parameter moves it meaningfully towards the paper by +/-20 %"
+    scale = 1e3 if row.unit == "mm" else 1.0
+    return (f"{best[1]} {'+' if best[2] > 0 else '-'}{SENSITIVITY_STEP:.0%} moves it to "
+            f"{best[3] * scale:.3g} {row.unit}")
+
+
+def full_stroke(cfg: PlantConfig, load: float = 5700.0) -> dict:
+    """Opening/closing times and peak speed at full command through the flow-control valves."""
+    stroke = cfg.p("cylinder.stroke")
+    out = {}
+    for name, direction in (("opening", +1), ("closing", -1)):
+        x0 = 0.0 if direction > 0 else stroke
+        u = cfg.p("valve.centre_voltage") + direction * cfg.p("valve.command_limit")
+        cmd = Profile(np.array([0.0, 0.2, 0.2]), np.array([cfg.p("valve.centre_voltage")] * 2 + [u]))
+        df = simulate(cfg, Scenario(duration=20.0, initial_position=x0, command=cmd, load=load, flow_control=True))
+        t = df.time.to_numpy()
+        x = df.position_true.to_numpy()
+        out[name] = stroke_time(t, x, stroke, name)[0]
+        out[f"{name}_speed"] = speed_extremes(t, x)[0]
+    return out
+
+
+def compare(cfg: PlantConfig, explain: bool = True) -> Comparison:
+    """Run every test of the paper table and build the comparison (see module docstring)."""
+    comp = Comparison(stall_error=stall_error(cfg))
+    for case in CASES:
+        rows = _case_rows(cfg, case)
+        idxs = [i for i in case.paper for _ in (0, 1)]
+        for idx, row in zip(idxs, rows):
+            row.flagged = _flag(row)
+            if row.flagged and explain:
+                row.driver = _driver(cfg, case, idx, row)
+            comp.rows.append(row)
+    fs = full_stroke(cfg)
+    for name, key in (("opening time t_a", "opening"), ("closing time t_f", "closing")):
+        comp.rows.append(Row("speed-governor set-up (5.7 kN)", name, fs[key], 5.0, "s"))
+    vmax = max(fs["opening_speed"], fs["closing_speed"])
+    r = Row("speed-governor set-up (5.7 kN)", "max speed", vmax, 0.09, "m/s")
+    r.flagged = abs(vmax - 0.09) > 0.35 * 0.09
+    if r.flagged:
+        r.driver = ("peak speed comes from the first instants, when the exhaust side still holds its "
+                    "initial pressure; the meter-out throttle model (series ISO 6358 conductance, no "
+                    "throttle check valve dynamics) and the assumed load set it")
+    comp.rows.append(r)
+    comp.rows.extend(_overall_rows(cfg))
+    comp.notes.append(
+        f"With lc = {cfg.p('controller.compensation_width'):.2f} V and K_P = {cfg.p('controller.kp'):.0f} V/m the "
+        f"compensated valve stays shut once |e| < {comp.stall_error * 1e3:.2f} mm: an ideal dead zone leaves steady "
+        f"errors up to that value, and stick-slip can end anywhere inside it. The paper measured 0.24-0.32 mm (up to "
+        f"0.8 mm): flow through the real valve near its null, or a narrower lc, closes that gap (reference-plant.md)."
+    )
+    return comp
+
+
+def _overall_rows(cfg: PlantConfig) -> list[Row]:
+    """The sinusoid (no paper figure) and the 1/2/5/10 % step campaign (paper: errors 0.5-0.8 % of stroke)."""
+    from compliance.simulation.profiles import sine
+
+    stroke = cfg.p("cylinder.stroke")
+    x0, load = 0.08, 5700.0
+    prof = sine(8e-3, 0.05, x0, start=1.0, duration=40.0)
+    df = simulate(cfg, Scenario(duration=41.0, initial_position=x0, reference=prof, load=load))
+    err = np.abs(df.reference.to_numpy() - df.position_true.to_numpy())[1000:]
+    rows = [Row("sinusoid 8 mm at pi/10 rad/s (80 mm, 5.7 kN)", "max tracking error", float(err.max()), None, "mm")]
+    worst = 0.0
+    for pct in (1, 2, 5, 10):
+        case = StepCase("", x0, load, cfg.p("controller.kd"), f"{pct}%@1s,-{pct}%@4s", 7.0, False, {})
+        for m in _step_metrics(cfg, case):
+            worst = max(worst, m.steady_state_error)
+    r = Row("1, 2, 5, 10 % steps up and down (80 mm, 5.7 kN)", "max steady error", 100 * worst / stroke, 0.8, "% stroke")
+    r.note = "paper: 0.5-0.8 % of stroke"
+    rows.append(r)
+    return rows
+
+
+def format_table(comp: Comparison) -> str:
+    """Plain-text table of the comparison with definitions and flags."""
+    lines = [
+        "Paper comparison, seed 000 section 5 (plant A)",
+        f"  settling time: from the step to the last exit from +/-{SETTLING_BAND:.0%} of the actual change around the settled position",
+        "  steady error: |set-point - mean position over the last 0.5 s before the next step|",
+        "  t_a / t_f: 25 % -> 75 % of stroke at full command with 2V2/2V3 installed, extrapolated to 100 %",
+        f"  flagged (!): settling off by > {SETTLING_TOLERANCE:.0%}, steady error off by > {STEADY_TOLERANCE * 1e3:.1f} mm",
+        "",
+        f"{'test':42s} {'metric':18s} {'simulated':>10s} {'paper':>8s}  ",
+    ]
+    for r in comp.rows:
+        scale = 1e3 if r.unit == "mm" else 1.0
+        sim = "-" if r.simulated is None else f"{r.simulated * scale:.3g}"
+        pap = "-" if r.paper is None else f"{r.paper * scale:.3g}"
+        flag = "!" if r.flagged else " "
+        lines.append(f"{r.test:42s} {r.metric:18s} {sim:>10s} {pap:>8s} {r.unit:4s}{flag}")
+        if r.flagged and r.driver:
+            lines.append(f"{'':42s}   -> {r.driver}")
+    lines.append("")
+    lines.extend("Note: " + n for n in comp.notes)
+    return "\n".join(lines)

@@ -1,0 +1,153 @@
+"""From an operating point to simulated runs: the steps every procedure runner shares.
+
+Where a run starts (the operating point's position inside the stroke), what load it holds,
+the full-command voltages, the one call into the simulator, and the samples every
+closed-loop run adds (peak speeds, valve saturation). No physics here: the plant is
+``compliance.simulation``'s.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from compliance import metrics as M
+from compliance.errors import InputError
+from compliance.simulation.scenario import scenario_load
+from compliance.procedures.outcomes import Sample, downsample
+
+__all__ = [
+    "add_drive_samples",
+    "closed_loop_trace",
+    "full_command",
+    "full_command_stroke",
+    "simulate_run",
+    "start_position",
+    "stroke",
+    "swing",
+]
+
+
+def stroke(cfg) -> float:
+    """Servomotor stroke of the plant [m]."""
+    return cfg.p("cylinder.stroke")
+
+
+def start_position(cfg, op, procedure) -> float:
+    """The operating point's initial position for ``procedure`` [m], inside the stroke.
+
+    Raises
+    ------
+    InputError
+        The operating point has no initial position, or it lies outside the stroke.
+    """
+    if op.initial_position is None:
+        raise InputError(f"operating point '{op.name}' has no initial_position, needed by procedure '{procedure.name}'")
+    x0 = op.initial_position.resolve(stroke(cfg))
+    if not 0.0 <= x0 <= stroke(cfg):
+        raise InputError(f"operating point '{op.name}': initial position {x0*1e3:.1f} mm is outside the stroke")
+    return x0
+
+
+def full_command(cfg, setting) -> tuple[float, float]:
+    """(opening, closing) full command voltages about the valve centre [V].
+
+    ``setting`` is ``"full"`` (the valve's command limit) or an Amount in volts.
+    """
+    centre = cfg.p("valve.centre_voltage")
+    mag = cfg.p("valve.command_limit") - abs(centre) if setting == "full" else setting.value
+    return centre + mag, centre - mag
+
+
+def simulate_run(cfg, duration, x0, *, reference=None, command=None, load=None, flow_control=None):
+    """Simulate one scenario (``compliance.simulation``, looked up at call time) -> DataFrame."""
+    from compliance.simulation import Scenario, simulate
+
+    return simulate(cfg, Scenario(duration, x0, reference=reference, command=command, load=load, flow_control=flow_control))
+
+
+def full_command_stroke(cfg, op, direction, command, duration, flow_control):
+    """Open-loop run at full valve command from the end of the stroke a ``direction`` starts at.
+
+    Parameters
+    ----------
+    cfg : PlantConfig
+    op : requirements.OperatingPoint
+        Its load is held.
+    direction : {"opening", "closing"}
+        Opening starts closed (x = 0), closing starts fully open (x = stroke).
+    command : "full" or Amount
+        Valve command magnitude about the centre [V].
+    duration : float
+        Simulated time [s].
+    flow_control : bool or None
+        Flow-control valves in the circuit (None = as configured).
+
+    Returns
+    -------
+    pandas.DataFrame
+    """
+    from compliance.simulation.profiles import Profile
+
+    u_open, u_close = full_command(cfg, command)
+    x0, u = (0.0, u_open) if direction == "opening" else (stroke(cfg), u_close)
+    return simulate_run(cfg, duration, x0, command=Profile.constant(u), load=scenario_load(cfg, op), flow_control=flow_control)
+
+
+def swing(cfg, proc, op) -> tuple[float, float]:
+    """Centre and amplitude of a set-point swinging about the operating point [m], inside the stroke.
+
+    The amplitude is the procedure's ``amplitude`` setting (possibly per cent of stroke).
+
+    Raises
+    ------
+    InputError
+        The operating point has no position inside the stroke, or ``x0 +/- amplitude``
+        leaves it (naming the procedure and the operating point).
+    """
+    stroke_length = stroke(cfg)
+    x0 = start_position(cfg, op, proc)
+    amplitude = proc.settings["amplitude"].resolve(stroke_length)
+    if x0 - amplitude < 0 or x0 + amplitude > stroke_length:
+        raise InputError(
+            f"procedure '{proc.name}' at '{op.name}': {x0*1e3:.1f} +/- {amplitude*1e3:.1f} mm leaves the stroke"
+        )
+    return x0, amplitude
+
+
+def closed_loop_trace(cfg, proc, op, out, duration, x0, reference):
+    """Simulate ``reference`` in closed loop at the operating point, keep its plot trace.
+
+    Parameters
+    ----------
+    cfg : PlantConfig
+    proc, op : requirements.Procedure, requirements.OperatingPoint
+    out : RunOutcome
+        Receives the downsampled trace, labelled ``procedure@operating_point``.
+    duration : float
+        Simulated time [s].
+    x0 : float
+        Initial position [m].
+    reference : profiles.Profile
+        Position set-point [m].
+
+    Returns
+    -------
+    tuple
+        (label, time [s], position [m], reference [m], valve command [V]) arrays.
+    """
+    df = simulate_run(cfg, duration, x0, reference=reference, load=scenario_load(cfg, op), flow_control=op.flow_control)
+    label = f"{proc.name}@{op.name}"
+    out.traces.append(downsample(df, label))
+    tt, x, r, u = M.frame_columns(df, "time", "position", "reference", "valve_command")
+    return label, tt, x, r, u
+
+
+def add_drive_samples(cfg, out, tt, x, u, label, t_from=-np.inf, t_to=np.inf):
+    """Add the peak speeds [m/s] and the valve-saturation fraction [-] of a window to ``out``."""
+    v, vo, vc = M.speed_extremes(tt, x, t_from, t_to)
+    for key, val in (("max_speed", v), ("max_opening_speed", vo), ("max_closing_speed", vc)):
+        out.add(key, Sample(val, label))
+    thr = cfg.p("valve.saturation_voltage")
+    centre = cfg.p("valve.centre_voltage")
+    out.add("saturation_fraction", Sample(M.saturation_fraction(tt, u - centre, thr, t_from, t_to), label,
+                                          detail={"threshold_V": thr}))

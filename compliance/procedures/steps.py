@@ -1,0 +1,172 @@
+"""The ``steps`` procedure: a set-point step sequence in closed loop, one step response per step.
+
+Every step metric is measured on every step with the options each requirement asks for. A
+time constant measured while the servo runs at its rate limit (valve command saturated, peak
+speed near the full-command peak, or mean speed up to 63.2 % near the speed the flow-control
+valves allow on the straight part of a full stroke, under the same load and circuit) is kept for the
+report but not eligible for a verdict: it then reflects flow saturation, not the linear
+time constant (IEC 61362 asks for small steps).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from compliance import metrics as M
+from compliance.model.dead_zone_stall import stall_error
+from compliance.errors import InputError
+from compliance.procedures.scenarios import add_drive_samples, closed_loop_trace, full_command_stroke, start_position, stroke
+from compliance.procedures.outcomes import Sample, request_key
+
+__all__ = ["RATE_LIMIT_FRACTION", "flow_saturation_voltage", "run_steps"]
+
+# a step whose peak speed reaches this fraction of the full-command speed is rate limited
+RATE_LIMIT_FRACTION = 0.9
+# a step counts for the time constant only if its 63.2 % point lies this many stall bands away
+# from the set-point: closer in, the response is governed by the valve dead zone, not the loop
+STALL_MARGIN = 2.0
+
+
+def _step_profile(x0, size, pattern, lead, dwell, stroke_length, where):
+    from compliance.simulation.profiles import Profile
+
+    for flip in (1.0, -1.0):
+        levels = [x0]
+        for d in pattern:
+            levels.append(levels[-1] + flip * (size if d == "up" else -size))
+        if all(-1e-12 <= v <= stroke_length + 1e-12 for v in levels):
+            times, values = [0.0], [x0]
+            for k, lv in enumerate(levels[1:]):
+                t = lead + k * dwell
+                times += [t, t]
+                values += [values[-1], lv]
+            used = pattern if flip > 0 else ["down" if d == "up" else "up" for d in pattern]
+            return Profile(np.array(times), np.array(values)), used, lead + len(pattern) * dwell
+    raise InputError(f"{where}: steps of {size*1e3:.1f} mm in the pattern {pattern} leave the stroke 0..{stroke_length*1e3:.0f} mm either way")
+
+
+def _full_command_speeds(cfg, op):
+    """Speeds at full command from each end under the operating point's load and circuit [m/s].
+
+    Returns ``{direction: (peak, straight)}``: the peak speed, and the speed of the straight part
+    of the stroke (25 % -> 75 %, or from 25 % to the end of the run if the stroke is slower), which
+    is the rate limit the flow-control valves set once the start-up surge has passed.
+    """
+    L = stroke(cfg)
+    res = {}
+    for d in ("opening", "closing"):
+        df = full_command_stroke(cfg, op, d, "full", 8.0, op.flow_control)
+        tt, x = M.frame_columns(df, "time", "position")
+        _, vo, vc = M.speed_extremes(tt, x)
+        travelled = x - x[0] if d == "opening" else x[0] - x
+        i25 = int(np.argmax(travelled >= 0.25 * L)) if np.any(travelled >= 0.25 * L) else None
+        straight = 0.0
+        if i25 is not None:
+            i75 = int(np.argmax(travelled >= 0.75 * L)) if np.any(travelled >= 0.75 * L) else len(tt) - 1
+            if i75 > i25:
+                straight = (travelled[i75] - travelled[i25]) / (tt[i75] - tt[i25])
+        res[d] = (vo if d == "opening" else vc, straight)
+    return res
+
+
+def flow_saturation_voltage(cfg, direction: int, flow_control: bool | None) -> float:
+    """Command magnitude beyond which the flow through the valve stops growing [V].
+
+    Without flow-control valves that is where the valve is fully open (``valve.saturation_voltage``).
+    With a meter-out throttle of conductance C_thr in the exhaust path, the path's conductance
+    1/sqrt(1/(A_re*C)^2 + 1/C_thr^2) (ISO 6358 series rule) is within 30 % of C_thr once
+    A_re*C >= C_thr: beyond the opening A_re = C_thr/C the throttle, not the valve, sets the
+    flow, so a step that drives the command past it is rate limited.
+    """
+    p = cfg.p
+    installed = cfg.flow_control_installed if flow_control is None else bool(flow_control)
+    dz = p("valve.dead_zone_positive") if direction > 0 else p("valve.dead_zone_negative")
+    u_sat = p("valve.saturation_voltage")
+    if not installed:
+        return u_sat
+    c_thr = p("flow_control.opening_conductance") if direction > 0 else p("flow_control.closing_conductance")
+    c = p("valve.sonic_conductance")
+    if c_thr <= 0.0 or c_thr >= c:
+        return u_sat
+    return dz + (u_sat - dz) * c_thr / c
+
+
+def _opts(options: dict) -> dict:
+    """Requirement options -> keyword arguments of metrics.step_response (SI)."""
+    kw = {}
+    for k in M.STEP_OPTION_DEFAULTS:
+        if k in options:
+            kw[k] = options[k].value
+    return kw
+
+
+def run_steps(cfg, proc, op, requests, out):
+    """Run a ``steps`` procedure at ``op`` and add its samples to ``out`` (see ``procedures.run``)."""
+    s = proc.settings
+    L = stroke(cfg)
+    x0 = start_position(cfg, op, proc)
+    size = s["size"].resolve(L)
+    ref, used, duration = _step_profile(x0, size, s["pattern"], s["lead"].value, s["dwell"].value, L,
+                                        f"procedure '{proc.name}' at '{op.name}'")
+    if used != s["pattern"]:
+        out.notes.append(f"pattern reversed to {used} to stay inside the stroke from {x0*1e3:.1f} mm")
+    label, tt, x, r, u = closed_loop_trace(cfg, proc, op, out, duration, x0, ref)
+    events = M.find_steps(tt, r, min_size=min(5e-5, 0.5 * size))
+    wants_tau = any(m == "time_constant" for m, _ in requests)
+    vmax = _full_command_speeds(cfg, op) if wants_tau else None
+    if vmax:
+        out.notes.append(
+            "rate limit check at full command under this load and circuit: peak "
+            f"{vmax['opening'][0]*1e3:.0f} / {vmax['closing'][0]*1e3:.0f} mm/s, straight part "
+            f"{vmax['opening'][1]*1e3:.0f} / {vmax['closing'][1]*1e3:.0f} mm/s (opening / closing)"
+        )
+    wanted = {m: (m, {}) for m, info in M.METRICS.items() if "steps" in info.kinds}
+    wanted.update({request_key(m, o): (m, o) for m, o in requests if "steps" in M.METRICS[m].kinds})
+    sat = {+1: flow_saturation_voltage(cfg, +1, op.flow_control), -1: flow_saturation_voltage(cfg, -1, op.flow_control)}
+    centre = cfg.p("valve.centre_voltage")
+    stall = {+1: stall_error(cfg, "opening"), -1: stall_error(cfg, "closing")}
+    per_opts: dict = {}
+    for key, (metric, opts) in wanted.items():
+        okey = request_key("", opts)
+        if okey not in per_opts:
+            per_opts[okey] = [M.step_response(tt, x, ev, valve_command=u - centre,
+                                              command_saturation=sat[1 if ev.size > 0 else -1], **_opts(opts))
+                              for ev in events]
+        for k, (ev, sm) in enumerate(zip(events, per_opts[okey])):
+            direction = "up" if ev.size > 0 else "down"
+            lab = f"step {k+1} {direction} {abs(ev.size)*1e3:.2f} mm at {ev.t_step:.2f} s"
+            detail = {"t_step": ev.t_step, "size": ev.size, "x_start": sm.x_start, "x_final": sm.x_final}
+            if metric in ("max_speed", "max_opening_speed", "max_closing_speed", "saturation_fraction"):
+                continue
+            val = getattr(sm, metric)
+            reason = sm.reasons.get(metric)
+            eligible = True
+            if metric == "time_constant" and val is not None:
+                if sm.rate_limited:
+                    eligible = False
+                elif (1.0 - M.TAU_FRACTION) * abs(ev.size) < STALL_MARGIN * stall[1 if ev.size > 0 else -1]:
+                    eligible = False
+                    reason = (f"dead-zone dominated: the 63.2 % point lies {(1 - M.TAU_FRACTION) * abs(ev.size) * 1e3:.2f} mm "
+                              f"from the set-point, inside {STALL_MARGIN:g} x the stall band "
+                              f"{stall[1 if ev.size > 0 else -1] * 1e3:.2f} mm "
+                              f"where the compensated valve shuts")
+                elif vmax is not None:
+                    peak, straight = vmax["opening" if ev.size > 0 else "closing"]
+                    mean_speed = M.TAU_FRACTION * abs(ev.size) / val if val > 0 else float("inf")
+                    if peak > 0 and sm.max_speed >= RATE_LIMIT_FRACTION * peak:
+                        eligible = False
+                        reason = (f"rate limited: peak speed {sm.max_speed*1e3:.0f} mm/s >= "
+                                  f"{RATE_LIMIT_FRACTION:.0%} of the full-command speed {peak*1e3:.0f} mm/s")
+                    elif straight > 0 and mean_speed >= RATE_LIMIT_FRACTION * straight:
+                        eligible = False
+                        reason = (f"rate limited: mean speed to 63.2 % {mean_speed*1e3:.0f} mm/s >= "
+                                  f"{RATE_LIMIT_FRACTION:.0%} of the flow-control speed {straight*1e3:.0f} mm/s "
+                                  f"(straight part of the full-command stroke)")
+                    detail["mean_speed_to_63"] = mean_speed
+                detail["peak_speed"] = sm.max_speed
+            out.add(key, Sample(val, lab, reason, eligible, detail))
+    # marks for plots (default options)
+    for k, (ev, sm) in enumerate(zip(events, per_opts[request_key("", {})])):
+        for name, v in sm.marks.items():
+            out.marks.append({"trace": label, "step": k + 1, "type": name, "value": v})
+    add_drive_samples(cfg, out, tt, x, u, label)

@@ -1,0 +1,111 @@
+"""Delimited text recordings: the canonical CSV (also ``.csv.gz``) and any table a column map describes.
+
+Comment and blank lines are skipped, a header line names the columns (or the map says
+``header = false`` and columns are taken by index), every cell must be a number. Errors name
+the file's own line numbers.
+"""
+
+from __future__ import annotations
+
+import gzip
+import io
+import re
+from pathlib import Path
+
+import pandas as pd
+
+from compliance.recordings.column_map import ColumnMap, ColumnSpec
+from compliance.errors import InputError
+from compliance.recordings.columns import RecordingSource, column_position, numeric_column
+
+__all__ = ["TEXT_SUFFIXES", "read_text_table"]
+
+TEXT_SUFFIXES = (".csv", ".txt", ".tsv", ".dat")
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _split(line: str, delim: str | None) -> list[str]:
+    return line.split() if delim is None else line.split(delim)
+
+
+def read_text_table(path: Path, cmap: ColumnMap | None) -> RecordingSource:
+    """Read a delimited text recording (see the module docstring) into raw float columns.
+
+    Raises
+    ------
+    InputError
+        Not UTF-8 text, no data, no header (or a bad one), a row with the wrong number of
+        fields, a cell that is not a number.
+    """
+    try:
+        if path.name.lower().endswith(".gz"):
+            with gzip.open(path, "rt", encoding="utf-8") as fh:
+                text = fh.read()
+        else:
+            text = path.read_text(encoding="utf-8")
+    except (UnicodeDecodeError, OSError, EOFError) as exc:
+        raise InputError(f"{path}: cannot read as UTF-8 text ({exc.__class__.__name__}: {exc})") from None
+    comment = cmap.comment if cmap else "#"
+    skip = cmap.skip_rows if cmap else 0
+    delim = cmap.delimiter if cmap else ","
+    header = cmap.header if cmap else True
+    numbers, lines = [], []
+    for no, line in enumerate(text.splitlines()[skip:], start=skip + 1):
+        stripped = line.strip()
+        if stripped and not stripped.startswith(comment):
+            numbers.append(no)
+            lines.append(line)
+    if not lines:
+        raise InputError(f"{path}: no data (only blank or '{comment}' comment lines)")
+    names = None
+    if header:
+        names = [h.strip().strip("\"'") for h in _split(lines[0], delim)]
+        if all(_is_number(h) for h in names):
+            raise InputError(
+                f"{path}: line {numbers[0]}: no header line (the first line is all numbers); the canonical "
+                f"CSV starts with column names (time,position,...), or give a column map with header = false"
+            )
+        for j, h in enumerate(names):
+            if not h:
+                raise InputError(f"{path}: line {numbers[0]}: header column {j + 1} has no name")
+            if h in names[:j]:
+                raise InputError(f"{path}: line {numbers[0]}: column name '{h}' appears twice in the header")
+        numbers, lines = numbers[1:], lines[1:]
+        if not lines:
+            raise InputError(f"{path}: a header but no data rows")
+    try:
+        table = pd.read_csv(
+            io.StringIO("\n".join(lines)),
+            header=None,
+            sep=r"\s+" if delim is None else delim,
+            skipinitialspace=True,
+            engine="c",
+        )
+    except pd.errors.ParserError as exc:
+        m = re.search(r"line (\d+), saw (\d+)", str(exc))
+        where = f"line {numbers[int(m.group(1)) - 1]}" if m else "a data line"
+        raise InputError(f"{path}: {where}: wrong number of fields ({exc})") from None
+    width = len(names) if names is not None else table.shape[1]
+    if table.shape[1] != width:
+        counts = [len(_split(line, delim)) for line in lines]
+        bad = next((i for i, c in enumerate(counts) if c != width), 0)
+        raise InputError(f"{path}: line {numbers[bad]}: {counts[bad]} fields, the header has {width}")
+    columns = []
+    for j in range(table.shape[1]):
+        col = table.iloc[:, j]
+        label = f"column '{names[j]}'" if names else f"column {j} (0-based)"
+        columns.append(numeric_column(col, lambda i, label=label: f"{path}: line {numbers[i]}, {label}"))
+    keys = names if names is not None else [str(j) for j in range(len(columns))]
+    too_few = f"the file has {len(columns)} columns"
+
+    def get(spec: ColumnSpec):
+        return columns[column_position(spec, keys, str(path), "column", too_few, "header has")], None
+
+    return RecordingSource(keys, get, lambda i: f"line {numbers[i]}")

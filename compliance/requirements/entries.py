@@ -1,0 +1,229 @@
+"""Build and check each merged entry of a requirement file: operating points, procedures, requirements.
+
+After ``extends`` has been merged (``compliance.requirements.loading``), every entry is turned into
+its frozen object (``compliance.requirements.requirement_set``) and checked for meaning: quantities with
+units, procedure kinds and their settings, metric names, comparators and limits, and that a
+requirement names operating points and procedures that exist and can measure its metric.
+Messages name the file that set the offending key.
+"""
+
+from __future__ import annotations
+
+from compliance.units.amounts import parse_amount
+from compliance.errors import did_you_mean
+from compliance.errors import InputError
+from compliance.metrics.catalogue import METRICS, STEP_OPTION_DEFAULTS
+from compliance.procedures.kinds import KINDS, parse_setting
+from compliance.requirements.schema import OPEN_LIMIT
+from compliance.requirements.requirement_set import LimitHistory, OperatingPoint, Procedure, Requirement
+from compliance.requirements.verdict import COMPARATORS
+
+__all__ = ["SEVERITIES", "SOURCES", "build_operating_point", "build_procedure", "build_requirement", "parse_limit"]
+
+SEVERITIES = ("mandatory", "advisory")
+SOURCES = ("simulation", "linear")
+
+
+def _where(origin, section, name, key):
+    """``"FILE: section.name.key"`` naming the file that set the key last."""
+    f = origin.get((section, name, key), "?")
+    return f"{f}: {section}.{name}.{key}"
+
+
+def build_operating_point(name: str, e: dict, origin) -> OperatingPoint:
+    """Operating point ``name`` from its merged table ``e``.
+
+    Parameters
+    ----------
+    name : str
+    e : dict
+        Merged keys of ``[operating_points.NAME]``.
+    origin : dict
+        (section, name, key) -> file that set it, for messages.
+    """
+    pos = None
+    if e.get("initial_position") is not None:
+        pos = parse_amount(e["initial_position"], "m", _where(origin, "operating_points", name, "initial_position"))
+    load_text = e.get("load", "none")
+    if load_text is None or load_text.strip().lower() in ("none", "0", ""):
+        load = None
+        load_text = "none"
+    elif load_text.strip().lower() in ("curve", "nominal"):
+        load = load_text.strip().lower()
+    else:
+        load = parse_amount(load_text, "N", _where(origin, "operating_points", name, "load")).value
+    return OperatingPoint(name, e.get("title") or name, pos, load, load_text, e.get("flow_control"), e.get("note") or "")
+
+
+def build_procedure(name: str, e: dict, origin) -> Procedure:
+    """Procedure ``name`` from its merged table: a known kind and its settings, defaults filled in.
+
+    Raises
+    ------
+    InputError
+        Missing or unknown kind, unknown setting, a required setting missing, a bad value.
+    """
+    where = _where(origin, "procedures", name, "kind")
+    kind = e.get("kind")
+    if kind is None:
+        raise InputError(f"{where}: missing 'kind' (one of {', '.join(KINDS)})")
+    if kind not in KINDS:
+        raise InputError(f"{where}: '{kind}' is not a procedure kind{did_you_mean(kind, KINDS)} (known: {', '.join(KINDS)})")
+    spec = KINDS[kind]
+    settings = {}
+    for k, v in e.items():
+        if k in ("kind", "title", "note"):
+            continue
+        if k not in spec.settings:
+            raise InputError(
+                f"{_where(origin, 'procedures', name, k)}: unknown setting for a '{kind}' procedure"
+                f"{did_you_mean(k, spec.settings)} (settings: {', '.join(spec.settings)})"
+            )
+        settings[k] = parse_setting(spec.settings[k], v, _where(origin, "procedures", name, k))
+    for k, s in spec.settings.items():
+        if k not in settings:
+            if s.default is None:
+                raise InputError(f"{origin.get(('procedures', name, 'kind'), '?')}: procedures.{name}: missing setting '{k}' ({s.meaning})")
+            settings[k] = parse_setting(s, s.default, f"default of {kind}.{k}")
+    return Procedure(name, kind, e.get("title") or name, settings, e.get("note") or "")
+
+
+def parse_limit(e: dict, where: str, metric: str, comparator: str):
+    """A requirement's limit in the metric's unit: one Amount, a (low, high) pair for ``within``,
+    or None when it is open (``"purchaser"``).
+
+    Raises
+    ------
+    InputError
+        Missing limit, a bare number, the wrong unit, a pair where one is expected (or the
+        reverse), low above high.
+    """
+    lim = e.get("limit")
+    if lim is None:
+        raise InputError(f"{where}: missing 'limit' (a quantity with a unit, a [low, high] pair for 'within', or '{OPEN_LIMIT}')")
+    if isinstance(lim, str) and lim.strip().lower() == OPEN_LIMIT:
+        return None
+    unit = METRICS[metric].si_unit
+    if comparator == "within":
+        if not isinstance(lim, list) or len(lim) != 2:
+            raise InputError(f"{where}: 'within' needs limit = [low, high], e.g. ['0.10 s', '0.25 s']")
+        a = (parse_amount(lim[0], unit, where), parse_amount(lim[1], unit, where))
+        if a[0].per_stroke == a[1].per_stroke and a[0].value > a[1].value:
+            raise InputError(f"{where}: low limit {a[0].text} is above high limit {a[1].text}")
+        return a
+    if isinstance(lim, list):
+        raise InputError(f"{where}: comparator '{comparator}' takes one limit, got a list")
+    return (parse_amount(lim, unit, where),)
+
+
+def build_requirement(rid, e, origin, defined_in, ops, procs, hist) -> Requirement:
+    """Requirement ``rid`` from its merged table, checked against the operating points and procedures.
+
+    Parameters
+    ----------
+    rid : str
+    e : dict
+        Merged keys of ``[requirements.ID]``.
+    origin : dict
+        (section, name, key) -> file that set it, for messages.
+    defined_in : str
+        File that first declared the requirement.
+    ops, procs : dict
+        Built operating points and procedures, by name.
+    hist : list of (file, dict)
+        The entry as each file in the chain left it (for the tighten / loosen check).
+
+    Raises
+    ------
+    InputError
+        A missing or unknown value, a metric the named procedures cannot measure, an
+        operating point without the initial position a procedure needs, an unknown option.
+    """
+    sec = "requirements"
+
+    def need(key, choices=None):
+        v = e.get(key)
+        if v is None:
+            raise InputError(f"{defined_in}: {sec}.{rid}: missing '{key}'" + (f" (one of {', '.join(choices)})" if choices else ""))
+        if choices is not None and v not in choices:
+            raise InputError(f"{_where(origin, sec, rid, key)}: '{v}' is not one of {', '.join(choices)}{did_you_mean(v, choices)}")
+        return v
+
+    title = need("title")
+    metric = need("metric", list(METRICS))
+    comparator = need("comparator", list(COMPARATORS))
+    severity = e.get("severity", "mandatory")
+    if severity not in SEVERITIES:
+        raise InputError(f"{_where(origin, sec, rid, 'severity')}: '{severity}' is not one of {', '.join(SEVERITIES)}")
+    source = e.get("source", "simulation")
+    if source not in SOURCES:
+        raise InputError(f"{_where(origin, sec, rid, 'source')}: '{source}' is not one of {', '.join(SOURCES)}")
+    limit = parse_limit(e, _where(origin, sec, rid, "limit"), metric, comparator)
+    op_names = tuple(e.get("operating_points") or ())
+    if not op_names:
+        raise InputError(f"{defined_in}: {sec}.{rid}: missing 'operating_points' (a list of names from [operating_points])")
+    for n in op_names:
+        if n not in ops:
+            raise InputError(f"{_where(origin, sec, rid, 'operating_points')}: operating point '{n}' is not declared{did_you_mean(n, ops)}")
+    proc_names = tuple(e.get("procedures") or ())
+    info = METRICS[metric]
+    if source == "simulation":
+        if not proc_names:
+            raise InputError(f"{defined_in}: {sec}.{rid}: missing 'procedures' (a list of names from [procedures])")
+        for n in proc_names:
+            if n not in procs:
+                raise InputError(f"{_where(origin, sec, rid, 'procedures')}: procedure '{n}' is not declared{did_you_mean(n, procs)}")
+            if procs[n].kind not in info.kinds:
+                raise InputError(
+                    f"{_where(origin, sec, rid, 'procedures')}: metric '{metric}' cannot be measured by procedure "
+                    f"'{n}' of kind '{procs[n].kind}' (it needs one of: {', '.join(info.kinds)})"
+                )
+            if procs[n].kind != "full_stroke" and procs[n].kind != "independent_adjustment":
+                for o in op_names:
+                    if ops[o].initial_position is None:
+                        raise InputError(
+                            f"{_where(origin, sec, rid, 'operating_points')}: operating point '{o}' has no "
+                            f"initial_position, which procedure '{n}' ({procs[n].kind}) needs"
+                        )
+    options = {}
+    for k, v in (e.get("options") or {}).items():
+        if k not in info.options:
+            raise InputError(
+                f"{_where(origin, sec, rid, 'options')}.{k}: metric '{metric}' takes no option '{k}'"
+                + (f"{did_you_mean(k, info.options)} (options: {', '.join(info.options)})" if info.options else "")
+            )
+        options[k] = parse_amount(v, STEP_OPTION_DEFAULTS[k][0], f"{_where(origin, sec, rid, 'options')}.{k}")
+    history = []
+    for fpath, snap in hist:
+        try:
+            lim = parse_limit(snap, f"{fpath}: {sec}.{rid}.limit", metric, snap.get("comparator", comparator))
+        except InputError:
+            lim = None if str(snap.get("limit", "")).lower() == OPEN_LIMIT else limit
+        history.append(
+            LimitHistory(
+                fpath,
+                snap.get("comparator", comparator),
+                lim,
+                snap.get("severity", "mandatory"),
+                bool(snap.get("enabled", True)),
+                bool(snap.get("allow_loosen", False)),
+            )
+        )
+    return Requirement(
+        id=rid,
+        title=title,
+        standard=e.get("standard", ""),
+        clause=need("clause"),
+        metric=metric,
+        comparator=comparator,
+        limit=limit,
+        procedures=proc_names,
+        operating_points=op_names,
+        severity=severity,
+        source=source,
+        options=options,
+        note=e.get("note", ""),
+        enabled=bool(e.get("enabled", True)),
+        defined_in=defined_in,
+        history=tuple(history),
+    )

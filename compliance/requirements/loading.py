@@ -1,0 +1,162 @@
+"""Requirement files: load TOML, follow ``extends``, validate with units, freeze.
+
+A requirement file (``requirements/*.toml``, schema ``govcheck-requirements/1``) declares
+operating points, test procedures and requirements, each a table keyed by its name or id.
+A file may ``extends`` others (a reference name such as ``"iec61362"`` or a path relative
+to the file); tables are merged key by key, the extending file winning. A limit may be
+tightened freely; loosening it (or lowering the severity, or disabling a requirement) must
+say ``allow_loosen = true`` and is reported. The format is described in docs/requirements.md.
+
+This module finds, reads and merges the files; the rest lives beside it:
+``requirement_schema`` (file structure), ``requirement_entries`` (each entry's meaning),
+``requirement_set`` (the frozen objects), ``amounts`` (``"1 %stroke"``) and
+``limit_tightening`` (:func:`check_tightening`).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import tomllib
+from importlib import resources
+from pathlib import Path
+
+from pydantic import BaseModel
+
+from compliance.units.amounts import Amount, parse_amount
+from compliance.errors import did_you_mean
+from compliance.errors import InputError
+from compliance.requirements.tightening import check_tightening
+from compliance.requirements.entries import SEVERITIES, SOURCES, build_operating_point, build_procedure, build_requirement
+from compliance.requirements.schema import OPEN_LIMIT, SCHEMA, validate_file
+from compliance.requirements.requirement_set import LimitHistory, OperatingPoint, Procedure, Requirement, RequirementSet
+
+__all__ = [
+    "OPEN_LIMIT",
+    "SCHEMA",
+    "SEVERITIES",
+    "SOURCES",
+    "Amount",
+    "LimitHistory",
+    "OperatingPoint",
+    "Procedure",
+    "Requirement",
+    "RequirementSet",
+    "check_tightening",
+    "load_requirements",
+    "parse_amount",
+    "reference_requirement_files",
+    "resolve_requirements_path",
+]
+
+
+def reference_requirement_files() -> list[str]:
+    """Names of the requirement files shipped with the package (``iec61362``, ...)."""
+    folder = resources.files("compliance") / "data" / "requirements"
+    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
+
+
+def resolve_requirements_path(source: str | os.PathLike, relative_to: Path | None = None, where: str = "") -> Path:
+    """Path of a requirement file given as a path or a reference name (``"iec61362"``)."""
+    s = str(source)
+    looks_like_path = s.endswith(".toml") or "/" in s or os.sep in s
+    if looks_like_path:
+        p = Path(s)
+        if relative_to is not None and not p.is_absolute():
+            p = relative_to / p
+        if not p.is_file():
+            raise InputError(f"{where or s}: requirement file '{s}' not found")
+        return p
+    ref = resources.files("compliance") / "data" / "requirements" / f"{s}.toml"
+    if not ref.is_file():
+        p = Path(s)
+        if p.is_file():
+            return p
+        names = reference_requirement_files()
+        raise InputError(
+            f"{where or s}: '{s}' is neither a file nor a reference requirement file{did_you_mean(s, names)} "
+            f"(known: {', '.join(names) or 'none'})"
+        )
+    return Path(str(ref))
+
+
+def _read_file(path: Path) -> tuple[dict, str]:
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read ({exc.strerror})") from None
+    try:
+        data = tomllib.loads(raw.decode("utf-8"))
+    except UnicodeDecodeError:
+        raise InputError(f"{path}: not a UTF-8 text file") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{path}: malformed TOML ({exc})") from None
+    return data, hashlib.sha256(raw).hexdigest()
+
+
+def _load_chain(path: Path, seen: tuple[str, ...]) -> list[tuple[Path, str, dict]]:
+    """Files in merge order (bases first), each (path, digest, raw dict) validated structurally."""
+    key = str(path.resolve())
+    if key in seen:
+        raise InputError(f"{path}: extends itself through {' -> '.join(seen)}")
+    data, digest = _read_file(path)
+    model = validate_file(data, path)
+    chain: list[tuple[Path, str, dict]] = []
+    bases = model.extends if isinstance(model.extends, list) else ([model.extends] if model.extends else [])
+    for base in bases:
+        bpath = resolve_requirements_path(base, path.parent, f"{path}: extends")
+        for item in _load_chain(bpath, seen + (key,)):
+            if all(str(item[0].resolve()) != str(c[0].resolve()) for c in chain):
+                chain.append(item)
+    chain.append((path, digest, model.model_dump(exclude_unset=True)))
+    return chain
+
+
+def load_requirements(source: str | os.PathLike) -> RequirementSet:
+    """Load a requirement file (path or reference name) with everything it extends.
+
+    Raises
+    ------
+    InputError
+        One message naming the file and key path of the first problem.
+    """
+    path = resolve_requirements_path(source)
+    chain = _load_chain(path, ())
+    merged: dict[str, dict[str, dict]] = {"operating_points": {}, "procedures": {}, "requirements": {}}
+    origin: dict[tuple[str, str, str], str] = {}
+    first_file: dict[tuple[str, str], str] = {}
+    history: dict[str, list[tuple[str, dict]]] = {}
+    top = chain[-1][2]
+    for fpath, _, data in chain:
+        fstd = data.get("standard", "")
+        for section in merged:
+            for name, entry in (data.get(section) or {}).items():
+                if isinstance(entry, BaseModel):
+                    entry = entry.model_dump(exclude_unset=True)
+                slot = merged[section].setdefault(name, {})
+                first_file.setdefault((section, name), str(fpath))
+                if section == "requirements" and "standard" not in slot and "standard" not in entry and fstd:
+                    slot["standard"] = fstd
+                for k, v in entry.items():
+                    slot[k] = v
+                    origin[(section, name, k)] = str(fpath)
+                if section == "requirements":
+                    history.setdefault(name, []).append((str(fpath), dict(slot)))
+    ops = {n: build_operating_point(n, e, origin) for n, e in merged["operating_points"].items()}
+    procs = {n: build_procedure(n, e, origin) for n, e in merged["procedures"].items()}
+    reqs = tuple(
+        build_requirement(rid, e, origin, first_file[("requirements", rid)], ops, procs, history[rid])
+        for rid, e in merged["requirements"].items()
+    )
+    if not reqs:
+        raise InputError(f"{path}: declares no requirements (a [requirements.ID] table)")
+    return RequirementSet(
+        name=top.get("name") or path.stem,
+        title=top.get("title") or top.get("name") or path.stem,
+        path=str(path),
+        digest=chain[-1][1],
+        files=tuple((str(p), d) for p, d, _ in chain),
+        operating_points=ops,
+        procedures=procs,
+        requirements=reqs,
+    )

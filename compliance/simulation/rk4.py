@@ -1,0 +1,97 @@
+"""The pieces every compiled loop shares: one RK4 step, one sample recorder, delay histories.
+
+The plant is integrated with classical RK4 at the pinned step ``simulation.step`` (several
+steps per controller sample). Valve and sensor delays use histories sampled on that grid,
+averaged over each step so results move continuously with the delay (the diagnosis fits need it).
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from compliance.model.assembly import plant_rhs
+from compliance.model.vector_slots import A_FRIC, A_LOAD, A_OPEN, A_QA, A_QB, P_HT_ON, P_PS, P_SD_ON, P_TS, S_PA, S_PB, S_PSUP, S_TA, S_TB, S_V, S_X
+
+OUTPUT_COLUMNS = (
+    "time", "position", "reference", "valve_command", "pressure_a", "pressure_b", "supply_pressure",
+    "position_true", "velocity", "load_force", "friction_force", "flow_a", "flow_b", "opening",
+    "temperature_a", "temperature_b", "command_demand",
+)
+(O_T, O_XM, O_REF, O_U, O_PA, O_PB, O_PS, O_X, O_V, O_LOAD, O_FRIC, O_QA, O_QB, O_OPEN, O_TA, O_TB, O_UD) = range(len(OUTPUT_COLUMNS))
+N_OUT = len(OUTPUT_COLUMNS)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def zoh_average(hist, ts, t_a, t_b):
+    """Average over [t_a, t_b] of the zero-order-hold signal hist[k] on [k*ts, (k+1)*ts)."""
+    n = hist.shape[0]
+    ka = int(math.floor(t_a / ts))
+    kb = int(math.floor(t_b / ts))
+    if ka < 0:
+        ka = -1
+    if kb < 0:
+        kb = -1
+    va = hist[0] if ka < 0 else hist[min(ka, n - 1)]
+    if ka == kb or t_b <= t_a:
+        return va
+    vb = hist[0] if kb < 0 else hist[min(kb, n - 1)]
+    t_sw = kb * ts
+    return (va * (t_sw - t_a) + vb * (t_b - t_sw)) / (t_b - t_a)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def interp_uniform(hist, h, t):
+    """Linear interpolation of a signal sampled every ``h`` from t = 0 (held before 0)."""
+    if t <= 0.0:
+        return hist[0]
+    f = t / h
+    i = int(math.floor(f))
+    n = hist.shape[0]
+    if i >= n - 1:
+        return hist[n - 1]
+    w = f - i
+    return hist[i] * (1.0 - w) + hist[i + 1] * w
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def record_sample(out, k, ts, xm, ref_k, u, u_d, y, aux, P):
+    """Write the canonical columns of controller sample ``k`` (shared by every compiled loop)."""
+    out[k, O_T] = k * ts
+    out[k, O_XM] = xm
+    out[k, O_REF] = ref_k
+    out[k, O_U] = u
+    out[k, O_PA] = y[S_PA]
+    out[k, O_PB] = y[S_PB]
+    out[k, O_PS] = y[S_PSUP] if P[P_SD_ON] != 0.0 else P[P_PS]
+    out[k, O_X] = y[S_X]
+    out[k, O_V] = y[S_V]
+    out[k, O_LOAD] = aux[A_LOAD]
+    out[k, O_FRIC] = aux[A_FRIC]
+    out[k, O_QA] = aux[A_QA]
+    out[k, O_QB] = aux[A_QB]
+    out[k, O_OPEN] = aux[A_OPEN]
+    out[k, O_TA] = y[S_TA] if P[P_HT_ON] != 0.0 else P[P_TS]
+    out[k, O_TB] = y[S_TB] if P[P_HT_ON] != 0.0 else P[P_TS]
+    out[k, O_UD] = u_d
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def rk4_step(y, P, u, lx, ly, h, k1, k2, k3, k4, tmp, aux, k1_ready=False):
+    """One classical RK4 step in place; ``k1_ready`` reuses a slope already evaluated at (y, u)."""
+    n = y.shape[0]
+    if not k1_ready:
+        plant_rhs(y, P, u, lx, ly, k1, aux)
+    for i in range(n):
+        tmp[i] = y[i] + 0.5 * h * k1[i]
+    plant_rhs(tmp, P, u, lx, ly, k2, aux)
+    for i in range(n):
+        tmp[i] = y[i] + 0.5 * h * k2[i]
+    plant_rhs(tmp, P, u, lx, ly, k3, aux)
+    for i in range(n):
+        tmp[i] = y[i] + h * k3[i]
+    plant_rhs(tmp, P, u, lx, ly, k4, aux)
+    for i in range(n):
+        y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+

@@ -1,0 +1,1 @@
+"""Model validation against a recording: replay, locate the mismatch, regimes, fit measures."""
