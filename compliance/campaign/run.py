@@ -20,7 +20,7 @@ import time
 from compliance.files.display import display_path
 from compliance import __version__
 from compliance.campaign.plan import Job, plan
-from compliance.campaign.executor import available_cores, execute, warm_up
+from compliance.campaign.executor import available_cores, execute
 from compliance.campaign.judge import fmt, judge, sample_dict
 from compliance.errors import InputError
 from compliance.requirements.tightening import check_tightening
@@ -62,10 +62,8 @@ def plant_section(cfg) -> dict:
         params.append({"key": key, "value": float(value), "unit": spec.unit if spec else "",
                        "meaning": spec.meaning if spec else "", "source": cfg.sources.get(key, "")})
     effects = []
-    try:
-        from compliance.effects import EFFECTS
-    except ImportError:  # pragma: no cover - effects registry always ships with the core
-        EFFECTS = {}
+    from compliance.effects import EFFECTS
+
     for name, values in cfg.effects.items():
         eff = EFFECTS.get(name)
         effects.append({

@@ -48,10 +48,8 @@ def renderer(args):
     """The report renderer when --report/--pdf is asked for (imported lazily)."""
     if not (args.report or args.pdf):
         return None
-    try:
-        from compliance.report.render import render_report
-    except ImportError:
-        raise InputError("report rendering not available") from None
+    from compliance.report.render import render_report
+
     return render_report
 
 

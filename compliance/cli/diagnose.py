@@ -126,11 +126,9 @@ def _print_servo(d: dict, quiet: bool) -> None:
 
 
 def _render_servo_report(cfg, frame, meta, diag, data: dict, html_path: str) -> None:
-    try:
-        from compliance.report.render import render_validation_report
-        from compliance.validation.validate import ValidationSettings, validate
-    except ImportError as exc:  # pragma: no cover - depends on the report engineer's module
-        raise InputError(f"--report: the report renderer is not available yet ({exc}); use --json") from None
+    from compliance.report.render import render_validation_report
+    from compliance.validation.validate import ValidationSettings, validate
+
     settings = ValidationSettings(modes=("closed_loop",)) if "reference" in frame.columns else ValidationSettings(modes=("plant_only",))
     result = validate(cfg, frame, meta, settings)
     diag_entry = {"explanation": data["explanation"], "verdict": data["verdict"], "added": [], "effects_ranked": data["effects"]}

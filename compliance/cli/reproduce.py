@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 
 from compliance.model.config import load_plant
 from compliance.errors import InputError

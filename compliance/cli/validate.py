@@ -67,10 +67,8 @@ def _params(items) -> dict:
 
 
 def _render(result: dict, html: str, pdf: str | None) -> None:
-    try:
-        from compliance.report.render import render_validation_report
-    except ImportError:
-        raise InputError("report rendering not available yet") from None
+    from compliance.report.render import render_validation_report
+
     render_validation_report(result, html, pdf_path=pdf)
 
 

@@ -15,7 +15,6 @@ plant and scores:
 
 from __future__ import annotations
 
-import math
 import time
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
@@ -322,11 +321,6 @@ def format_summary(report: dict) -> str:
         lines.append(f"not scored ({len(s['not_visible'])}): no concealed draw was visible above the noise: "
                      + ", ".join(f"{h['truth']} (seed {h['seed']}, said {h['predicted']})" for h in s["not_visible"]))
     return "\n".join(lines)
-
-
-def is_finite(x) -> bool:
-    """True for a finite float."""
-    return isinstance(x, float) and math.isfinite(x)
 
 
 # ------------------------------------------------------------------------ recordings with answers

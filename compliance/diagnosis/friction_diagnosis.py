@@ -31,7 +31,7 @@ from scipy.signal import savgol_filter
 
 from compliance.errors import InputError
 from compliance.units import ATMOSPHERE_PA
-from compliance.diagnosis.friction_fit import LAWS, PRESLIDING, PRESSURE_EFFECT, LawFit, fit_law, predict
+from compliance.diagnosis.friction_fit import LAWS, PRESLIDING, PRESSURE_EFFECT, LawFit, fit_law
 from compliance.diagnosis.friction_runs import Run
 from compliance.diagnosis.noise_floor import sensor_noise_std
 from compliance.diagnosis.report_data import SCHEMA

@@ -31,7 +31,7 @@ def seal_figures(seal) -> list[tuple[str, str]]:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from compliance.diagnosis.friction_diagnosis import predict
+    from compliance.diagnosis.friction_fit import predict
 
     runs = seal.runs
     base = seal.fits["baseline"]

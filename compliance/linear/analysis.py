@@ -22,7 +22,7 @@ from compliance.model.config import PlantConfig
 from compliance.model.pid_controller import first_order_filter_gain
 from compliance.errors import InputError
 from compliance.model.vector_slots import P_BV, P_MASS, P_NFR, P_STROKE
-from compliance.linear.trim import OperatingPoint, linearise_plant, minimal_realisation, pneumatic_stiffness, trim
+from compliance.linear.trim import TrimPoint, linearise_plant, minimal_realisation, pneumatic_stiffness, trim
 
 PADE_ORDER = 3  # delays as 3rd-order Pade: phase error < 1 deg up to omega*T = 2 (well beyond crossover)
 STEP_FRACTION = 0.05  # predicted step: 5 % of stroke (the linear shape does not depend on the size)
@@ -170,7 +170,7 @@ def _modes(sys):
 class LinearAnalysis:
     """Everything the linear model says at one operating point (SI; see ``to_dict``)."""
 
-    op: OperatingPoint
+    op: TrimPoint
     plant: control.StateSpace
     plant_minimal: control.StateSpace
     loop: control.StateSpace

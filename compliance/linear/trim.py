@@ -32,7 +32,7 @@ OPENING_PROBE = 1e-4  # relative valve opening used to measure the flow slope pe
 
 
 @dataclass(frozen=True)
-class OperatingPoint:
+class TrimPoint:
     """A trimmed operating point of the plant.
 
     Attributes
@@ -84,7 +84,7 @@ def _where(cfg: PlantConfig) -> str:
     return cfg.path or cfg.name
 
 
-def trim(cfg: PlantConfig, position: float, load: float | str | None = None, *, flow_control: bool | None = None) -> OperatingPoint:
+def trim(cfg: PlantConfig, position: float, load: float | str | None = None, *, flow_control: bool | None = None) -> TrimPoint:
     """Trim the nonlinear plant at rest at ``position`` under ``load``.
 
     Parameters
@@ -134,7 +134,7 @@ def trim(cfg: PlantConfig, position: float, load: float | str | None = None, *, 
     Pl = viscous_parameters(P)
     dy = rhs(Pl, y, null, cfg)
     scale = state_scales(Pl)
-    return OperatingPoint(float(position), load, f, float(pa), float(pb), y, Pl, float(null), float(np.max(np.abs(dy) / scale)))
+    return TrimPoint(float(position), load, f, float(pa), float(pb), y, Pl, float(null), float(np.max(np.abs(dy) / scale)))
 
 
 def _rest_pressures(P: np.ndarray, f: float):
@@ -212,7 +212,7 @@ def kept_states(P: np.ndarray) -> list[int]:
     return keep
 
 
-def state_jacobian(op: OperatingPoint, cfg: PlantConfig, keep: list[int]) -> np.ndarray:
+def state_jacobian(op: TrimPoint, cfg: PlantConfig, keep: list[int]) -> np.ndarray:
     """d(dy/dt)/dy over the kept states at the trim (central differences, scaled steps).
 
     Steps that would cross an end of the stroke are taken one-sided, so the end-stop spring
@@ -255,7 +255,7 @@ def valve_gain(cfg: PlantConfig, direction: str) -> float:
     return 1.0 / (md * span)
 
 
-def flow_columns(op: OperatingPoint, cfg: PlantConfig, keep: list[int]) -> tuple[np.ndarray, np.ndarray]:
+def flow_columns(op: TrimPoint, cfg: PlantConfig, keep: list[int]) -> tuple[np.ndarray, np.ndarray]:
     """Change of dy/dt per unit relative opening, opening (P->A, B->T) and closing (P->B, A->T) [per 1].
 
     Measured through ``plant_rhs`` by opening the valve just past each dead-zone edge by
@@ -279,7 +279,7 @@ def flow_columns(op: OperatingPoint, cfg: PlantConfig, keep: list[int]) -> tuple
     return cols[0], cols[1]
 
 
-def input_column(op: OperatingPoint, cfg: PlantConfig, keep: list[int], gain: str = "mean") -> tuple[np.ndarray, np.ndarray, dict]:
+def input_column(op: TrimPoint, cfg: PlantConfig, keep: list[int], gain: str = "mean") -> tuple[np.ndarray, np.ndarray, dict]:
     """Effective input column per volt of u_d and, with spool dynamics, the spool's flow column.
 
     Returns
@@ -303,7 +303,7 @@ def input_column(op: OperatingPoint, cfg: PlantConfig, keep: list[int], gain: st
     return Bu, b, info
 
 
-def linearise_plant(op: OperatingPoint, cfg: PlantConfig, gain: str = "mean"):
+def linearise_plant(op: TrimPoint, cfg: PlantConfig, gain: str = "mean"):
     """(A, B, C, state names, info) of u_d [V] -> position [m] at the trim ``op``."""
     keep = kept_states(op.params)
     A = state_jacobian(op, cfg, keep)
@@ -357,7 +357,7 @@ def _krylov(A, b, tol):
     return np.array(basis).T if basis else np.zeros((n, 0))
 
 
-def pneumatic_stiffness(op: OperatingPoint) -> float:
+def pneumatic_stiffness(op: TrimPoint) -> float:
     """Pneumatic spring k = gamma*(A_A^2 p_A/V_A + A_B^2 p_B/V_B) at the trim [N/m] (isentropic, Merritt 1967).
 
     Tandem: A_A = A_B = A_cap + A_rod (reference-plant.md); single: A_A = A_cap, A_B = A_rod.

@@ -2,14 +2,7 @@
 
 from __future__ import annotations
 
-import math
-
 from numba import njit
-
-
-def circle_area(diameter: float) -> float:
-    """Area of a circle [m^2] from its diameter [m]."""
-    return math.pi * diameter * diameter / 4.0
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -20,12 +13,6 @@ def tandem_volumes(x, stroke, dead_volume, area_cap, area_rod):
     """
     at = area_cap + area_rod
     return 2.0 * dead_volume + at * x, 2.0 * dead_volume + at * (stroke - x)
-
-
-@njit(cache=True, error_model="numpy", inline="always")
-def tandem_force(p_a, p_b, area_cap, area_rod):
-    """Net pneumatic force of the tandem pair F_p = (p_A - p_B)*(A_cap + A_rod) [N] (decoded seed 000 eq. 6)."""
-    return (p_a - p_b) * (area_cap + area_rod)
 
 
 @njit(cache=True, error_model="numpy", inline="always")

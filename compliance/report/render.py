@@ -199,15 +199,12 @@ def _common(results: dict) -> dict:
     v = dict(results.get("versions") or {})
     v.setdefault("govcheck", __version__)
     v.setdefault("python", platform.python_version())
-    try:
-        import matplotlib
-        import weasyprint
+    import matplotlib
+    import weasyprint
 
-        v.setdefault("matplotlib (report)", matplotlib.__version__)
-        v.setdefault("weasyprint (report)", weasyprint.__version__)
-        v.setdefault("jinja2 (report)", jinja2.__version__)
-    except ImportError:  # pragma: no cover - both are dependencies
-        pass
+    v.setdefault("matplotlib (report)", matplotlib.__version__)
+    v.setdefault("weasyprint (report)", weasyprint.__version__)
+    v.setdefault("jinja2 (report)", jinja2.__version__)
     return {"versions": v, "rendered": C.fmt_date(_now()), "govcheck_version": __version__}
 
 

@@ -19,8 +19,8 @@ from numba import njit
 from compliance.model.config import PlantConfig
 from compliance.model.pid_controller import dead_zone_compensation, pid_step, saturate
 from compliance.errors import InputError, SimulationError
-from compliance.model.vector_slots import A_FRIC, A_LOAD, A_OPEN, A_QA, A_QB, N_AUX, N_STATES, P_CDZN, P_CDZP, P_CSLN, P_CSLP, P_HT_ON, P_LC, P_PS, P_SD_ON
-from compliance.model.vector_slots import P_TS, P_UCEN, P_ULIM, P_VD_ON, S_PA, S_PB, S_PSUP, S_SP, S_TA, S_TB, S_V, S_X
+from compliance.model.vector_slots import N_AUX, N_STATES, P_CDZN, P_CDZP, P_CSLN, P_CSLP, P_LC
+from compliance.model.vector_slots import P_UCEN, P_ULIM, P_VD_ON, S_PA, S_PB, S_SP, S_V, S_X
 from compliance.model.assembly import initial_state, load_curve_arrays, parameter_vector, plant_rhs, valve_lag_input
 from compliance.simulation.rk4 import OUTPUT_COLUMNS, record_sample, rk4_step
 from compliance.simulation.scenario import Scenario, SensorNoise, sample_profile

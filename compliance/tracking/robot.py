@@ -17,7 +17,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import pandas as pd
 
 from compliance.model.config import PlantConfig
 from compliance.errors import InputError
@@ -144,14 +143,3 @@ def run_robot(robot: Robot, trajectory: Trajectory, *, mode: str | None = None, 
         df.attrs["axis"] = a.name
         frames[a.name] = df
     return RobotRun(trajectory, frames, robot)
-
-
-def combined_frame(run: RobotRun) -> pd.DataFrame:
-    """One frame with time, reference and position of the three axes (workspace coordinates) [m]."""
-    ref = run.stacked("reference")
-    pos = run.stacked("position")
-    data = {"time": run.time}
-    for i, n in enumerate(AXES):
-        data[f"reference_{n}"] = ref[:, i]
-        data[f"position_{n}"] = pos[:, i]
-    return pd.DataFrame(data)

@@ -9,7 +9,7 @@ import pytest
 from compliance.cli import main
 from compliance.campaign.regression_gate import compare, gate_markdown
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 REQS = """
 schema = "govcheck-requirements/1"

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from compliance.model.config import load_plant
-from compliance.model.vector_slots import A_FRIC, A_LOAD, N_AUX, N_STATES, S_V, S_X, S_X2
+from compliance.model.vector_slots import A_FRIC, A_LOAD, N_AUX, N_STATES, S_V, S_X2
 from compliance.model.assembly import initial_state, load_curve_arrays, parameter_vector, plant_rhs
 from compliance.simulation.profiles import Profile, steps
 from compliance.simulation import Scenario, simulate

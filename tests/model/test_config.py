@@ -12,7 +12,7 @@ from compliance.model.config import load_plant, save_plant
 from compliance.errors import InputError
 from compliance.units import parse_quantity
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_reference_sheet_values_in_si():

@@ -19,7 +19,7 @@ from compliance.recordings.column_map import load_column_map
 from compliance.errors import InputError
 from compliance.recordings.reader import read_recording, sidecar_path
 
-DATA = Path(__file__).parent / "data"
+DATA = Path(__file__).resolve().parents[1] / "data"
 ATM = 101325.0
 ZILLEN_NEEDS = ("time", "position", "pressure_a", "force")
 

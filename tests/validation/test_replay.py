@@ -27,7 +27,7 @@ from compliance.validation.replay import (
 )
 from compliance.validation.fit_metrics import fit_percent
 
-SHARED = Path(__file__).resolve().parents[2] / "shared" / "practice-recordings"
+SHARED = Path(__file__).resolve().parents[3] / "shared" / "practice-recordings"
 OUTPUTS = ("position", "pressure_a", "pressure_b")
 
 

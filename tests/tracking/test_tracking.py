@@ -24,7 +24,7 @@ from compliance.model.observers import observe
 from compliance.tracking.paths import circle, read_path_csv, stroke_path, time_parameterise
 from compliance.simulation.state_feedback_loop import AxisReference, simulate_axis
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 TS = 1e-3
 
 

@@ -40,7 +40,7 @@ from compliance.physics import friction as phys_friction
 from compliance.physics import valve_flow as phys_flow
 from compliance.recordings.reader import read_recording
 
-DATA = Path(__file__).parent / "data"
+DATA = Path(__file__).resolve().parents[1] / "data"
 ATM = 101325.0
 K_SIGMA = 4.0  # |estimate - truth| < 4 standard errors: a false failure has probability ~6e-5 per check
 ISO_TRUE = {"conductance": 2.33e-8, "critical_ratio": 0.3}  # plant A's valve rating, a typical real b

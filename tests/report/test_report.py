@@ -1,7 +1,7 @@
 """HTML and PDF reports: self-contained, escaped, complete, atomic; checked as a reader would.
 
 The fixture ``tests/data/results_fixture.json`` is a trimmed real run (see ``regenerate``
-at the bottom: ``python -m tests.test_report --regenerate`` rebuilds it from
+at the bottom: ``python -m tests.report.test_report --regenerate`` rebuilds it from
 ``govcheck check plant-a -r shpp-400kw``, ``govcheck linear`` and ``govcheck validate``).
 """
 
@@ -26,7 +26,7 @@ from compliance.report import render as R
 from compliance.report.figures import decimate
 from compliance.report.render import render_report, render_validation_report
 
-FIXTURE = Path(__file__).parent / "data" / "results_fixture.json"
+FIXTURE = Path(__file__).resolve().parents[1] / "data" / "results_fixture.json"
 EVIL = "<script>alert(1)</script>"
 
 
@@ -354,7 +354,7 @@ def regenerate(path: Path = FIXTURE) -> None:  # pragma: no cover - run by hand
         "trimmed real run: govcheck check plant-a -r requirements/shpp-400kw.toml --json; runs " + ", ".join(keep)
         + " kept with traces cut to 300 points; 'linear' = govcheck linear plant-a --map --crosscheck --governor --json "
         "(Bode cut to 60 points); 'validation' = govcheck validate practice_internal_leakage.csv.gz --plant plant-a "
-        "--json (overlays cut to 300 points); rebuilt by python -m tests.test_report --regenerate")
+        "--json (overlays cut to 300 points); rebuilt by python -m tests.report.test_report --regenerate")
     path.write_text(json.dumps(res, separators=(",", ":")) + "\n", encoding="utf-8")
     print(f"wrote {path} ({path.stat().st_size / 1e3:.0f} kB)")
 

@@ -19,7 +19,7 @@ from compliance.model import axis_design as design
 from compliance.characterise import flow_rating
 from compliance.characterise.flow_trend import flow_claim
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 GAMMA, R, T = 1.4, 287.0, 293.15
 
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 import pytest
@@ -148,7 +147,7 @@ def test_step_halving_convergence(cfg):
 @pytest.mark.slow
 def test_agrees_with_independent_solve_ivp_model(cfg):
     """The compiled core and an independent Radau implementation agree within 0.1 mm on a 2 % step."""
-    from tests import reference_model as ref
+    from tests.simulation import reference_model as ref
 
     x0, load, kd = 0.136, 11400.0, 6.0
     prof = steps("2%@0.1s", x0, STROKE)

@@ -9,7 +9,7 @@ from compliance.cli import main
 from compliance.errors import InputError
 from compliance.requirements.loading import check_tightening, load_requirements, reference_requirement_files
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 STROKE = 0.160
 
 MINIMAL = """
