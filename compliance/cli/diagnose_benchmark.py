@@ -13,9 +13,8 @@ directory instead and scores them against its ANSWERS.json. Exit 0 when the targ
 from __future__ import annotations
 
 import argparse
-import json
-from pathlib import Path
 
+from compliance.cli.common import add_jobs, add_outputs, add_quiet, add_reproducible, check_args_outputs
 from compliance.errors import InputError
 
 TOP1_TARGET = 0.9
@@ -36,7 +35,7 @@ def register(sub):
             "examples:\n"
             "  govcheck diagnose-benchmark --cases 3 --seed 1 --json bench.json\n"
             "  govcheck diagnose-benchmark --effects heat_transfer,internal_leakage --cases 2 --jobs 2\n"
-            "  govcheck diagnose-benchmark --practice /work/shared/practice-recordings"
+            "  govcheck diagnose-benchmark --practice tests/data/practice"
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -45,11 +44,13 @@ def register(sub):
     p.add_argument("--seed", type=int, default=1, help="seed of the case generator (default 1)")
     p.add_argument("--effects", help="effects to generate cases of (default: all declared)")
     p.add_argument("--library", help="candidate effects the diagnosis chooses from (default: all declared)")
-    p.add_argument("--jobs", type=int, default=None, help="cases diagnosed in parallel (default: the available cores)")
+    add_jobs(p, "cases diagnosed in parallel")
     p.add_argument("--no-null", action="store_true", help="no null cases")
     p.add_argument("--no-miscalibrations", action="store_true", help="no miscalibrated-parameter cases")
     p.add_argument("--practice", help="diagnose the recordings of this directory and score them against its ANSWERS.json")
-    p.add_argument("--json", dest="json_out", help="write every case and the summary to this JSON file")
+    add_outputs(p, "json", help={"json": "write every case and the summary to FILE.json"})
+    add_quiet(p, "no per-case lines; print only the summary")
+    add_reproducible(p)
     return p
 
 
@@ -65,17 +66,11 @@ def _names(text: str | None, option: str):
     return names
 
 
-def _write(path: str, data: dict) -> None:
-    target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    target.write_text(json.dumps(data, indent=1, default=_plain) + "\n", encoding="utf-8")
+def _write(args, data: dict) -> None:
+    from compliance.files.atomic import write_json_atomic
+    from compliance.files.reproducible import is_reproducible, make_reproducible
 
-
-def _plain(x):
-    try:
-        return float(x)
-    except (TypeError, ValueError):
-        return str(x)
+    write_json_atomic(args.json, make_reproducible(data) if is_reproducible(args.reproducible) else data)
 
 
 def run(args) -> int:
@@ -84,6 +79,7 @@ def run(args) -> int:
     from compliance.diagnosis.benchmark import format_summary, run_benchmark, run_practice
     from compliance.diagnosis.engine import default_jobs
 
+    check_args_outputs(args)
     if args.cases < 1:
         raise InputError(f"--cases {args.cases}: expected at least 1")
     jobs = default_jobs() if args.jobs is None else args.jobs
@@ -98,21 +94,26 @@ def run(args) -> int:
             print(f"{mark} {row['name']:32s} truth {row['truth']:18s} -> {row['verdict']:16s} {row['winner'] or '-':28s} "
                   f"{row['seconds']:5.1f} s  {row['parameters']}")
         print(f"\n{rep['correct']}/{len(rep['recordings'])} practice recordings diagnosed correctly")
-        if args.json_out:
-            _write(args.json_out, rep)
+        if args.json:
+            _write(args, rep)
         return 0 if rep["correct"] == len(rep["recordings"]) else 1
 
-    def progress(r):
-        mark = "OK " if r.correct else "BAD"
-        err = "" if r.main_error is None else f" main-parameter error {100*r.main_error:.1f} %"
-        print(f"{mark} {r.kind:14s} {r.truth:28s} -> {r.predicted:28s} {r.seconds:5.1f} s{err}", flush=True)
+    from compliance.cli.progress import progress as progress_bar
 
-    rep = run_benchmark(cfg, effects=_names(args.effects, "--effects"), cases=args.cases, seed=args.seed, library=library,
-                        jobs=jobs, null=not args.no_null, miscalibrations=not args.no_miscalibrations, progress=progress)
+    with progress_bar(None, "diagnose-benchmark", quiet=args.quiet, unit="case") as bar:
+        def progress(r):
+            mark = "OK " if r.correct else "BAD"
+            err = "" if r.main_error is None else f" main-parameter error {100*r.main_error:.1f} %"
+            if not args.quiet:
+                print(f"{mark} {r.kind:14s} {r.truth:28s} -> {r.predicted:28s} {r.seconds:5.1f} s{err}", flush=True)
+            bar.update(1)
+
+        rep = run_benchmark(cfg, effects=_names(args.effects, "--effects"), cases=args.cases, seed=args.seed, library=library,
+                            jobs=jobs, null=not args.no_null, miscalibrations=not args.no_miscalibrations, progress=progress)
     print()
     print(format_summary(rep))
-    if args.json_out:
-        _write(args.json_out, rep)
+    if args.json:
+        _write(args, rep)
     s = rep["summary"]
     ok = (s["top1_accuracy"] is None or s["top1_accuracy"] >= TOP1_TARGET) and (s["null_accuracy"] is None or s["null_accuracy"] >= NULL_TARGET)
     return 0 if ok else 1

@@ -22,27 +22,13 @@ from compliance.model.config import PlantConfig
 from compliance.model.pid_controller import first_order_filter_gain
 from compliance.errors import InputError
 from compliance.model.vector_slots import P_BV, P_MASS, P_NFR, P_STROKE
+from compliance.files.jsonable import jsonable  # the one JSON cleaner (re-exported for linear/*)
 from compliance.linear.trim import TrimPoint, linearise_plant, minimal_realisation, pneumatic_stiffness, trim
 
 PADE_ORDER = 3  # delays as 3rd-order Pade: phase error < 1 deg up to omega*T = 2 (well beyond crossover)
 STEP_FRACTION = 0.05  # predicted step: 5 % of stroke (the linear shape does not depend on the size)
 METRIC_NAMES = ("time_constant", "gain_margin_db", "phase_margin_deg", "bandwidth_hz", "damping_ratio",
                 "pneumatic_damping_ratio", "natural_frequency_hz", "dominant_time_constant")
-
-
-def jsonable(obj):
-    """Plain Python copy of ``obj``: numpy scalars/arrays to float/list, non-finite floats to None."""
-    if isinstance(obj, dict):
-        return {str(k): jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple, np.ndarray)):
-        return [jsonable(v) for v in obj]
-    if isinstance(obj, (bool, np.bool_)):
-        return bool(obj)
-    if isinstance(obj, (int, np.integer)):
-        return int(obj)
-    if isinstance(obj, (float, np.floating)):
-        return float(obj) if math.isfinite(obj) else None
-    return obj
 
 
 def _pade_ss(delay, order=PADE_ORDER):
