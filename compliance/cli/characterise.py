@@ -109,13 +109,23 @@ def _run_valve(args) -> int:
         supply = meta["conditions"]["supply_pressure"]
     if args.window is not None and (args.window < 5 or args.window % 2 == 0):
         raise InputError(f"--window: must be an odd number of samples >= 5, got {args.window}")
-    result = characterise_valve(
-        frame, volume, supply_pressure=supply, exhaust_pressure=exhaust, temperature=temperature,
-        pressure_column=args.pressure_column, mode=args.mode, window=args.window, laws=laws, source=args.recording,
-    )
+    if not volume > 0:
+        raise InputError(f"--volume {args.volume!r}: expected a positive volume such as '1 L'")
+    try:
+        result = characterise_valve(
+            frame, volume, supply_pressure=supply, exhaust_pressure=exhaust, temperature=temperature,
+            pressure_column=args.pressure_column, mode=args.mode, window=args.window, laws=laws, source=args.recording,
+        )
+    except InputError as exc:
+        if args.recording in str(exc):
+            raise
+        raise InputError(f"{args.recording}: {exc}") from None
     print(_valve_table(result))
     if args.json:
-        _write_json(args.json, result.to_dict())
+        data = result.to_dict()
+        for row, fit in zip(data["ranking"], result.fits):
+            row["implausible"] = fit.implausible  # never ranked best (compliance.characterise.flow_law)
+        _write_json(args.json, data)
     if args.plot:
         from compliance.characterise.plots import plot_valve
 
@@ -141,7 +151,8 @@ def _valve_table(r) -> str:
     ]
     for i, fit in enumerate(r.fits, 1):
         params = ", ".join(f"{k} = {_fmt(v, fit.stderr.get(k))} {fit.units.get(k, '').strip('-')}".rstrip() for k, v in fit.params.items())
-        lines.append(f"{i:<5}{fit.law:<12}{fit.aic:>10.1f}{fit.rms * 1e3:>12.4g}  {params}")
+        lines.append(f"{i:<5}{fit.law:<12}{fit.aic:>10.1f}{fit.rms * 1e3:>12.4g}  {params}"
+                     + (f"  NOT PHYSICAL: {fit.implausible}" if fit.implausible else ""))
     best = r.best
     if best.law == "iso6358":
         c = best.params["conductance"]

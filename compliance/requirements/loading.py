@@ -27,6 +27,7 @@ from compliance.units.amounts import Amount, parse_amount
 from compliance.errors import did_you_mean
 from compliance.errors import InputError
 from compliance.requirements.tightening import check_tightening
+from compliance.requirements.limit_sign import check_limit_signs
 from compliance.requirements.entries import SEVERITIES, SOURCES, build_operating_point, build_procedure, build_requirement
 from compliance.requirements.schema import OPEN_LIMIT, SCHEMA, validate_file
 from compliance.requirements.requirement_set import LimitHistory, OperatingPoint, Procedure, Requirement, RequirementSet
@@ -150,6 +151,7 @@ def load_requirements(source: str | os.PathLike) -> RequirementSet:
     )
     if not reqs:
         raise InputError(f"{path}: declares no requirements (a [requirements.ID] table)")
+    check_limit_signs(reqs, origin)
     return RequirementSet(
         name=top.get("name") or path.stem,
         title=top.get("title") or top.get("name") or path.stem,
