@@ -32,7 +32,9 @@ def run(args) -> int:
     check_args_outputs(args)
     cfg = plant_from_args(args)
     if cfg.options["cylinder.arrangement"] != "tandem":
-        raise InputError(f"{cfg.path or cfg.name}: the paper comparison exists for the tandem gate servo (plant A) only")
+        from compliance.files.display import display_path
+
+        raise InputError(f"{display_path(cfg.path) or cfg.name}: the paper comparison exists for the tandem gate servo (plant A) only")
     comp = compare(cfg, explain=not args.no_explain)
     print(format_table(comp))
     if args.json:

@@ -37,7 +37,8 @@ def check_output(path, flag: str, suffixes: tuple[str, ...] | None = None) -> No
         raise InputError(f"{flag}: empty path; expected a file name")
     folder = p.parent if str(p.parent) else Path(".")
     if p.is_dir():
-        raise InputError(f"{flag} {path}: is a folder; expected a file path such as {Path(path) / ('out' + (suffixes[0] if suffixes else '.json'))}")
+        example = Path(path) / ("results" + (suffixes[0] if suffixes else ".json"))
+        raise InputError(f"{flag} {path}: is a folder; expected a file name (e.g. {example})")
     if suffixes:
         name = p.name.lower()
         if not any(name.endswith(s) for s in suffixes):
@@ -46,7 +47,7 @@ def check_output(path, flag: str, suffixes: tuple[str, ...] | None = None) -> No
         raise InputError(f"{flag} {path}: folder '{folder}' does not exist (govcheck does not create folders)")
     if not os.access(folder, os.W_OK | os.X_OK):
         raise InputError(f"{flag} {path}: folder '{folder}' is not writable")
-    if p.exists() and not os.access(p, os.W_OK):
+    if p.exists() and (not os.access(p, os.W_OK) or not p.stat().st_mode & 0o222):  # mode bits too: root may write anything
         raise InputError(f"{flag} {path}: the file exists and is read-only; govcheck does not replace it")
 
 
