@@ -3,7 +3,7 @@
 ``synthesise`` runs the closed-loop practice test (ANSWERS.md of the practice recordings)
 on any configuration, with the practice sensors, and returns a canonical recording with its
 sidecar metadata; ``write_recording`` stores it as the canonical CSV (optionally gzip) plus
-the ``NAME.toml`` sidecar of ``/work/shared/recording-format.md``. The validation tests and
+the ``NAME.toml`` sidecar of docs/recording-format.md. The validation tests and
 the diagnosis benchmarks use both.
 """
 
