@@ -95,7 +95,8 @@ def run(args) -> int:
     cfg = plant_from_args(args)
     reqset = load_requirements(args.requirements)
     stages = 1 + bool(args.linear) + (render is not None)
-    with progress(stages, "check", quiet=args.quiet or sys.stderr.isatty(), unit="stage") as bar:
+    # the campaign reports its runs itself; these are the stages (one line each in a CI log)
+    with progress(stages, "check", quiet=args.quiet or sys.stderr.isatty(), unit="stage", heartbeat=False) as bar:
         bar.set_postfix_str("campaign")
         results = run_campaign(cfg, reqset, workers=args.jobs, progress=not args.quiet, command_line=command_line(args))
         bar.update(1)

@@ -95,7 +95,12 @@ def run(args) -> int:
         raise InputError(f"{args.recordings[0]}: no CONFIG given and the sidecar names no 'plant'")
     cfg = load_plant(plant)
     check_sidecar_conditions(cfg, meta, args.recordings[0])
-    diag = diagnose(cfg, frame, meta, effects=effects, jobs=args.jobs, recalibrate=not args.no_recalibration)
+    from compliance.cli.progress import progress
+
+    with progress(1, "diagnose", quiet=args.quiet, unit="stage") as bar:
+        bar.set_postfix_str("replay, locate, fit every candidate")
+        diag = diagnose(cfg, frame, meta, effects=effects, jobs=args.jobs, recalibrate=not args.no_recalibration)
+        bar.update(1)
     unsaved = None
     if args.save_model:
         if diag.fitted_cfg is None:

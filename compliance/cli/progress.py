@@ -1,13 +1,16 @@
 """Progress for the commands: a tqdm bar on a terminal, periodic one-line updates in a CI log.
 
-On a terminal tqdm redraws one line; when stderr is a file or a pipe (CI), every update is
-a complete line of its own, at most one every ``LOG_INTERVAL`` seconds plus the first and the
-last, so a log shows that something is happening without filling up.
+On a terminal tqdm redraws one line; when stderr is a file or a pipe (CI), every update is a
+complete line of its own, at most one every ``LOG_INTERVAL`` seconds plus the first and the
+last, and a long stage without updates still prints its elapsed time every ``LOG_INTERVAL``
+seconds, so a CI log shows that something is happening without filling up.
 """
 
 from __future__ import annotations
 
+import contextlib
 import sys
+import threading
 
 LOG_INTERVAL = 10.0  # [s] between lines when stderr is not a terminal
 
@@ -27,18 +30,37 @@ class _LineWriter:
         self.stream.flush()
 
 
-def progress(total: int, desc: str, *, quiet: bool = False, unit: str = "step"):
-    """A tqdm progress bar on stderr (disabled when ``quiet``).
+def _heartbeat(bar, stop: threading.Event) -> None:
+    while not stop.wait(LOG_INTERVAL):
+        bar.refresh()  # one line with the elapsed time, even while a single stage runs
 
-    Use as a context manager; call ``.update(1)`` per item and ``.set_postfix_str(text)`` for
-    the item's name.
+
+@contextlib.contextmanager
+def progress(total: int | None, desc: str, *, quiet: bool = False, unit: str = "step", heartbeat: bool = True):
+    """A tqdm progress bar on stderr (disabled when ``quiet``), as a context manager.
+
+    Call ``.update(1)`` per item and ``.set_postfix_str(text)`` for the item's name. ``heartbeat``
+    (not on a terminal): a line with the elapsed time every ``LOG_INTERVAL`` seconds even without
+    updates; switch it off where the work itself reports per item.
     """
     from tqdm import tqdm
 
     tty = hasattr(sys.stderr, "isatty") and sys.stderr.isatty()
-    return tqdm(
+    bar = tqdm(
         total=total, desc=desc, unit=unit, disable=quiet, leave=tty,
         file=sys.stderr if tty else _LineWriter(sys.stderr),
-        mininterval=0.1 if tty else LOG_INTERVAL, maxinterval=LOG_INTERVAL if not tty else 10.0,
+        mininterval=0.1 if tty else LOG_INTERVAL, maxinterval=LOG_INTERVAL,
         ascii=not tty, dynamic_ncols=tty, ncols=None if tty else 100,
     )
+    stop = threading.Event()
+    beat = None
+    if heartbeat and not tty and not quiet and LOG_INTERVAL > 0:
+        beat = threading.Thread(target=_heartbeat, args=(bar, stop), daemon=True)
+        beat.start()
+    try:
+        yield bar
+    finally:
+        stop.set()
+        if beat is not None:
+            beat.join()
+        bar.close()

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from compliance.cli.common import (add_outputs, add_reproducible, check_args_outputs, check_sidecar_conditions,
+from compliance.cli.common import (add_outputs, add_quiet, add_reproducible, check_args_outputs, check_sidecar_conditions,
                                    parse_param_overrides, sidecar_plant, split_config)
 from compliance.errors import InputError
 from compliance.files.atomic import write_json_atomic
@@ -53,6 +53,7 @@ def register(sub):
                    help="override one plant parameter in SI, e.g. friction.bristle_stiffness=1e6 (repeatable)")
     add_outputs(p, "json", "report", "pdf", help={"json": "write the results (docs/validation-schema.md) to FILE.json",
                                                   "pdf": "also write the report as PDF to FILE.pdf (with --report)"})
+    add_quiet(p, "print only the result line")
     add_reproducible(p)
     p.add_argument("--max-windows", type=int, default=30, help="located windows printed per mode (default 30; all are in --json)")
     return p
@@ -168,7 +169,8 @@ def run(args) -> int:
         cfg = cfg.replace(params=params)
     check_sidecar_conditions(cfg, meta, recording)
     result = validate(cfg, df, meta, settings)
-    print(format_summary(result, args.max_windows))
+    summary = format_summary(result, args.max_windows)
+    print(summary.rstrip().splitlines()[-1] if args.quiet else summary)
     written = _finish(result, args)
     if args.json:
         write_json_atomic(args.json, written)

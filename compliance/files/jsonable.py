@@ -14,7 +14,7 @@ from pathlib import PurePath
 
 import numpy as np
 
-__all__ = ["json_text", "jsonable"]
+__all__ = ["json_number", "json_text", "jsonable"]
 
 
 def jsonable(obj):
@@ -41,6 +41,14 @@ def jsonable(obj):
     if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
         return jsonable(dataclasses.asdict(obj))
     return obj
+
+
+def json_number(value) -> float | None:
+    """One number for JSON: a finite float, or None (for None, NaN and infinities)."""
+    if value is None:
+        return None
+    f = float(value)
+    return f if math.isfinite(f) else None
 
 
 def json_text(data, *, indent: int | None = 1, compact: bool = False) -> str:

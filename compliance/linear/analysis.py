@@ -22,7 +22,7 @@ from compliance.model.config import PlantConfig
 from compliance.model.pid_controller import first_order_filter_gain
 from compliance.errors import InputError
 from compliance.model.vector_slots import P_BV, P_MASS, P_NFR, P_STROKE
-from compliance.files.jsonable import jsonable  # the one JSON cleaner (re-exported for linear/*)
+from compliance.files.jsonable import json_number, jsonable  # the one JSON cleaner (re-exported for linear/*)
 from compliance.linear.trim import TrimPoint, linearise_plant, minimal_realisation, pneumatic_stiffness, trim
 
 PADE_ORDER = 3  # delays as 3rd-order Pade: phase error < 1 deg up to omega*T = 2 (well beyond crossover)
@@ -294,7 +294,7 @@ def _figures(cfg, op, plant, gmin, Lc, Ld, T, Td, n_freq, detail):
     if detail:
         mc = margins(Lc, floor)
         f.update(gain_margin_db_continuous=mc["gain_margin_db"], phase_margin_deg_continuous=mc["phase_margin_deg"])
-    f["bandwidth_hz"] = _finite(control.bandwidth(T) / (2 * math.pi)) if f["stable"] else None
+    f["bandwidth_hz"] = json_number(control.bandwidth(T) / (2 * math.pi)) if f["stable"] else None
     # predicted step (discrete closed loop: what the sampled controller does) and its time constant
     tau_guess = f["dominant_time_constant"] or f["first_order_time_constant"] or 0.2
     dur = float(np.clip(12.0 * tau_guess, 1.5, 30.0))
@@ -335,10 +335,6 @@ def _figures(cfg, op, plant, gmin, Lc, Ld, T, Td, n_freq, detail):
                  "time_continuous": tc[::4].tolist(), "position_continuous": (op.position + size * yc[::4]).tolist()},
     }
     return f, data
-
-
-def _finite(v):
-    return float(v) if v is not None and np.isfinite(v) else None
 
 
 _CACHE: dict = {}
