@@ -202,22 +202,8 @@ def _product(**axes):
     return tuple(out)
 
 
-# effect -> starting points (parameters not named stay at their declared default)
-SCAN_GRIDS: dict[str, tuple[dict, ...]] = {
-    "heat_transfer": _product(conductance=(0.3, 1.0, 3.0, 10.0, 30.0, 100.0)),
-    "internal_leakage": _product(conductance=(3e-12, 1e-11, 3e-11, 1e-10, 3e-10, 1e-9)),
-    "external_leakage": _product(conductance=(3e-12, 1e-11, 3e-11, 1e-10, 3e-10, 1e-9)),
-    # a spool near the loop's bandwidth trades frequency, damping and delay: start in each basin
-    "valve_dynamics": _product(natural_frequency=(20.0, 30.0, 45.0, 70.0, 120.0, 250.0), damping=(0.5, 1.0),
-                               delay=(0.0, 0.006, 0.012, 0.02)),
-    "supply_droop": _product(reservoir_volume=(0.003, 0.02, 0.1), regulator_conductance=(1e-8, 1e-7, 1e-6)),
-    "pressure_dependent_friction": _product(coefficient=(1e-4, 3e-4, 1e-3, 2e-3)),
-    "valve_offset": _product(offset=(-0.4, -0.2, -0.1, 0.1, 0.2, 0.4)),
-    "position_dependent_load": _product(stiffness=(-1e5, -3e4, -1e4, 1e4, 3e4, 1e5)),
-    "sensor_lag": _product(time_constant=(0.002, 0.004, 0.008, 0.015, 0.03, 0.06), delay=(0.0, 0.002, 0.004, 0.007)),
-    "line_dynamics": _product(volume=(1e-4, 5e-4, 2e-3), conductance=(1e-8, 3e-8, 1e-7)),
-    "linkage_compliance": _product(stiffness=(3e4, 1e5, 4e5, 1.5e6, 6e6), damping=(300.0, 3000.0)),
-}
+# effect -> starting points (parameters not named stay at their declared default): ``Effect.fit_grid``
+SCAN_GRIDS: dict[str, tuple[dict, ...]] = {name: _product(**eff.fit_grid) for name, eff in EFFECTS.items()}
 
 # multiplicative steps tried in the 1-D scan of a base parameter (factor of 10 for the LuGre
 # stiffness, which data sheets rarely give within a decade)
