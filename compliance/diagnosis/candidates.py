@@ -20,12 +20,6 @@ from compliance.effects import EFFECTS
 from compliance.model.parameters import BASE_BY_KEY
 
 FRICTION_LEVEL = "friction.level"  # pseudo-parameter: one factor on static and Coulomb friction together
-# LuGre pre-sliding parameters: BASE_PARAMS declares no fit_bounds for them (reported to the lead);
-# these bounds span pneumatic seals (Canudas de Wit 1995: sigma0 ~ 1e5..1e8 N/m).
-_EXTRA_FIT_BOUNDS = {
-    "friction.bristle_stiffness": (1e5, 1e8, True),
-    "friction.bristle_damping": (0.0, 1e5, False),
-}
 # Base parameters the diagnosis may recalibrate, in the order they are tried (brief, issue 6:
 # valve sonic conductance, friction levels, dead volume, mass; plus the LuGre pre-sliding pair).
 BASE_REFIT = (
@@ -129,14 +123,11 @@ def base_param(cfg: PlantConfig, key: str) -> FitParam | None:
         return FitParam(key, "base", "", 0.25, max(hi, 1.01), True, 1.0, True)
     if key.startswith("friction.bristle") and cfg.option("friction.model") != "lugre":
         return None
-    if key in _EXTRA_FIT_BOUNDS:
-        lo, hi, log = _EXTRA_FIT_BOUNDS[key]
-    else:
-        spec = BASE_BY_KEY[key]
-        if spec.fit_bounds is None:
-            return None
-        lo, hi = spec.fit_bounds
-        log = lo > 0.0 and hi / lo > 20.0
+    spec = BASE_BY_KEY[key]
+    if spec.fit_bounds is None:
+        return None
+    lo, hi = spec.fit_bounds
+    log = lo > 0.0 and hi / lo > 20.0  # a range of decades is fitted in log space
     nominal = cfg.p(key)
     if not lo <= nominal <= hi:
         lo, hi = min(lo, nominal), max(hi, nominal)

@@ -48,6 +48,7 @@ BASE_PARAMS: tuple[Param, ...] = (
     _P("friction.stribeck_velocity", "m/s", "Stribeck velocity v_s", None, 0.0, 10.0, True, slot="v_stribeck"),
     _P("friction.viscous_coefficient", "N*s/m", "viscous coefficient b per cylinder", None, 0.0, 1e7, fit_bounds=(0.0, 5000.0), slot="viscous"),
     _P("friction.limit_velocity", "m/s", "limit speed below which the body sticks (variable viscous model)", 0.001, 0.0, 1.0, True, slot="v_limit"),
+    # LuGre pre-sliding fit ranges span pneumatic seals (Canudas de Wit et al. 1995: sigma0 ~ 1e5..1e8 N/m)
     _P("friction.bristle_stiffness", "N/m", "LuGre bristle stiffness sigma0", 1e6, 0.0, 1e12, True, fit_bounds=(1e5, 1e8), slot="sigma0"),
     _P("friction.bristle_damping", "N*s/m", "LuGre bristle damping sigma1", 3.873e3, 0.0, 1e9, fit_bounds=(0.0, 1e5), slot="sigma1"),
     _P("end_stop.stiffness", "N/m", "end-stop contact stiffness", 1e8, 0.0, 1e12, True, slot="k_stop"),
