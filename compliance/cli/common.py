@@ -173,10 +173,11 @@ def parse_param_overrides(items, option: str = "--param") -> dict:
             value = float(v)
         except ValueError:
             raise InputError(f"{option} {k}: '{v}' is not a number (give SI units, {spec.unit or 'dimensionless'})") from None
-        low_ok = value > spec.low if spec.low_open else value >= spec.low
-        if not (low_ok and value <= spec.high):
+        low, high = spec.bounds
+        low_ok = value > low if spec.low_open else value >= low
+        if not (low_ok and value <= high):
             bracket = "(" if spec.low_open else "["
-            raise InputError(f"{option} {k}={v}: outside the admissible range {bracket}{spec.low:g}, {spec.high:g}] "
+            raise InputError(f"{option} {k}={v}: outside the admissible range {bracket}{low:g}, {high:g}] "
                              f"{spec.unit} ({spec.meaning})")
         out[k] = value
     return out
