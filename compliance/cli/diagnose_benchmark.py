@@ -1,6 +1,6 @@
 """``govcheck diagnose-benchmark``: prove the diagnosis on generated concealed-effect recordings.
 
-    govcheck diagnose-benchmark [--cases N] [--seed S] [--effects a,b] [--library a,b] [--jobs N]
+    govcheck diagnose-benchmark [CONFIG] [--cases N] [--seed S] [--effects a,b] [--library a,b] [--jobs N]
                                 [--no-null] [--no-miscalibrations] [--practice DIR] [--json out.json]
 
 Generates N concealed cases per effect (plus null and miscalibrated-parameter cases) from the
@@ -14,7 +14,8 @@ from __future__ import annotations
 
 import argparse
 
-from compliance.cli.common import add_jobs, add_outputs, add_quiet, add_reproducible, check_args_outputs
+from compliance.cli.common import (add_jobs, add_outputs, add_plant_argument, add_quiet, add_reproducible,
+                                   check_args_outputs, plant_from_args)
 from compliance.errors import InputError
 
 TOP1_TARGET = 0.9
@@ -35,11 +36,11 @@ def register(sub):
             "examples:\n"
             "  govcheck diagnose-benchmark --cases 3 --seed 1 --json bench.json\n"
             "  govcheck diagnose-benchmark --effects heat_transfer,internal_leakage --cases 2 --jobs 2\n"
-            "  govcheck diagnose-benchmark --practice tests/data/practice"
+            "  govcheck diagnose-benchmark models/plant-a.toml --practice tests/data/practice"
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("--plant", default="plant-a", help="plant the cases are generated from and diagnosed against (default plant-a)")
+    add_plant_argument(p, help="plant configuration the cases are generated from and diagnosed against (default plant-a)")
     p.add_argument("--cases", type=int, default=3, help="cases per effect and null cases (default 3)")
     p.add_argument("--seed", type=int, default=1, help="seed of the case generator (default 1)")
     p.add_argument("--effects", help="effects to generate cases of (default: all declared)")
@@ -75,7 +76,6 @@ def _write(args, data: dict) -> None:
 
 def run(args) -> int:
     """Run the benchmark; 0 when the targets are met, 1 when not."""
-    from compliance.model.config import load_plant
     from compliance.diagnosis.benchmark import format_summary, run_benchmark, run_practice
     from compliance.diagnosis.engine import default_jobs
 
@@ -85,7 +85,7 @@ def run(args) -> int:
     jobs = default_jobs() if args.jobs is None else args.jobs
     if jobs < 1:
         raise InputError(f"--jobs {jobs}: expected a positive number of worker processes")
-    cfg = load_plant(args.plant)
+    cfg = plant_from_args(args, fallback="plant-a")
     library = _names(args.library, "--library")
     if args.practice:
         rep = run_practice(args.practice, cfg, library=library, jobs=jobs)

@@ -265,6 +265,8 @@ case("diag-unknown-effect", "diagnose plant.toml rec.csv --effects warp_drive -q
 case("diag-save-model-exists", "diagnose plant.toml rec.csv --save-model plant.toml", "exists already")
 case("diag-jobs-zero", "diagnose plant.toml rec.csv -j 0", "--jobs")
 case("bench-cases-zero", "diagnose-benchmark --cases 0", "--cases")
+case("bench-plant-conflict", "diagnose-benchmark plant-a --plant plant-b", "two plant configurations")
+case("bench-practice-no-answers", "diagnose-benchmark --practice out", "ANSWERS.json")
 case("bench-unknown-effect", "diagnose-benchmark --effects warp_drive", "warp_drive")
 case("report-not-json", "report rec.csv --report out/r.html", "not a JSON")
 case("report-wrong-schema", "report out/good.json --report out/r.html", "good.json")
