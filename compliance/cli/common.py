@@ -134,12 +134,13 @@ def quantity(text: str | None, si_unit: str, option: str, default: float | None 
 
 
 def cylinder_force_limit(cfg) -> float:
-    """Largest force the cylinder can produce: (p_s - p_atm) x piston area x pistons [N]."""
+    """Largest force the cylinder can produce: (p_s - p_atm) x the pressurised area [N] (docs/reference-plant.md)."""
     import math
 
-    area = math.pi / 4.0 * cfg.p("cylinder.piston_diameter") ** 2
-    pistons = 2 if cfg.options.get("cylinder.arrangement") == "tandem" else 1
-    return (cfg.p("air.supply_pressure") - cfg.p("air.atmospheric_pressure")) * area * pistons
+    cap = math.pi / 4.0 * cfg.p("cylinder.piston_diameter") ** 2
+    rod = cap - math.pi / 4.0 * cfg.p("cylinder.rod_diameter") ** 2
+    area = cap + rod if cfg.options.get("cylinder.arrangement") == "tandem" else cap  # tandem: A_cap + A_rod per side
+    return (cfg.p("air.supply_pressure") - cfg.p("air.atmospheric_pressure")) * area
 
 
 def check_load_force(cfg, load, where: str) -> None:

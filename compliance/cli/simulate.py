@@ -46,7 +46,7 @@ def register(sub):
     p.add_argument("--duration", default="10 s", help=f"simulated time (default 10 s, at most {MAX_DURATION:g} s)")
     p.add_argument("--flow-control", choices=("on", "off"), help="install/remove the 2V2/2V3 flow-control valves (default: as configured)")
     p.add_argument("--noise", action="store_true", help="add seeded sensor noise (20 um position, 300 Pa pressures, 16-bit)")
-    p.add_argument("--seed", type=int, default=0, help="noise seed (default 0)")
+    p.add_argument("--seed", type=int, default=0, help="noise seed, a whole number >= 0 (default 0)")
     p.add_argument("-o", "--output", required=True, metavar="FILE.csv", help="output file: .csv, .csv.gz or .parquet (the sidecar FILE.toml goes beside it)")
     p.add_argument("--plot", metavar="FILE.png", help="also write a plot of position, command and pressures (.png, .svg or .pdf)")
     return p
@@ -74,6 +74,9 @@ def _duration(cfg, text: str) -> float:
     duration = quantity(text, "s", "--duration")
     if not duration > 0:
         raise InputError(f"--duration {text!r}: must be a positive time")
+    ts = cfg.p("controller.sample_time")
+    if duration < 2 * ts:
+        raise InputError(f"--duration {text!r}: shorter than two controller samples ({2 * ts * 1e3:g} ms); nothing would be simulated")
     if duration > MAX_DURATION:
         raise InputError(f"--duration {text!r}: longer than the {MAX_DURATION:g} s one simulation may cover; split the test")
     samples = duration / cfg.p("controller.sample_time")
@@ -87,7 +90,7 @@ def _check_within(profile: Profile | None, duration: float, option: str) -> None
     if profile is None:
         return
     last = float(max(profile.times))
-    if last > duration:
+    if last > duration * (1 + 1e-12) + 1e-9:
         raise InputError(f"{option}: an event at t = {last:g} s is later than --duration {duration:g} s; "
                          "lengthen --duration or drop the event")
 
@@ -109,10 +112,12 @@ def build_scenario(cfg, args):
         _check_within(ref, duration, "--steps")
     elif args.sine:
         ref = parse_sine(args.sine, x0, duration)
-        _check_within(Profile([float(min(ref.times))], [0.0]), duration, "--sine start")
+        _check_within(ref, duration, "--sine (its START)")  # a sine starting after the end would be dropped
     elif args.open_loop_command:
         cmd = _command_profile(args.open_loop_command, cfg.p("valve.command_limit"))
         _check_within(cmd, duration, "--command")
+    if args.seed < 0:
+        raise InputError(f"--seed {args.seed}: expected a whole number >= 0")
     fc = None if args.flow_control is None else args.flow_control == "on"
     noise = SensorNoise(20e-6, 10e-6, 300.0, 1e6 / 65536) if args.noise else None
     return Scenario(duration=duration, initial_position=x0, reference=ref, command=cmd, load=load,

@@ -147,6 +147,8 @@ def run(args) -> int:
     if mode not in MODES + ("both",):
         raise InputError(f"--mode '{args.mode}' is not one of closed_loop, plant_only, both")
     modes = MODES if mode == "both" else (mode,)
+    if args.max_windows < 0:
+        raise InputError(f"--max-windows {args.max_windows}: expected a number of windows >= 0")
     if args.pdf and not args.report:
         raise InputError("--pdf needs --report FILE.html")
     check_args_outputs(args)  # fail before the work, nothing written

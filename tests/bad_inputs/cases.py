@@ -234,6 +234,10 @@ for cid, extra, frag in [
     ("sim-load-1e9", "--load 1e9", "largest force"),
     ("sim-load-wrong-unit", "--load 11mm", "--load"),
     ("sim-sine-syntax", "--sine 8mm", "--sine"),
+    ("sim-sine-after-duration", "--sine 8mm,1Hz,20s --duration 5", "later than --duration"),
+    ("sim-sine-zero-frequency", "--sine 8mm,0Hz", "frequency"),
+    ("sim-duration-one-sample", "--duration 1e-9", "two controller samples"),
+    ("sim-seed-negative", "--seed -1", "--seed"),
     ("sim-plant-conflict", "--plant plant-b", "two plant configurations"),
 ]:
     case(cid, f"{SIM} {extra}", frag)
@@ -246,6 +250,12 @@ case("gate-candidate-conflict", "gate plant.toml --candidate plant-b --baseline 
 case("gate-baseline-not-results", "gate plant.toml --baseline out/good.json", "missing from the results file")
 case("gate-baseline-missing", "gate plant.toml --baseline out/none.json", "not found")
 case("gate-no-requirements", "gate plant.toml --baseline plant-a", "--requirements")
+case("validate-negative-max-windows", "validate plant.toml rec.csv --max-windows -1", "--max-windows")
+case("validate-bad-noise", "validate plant.toml rec.csv --noise loud", "loud")
+case("validate-settings-missing", "validate plant.toml rec.csv --settings nothere.toml", "nothere.toml")
+case("linear-at-above-stroke", "linear plant.toml --at 200%", "outside the stroke")
+case("linear-load-too-large", "linear plant.toml --load 1e9", "cannot be held")
+case("gate-baseline-folder", "gate plant.toml --baseline a-folder.json", "is a folder")
 case("validate-bad-mode", "validate plant.toml rec.csv --mode sideways", "sideways")
 case("validate-param-negative-mass", "validate plant.toml rec.csv --param cylinder.moving_mass=-5", "moving_mass")
 case("validate-param-unknown", "validate plant.toml rec.csv --param cylinder.mass=5", "not a plant parameter")

@@ -132,6 +132,7 @@ def build(ws: Path) -> None:
     (out / "good.pdf").write_bytes(b"%PDF-1.4 good\n")
     (out / "good.csv").write_text("time,position\n0,0\n", encoding="utf-8")
     (out / "a-folder.json").mkdir()
+    (ws / "a-folder.json").mkdir()
     (out / "a-folder.html").mkdir()
     (out / "a-folder.pdf").mkdir()
     ro = out / "readonly.json"
