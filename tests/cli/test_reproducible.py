@@ -71,3 +71,17 @@ def test_gate_markdown_and_json_byte_identical(runs):
     assert codes[4] == codes[5] == 0
     assert (d / "e.md").read_bytes() == (d / "f.md").read_bytes()
     assert (d / "e.json").read_bytes() == (d / "f.json").read_bytes()
+
+
+def test_validate_and_linear_json_byte_identical(tmp_path, monkeypatch):
+    from tests.bad_inputs import workspace as W
+
+    W.build(tmp_path)
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.delenv("SOURCE_DATE_EPOCH", raising=False)
+    for name in ("v1", "v2"):
+        assert main(["validate", "plant.toml", "rec.csv", "--json", f"{name}.json", "-q", "--reproducible"]) == 0
+    assert (tmp_path / "v1.json").read_bytes() == (tmp_path / "v2.json").read_bytes()
+    for name in ("l1", "l2"):
+        assert main(["linear", "plant.toml", "--json", f"{name}.json", "-q", "--reproducible"]) == 0
+    assert (tmp_path / "l1.json").read_bytes() == (tmp_path / "l2.json").read_bytes()
