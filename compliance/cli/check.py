@@ -95,21 +95,20 @@ def run(args) -> int:
     cfg = plant_from_args(args)
     reqset = load_requirements(args.requirements)
     stages = 1 + bool(args.linear) + (render is not None)
-    # the campaign reports its runs itself; these are the stages (one line each in a CI log)
-    with progress(stages, "check", quiet=args.quiet or sys.stderr.isatty(), unit="stage", heartbeat=False) as bar:
-        bar.set_postfix_str("campaign")
+    # the campaign reports its runs itself on a terminal; in a CI log these stage lines (and a heartbeat) show progress
+    with progress(stages, "check", quiet=args.quiet or sys.stderr.isatty(), unit="stage", first="campaign") as bar:
         results = run_campaign(cfg, reqset, workers=args.jobs, progress=not args.quiet, command_line=command_line(args))
         bar.update(1)
         if args.linear:
             from compliance.linear.operating_points import linear_for_campaign
 
-            bar.set_postfix_str("linear analysis")
+            bar.set_postfix_str("linear analysis", refresh=False)
             results["linear"] = linear_for_campaign(cfg, reqset)
             bar.update(1)
         results = finish_results(results, args)
         table = summary_table(results)
         if render is not None:
-            bar.set_postfix_str("report")
+            bar.set_postfix_str("report", refresh=False)
             render(results, html_path=args.report, pdf_path=args.pdf)
             bar.update(1)
     if args.quiet:

@@ -97,8 +97,7 @@ def run(args) -> int:
     check_sidecar_conditions(cfg, meta, args.recordings[0])
     from compliance.cli.progress import progress
 
-    with progress(1, "diagnose", quiet=args.quiet, unit="stage") as bar:
-        bar.set_postfix_str("replay, locate, fit every candidate")
+    with progress(1, "diagnose", quiet=args.quiet, unit="stage", first="replay, locate, fit every candidate") as bar:
         diag = diagnose(cfg, frame, meta, effects=effects, jobs=args.jobs, recalibrate=not args.no_recalibration)
         bar.update(1)
     unsaved = None
