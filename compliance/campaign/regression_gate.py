@@ -34,6 +34,23 @@ def not_evaluated_reason(entry: dict | None) -> str | None:
     return "; ".join(reasons) if reasons else "no reason recorded"
 
 
+def _status_reasons(rid: str, b: dict | None, c: dict | None, why: str | None, allowed: bool):
+    """Why a status change trips the gate (list), and the note of an explicitly allowed one (or None)."""
+    bs = b["status"] if b else "absent"
+    cs = c["status"] if c else "absent"
+    if b is not None and c is None:
+        return ["requirement removed in the candidate"], None
+    if b is None and cs == "fail":
+        return ["new requirement fails"], None
+    if cs == "not_evaluated" and (bs == "pass" or (bs == "fail" and c["severity"] == "mandatory")):
+        if allowed:
+            return [], f"{bs} -> not_evaluated allowed explicitly (--allow-not-evaluated {rid}): {why}"
+        return [f"{bs} -> not_evaluated: could not be evaluated: {why}"], None
+    if bs == "pass" and cs != "pass":
+        return [f"{bs} -> {cs}"], None
+    return [], None
+
+
 def compare(baseline: dict, candidate: dict, max_margin_loss: float | None = None,
             allow_not_evaluated: tuple[str, ...] | list[str] = ()) -> dict:
     """Compare two results dicts.
@@ -70,19 +87,8 @@ def compare(baseline: dict, candidate: dict, max_margin_loss: float | None = Non
         bs = b["status"] if b else "absent"
         cs = c["status"] if c else "absent"
         delta = None if bm is None or cm is None else cm - bm
-        reasons, allowed_note = [], None
         why = not_evaluated_reason(c)
-        if b is not None and c is None:
-            reasons.append("requirement removed in the candidate")
-        elif b is None and cs == "fail":
-            reasons.append("new requirement fails")
-        elif cs == "not_evaluated" and (bs == "pass" or (bs == "fail" and c["severity"] == "mandatory")):
-            if rid in allowed:
-                allowed_note = f"{bs} -> not_evaluated allowed explicitly (--allow-not-evaluated {rid}): {why}"
-            else:
-                reasons.append(f"{bs} -> not_evaluated: could not be evaluated: {why}")
-        elif bs == "pass" and cs != "pass":
-            reasons.append(f"{bs} -> {cs}")
+        reasons, allowed_note = _status_reasons(rid, b, c, why, rid in allowed)
         if max_margin_loss is not None and delta is not None and -delta > max_margin_loss:
             reasons.append(f"margin lost {-delta:.1f} pp > {max_margin_loss:g} pp allowed")
         if reasons:
