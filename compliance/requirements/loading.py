@@ -8,9 +8,9 @@ tightened freely; loosening it (or lowering the severity, or disabling a require
 say ``allow_loosen = true`` and is reported. The format is described in docs/requirements.md.
 
 This module finds, reads and merges the files; the rest lives beside it:
-``requirement_schema`` (file structure), ``requirement_entries`` (each entry's meaning),
-``requirement_set`` (the frozen objects), ``amounts`` (``"1 %stroke"``) and
-``limit_tightening`` (:func:`check_tightening`).
+``schema`` (file structure), ``entries`` (each entry's meaning), ``requirement_set`` (the
+frozen objects), ``compliance.units.amounts`` (``"1 %stroke"``) and ``tightening``
+(:func:`check_tightening`). The TOML itself is read by ``compliance.model.toml_file``.
 """
 
 from __future__ import annotations
