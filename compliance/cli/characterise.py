@@ -10,7 +10,7 @@ import argparse
 import math
 from pathlib import Path
 
-from compliance.cli.common import add_outputs, check_args_outputs
+from compliance.cli.common import add_outputs, check_args_outputs, wrap_description
 from compliance.errors import InputError
 from compliance.units import parse_quantity
 
@@ -20,9 +20,9 @@ def register(subparsers):
     p = subparsers.add_parser(
         "characterise",
         help="fit the valve flow law or the seal friction map to bench recordings",
-        description="Characterise the bench: valve flow law from charging/discharging a known volume "
+        description=wrap_description("Characterise the bench: valve flow law from charging/discharging a known volume "
         "(ISO 6358, Sanville, Bobrow, power laws ranked by AIC), or the friction-velocity map from "
-        "constant-speed runs (Coulomb, static, Stribeck velocity, viscous; optional pressure-dependent Coulomb).",
+        "constant-speed runs (Coulomb, static, Stribeck velocity, viscous; optional pressure-dependent Coulomb)."),
         epilog="examples:\n"
                "  govcheck characterise valve charge.csv --volume '1 L' --supply-pressure '8 bar abs' --json valve.json\n"
                "  govcheck characterise friction O-ring257_*bar.csv --column-map zillen-friction --bore '25.7 mm' --plot f.png",
@@ -32,10 +32,10 @@ def register(subparsers):
 
     v = sub.add_parser(
         "valve", help="flow law from a fixed-volume charging/discharging recording",
-        description="Fit the valve's mass-flow law to a recording of the pressure in a known fixed volume being "
+        description=wrap_description("Fit the valve's mass-flow law to a recording of the pressure in a known fixed volume being "
                     "charged from the supply (or discharged to atmosphere) through the valve: the mass flow is "
-                    "V/(R T) dp/dt (isothermal vessel). Laws are ranked by AIC; a law whose fitted conductance or area "
-                    "is not positive is physically impossible and never ranked best. --volume is required.",
+                    "V/(gamma R T) dp/dt (adiabatic filling of a rigid volume, seed 001 eq. 3; isentropic expansion when discharging). Laws are ranked by AIC; a law whose fitted conductance or area "
+                    "is not positive is physically impossible and never ranked best. --volume is required."),
         epilog="examples:\n"
                "  govcheck characterise valve charge.csv --volume '1 L' --supply-pressure '8 bar abs'\n"
                "  govcheck characterise valve bench.txt --column-map bench.toml --volume '0.5 L' --mode discharge --json v.json --plot v.svg",
@@ -56,9 +56,9 @@ def register(subparsers):
 
     f = sub.add_parser(
         "friction", help="friction-velocity map from constant-speed runs (one seal, any pressures)",
-        description="Fit the friction-velocity map of one seal to constant-speed runs: friction = F - p_gauge A "
+        description=wrap_description("Fit the friction-velocity map of one seal to constant-speed runs: friction = F - p_gauge A "
                     "(drive force minus pressure force), binned by velocity; Coulomb, static, Stribeck velocity and "
-                    "viscous terms per direction, optionally a pressure-dependent Coulomb term across runs.",
+                    "viscous terms per direction, optionally a pressure-dependent Coulomb term across runs."),
         epilog="examples:\n"
                "  govcheck characterise friction O-ring257_*bar.csv --column-map zillen-friction --bore '25.7 mm'\n"
                "  govcheck characterise friction run1.csv run2.csv --area '518.8 mm^2' --symmetric --json f.json",

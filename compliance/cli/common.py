@@ -27,10 +27,17 @@ _OUTPUT_HELP = {
 _METAVAR = {"json": "FILE.json", "junit": "FILE.xml", "report": "FILE.html", "pdf": "FILE.pdf"}
 
 
-def add_parser(sub, name: str, *, help: str, description: str, examples: list[str]):
-    """A sub-command parser with its description and an ``examples:`` epilog (kept verbatim)."""
+def wrap_description(text: str) -> str:
+    """Paragraphs of ``text`` filled to 90 columns (the help keeps line breaks verbatim for the examples)."""
+    import textwrap
+
+    return "\n\n".join(textwrap.fill(" ".join(par.split()), 90, break_on_hyphens=False) for par in text.split("\n\n"))
+
+
+def add_parser(sub, name: str, *, help: str, description: str, examples: list[str], usage: str | None = None):
+    """A sub-command parser with its description (wrapped per paragraph) and an ``examples:`` epilog (kept verbatim)."""
     return sub.add_parser(
-        name, help=help, description=description,
+        name, help=help, description=wrap_description(description), usage=usage,
         epilog="examples:\n" + "\n".join(f"  {e}" for e in examples),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -80,7 +87,7 @@ def add_outputs(parser, *names: str, help: dict | None = None) -> None:
 
 def add_jobs(parser, what: str = "worker processes") -> None:
     """``--jobs/-j N``."""
-    parser.add_argument("--jobs", "-j", type=int, default=None, help=f"{what} (default: the available cores)")
+    parser.add_argument("--jobs", "-j", type=int, default=None, metavar="N", help=f"{what} (default: the available cores)")
 
 
 def add_quiet(parser, what: str = "no progress; print only the verdict line") -> None:

@@ -16,7 +16,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from compliance.cli.common import (add_jobs, add_outputs, add_quiet, add_reproducible, check_args_outputs,
+from compliance.cli.common import (add_parser, add_jobs, add_outputs, add_quiet, add_reproducible, check_args_outputs,
                                    check_sidecar_conditions, sidecar_plant, split_config)
 from compliance.errors import InputError
 from compliance.files.atomic import write_json_atomic
@@ -27,8 +27,8 @@ _SCALE = {"position": (1e3, "mm"), "valve_command": (1.0, "V"), "pressure_a": (1
 
 def register(sub):
     """Add the ``diagnose`` command."""
-    p = sub.add_parser(
-        "diagnose",
+    p = add_parser(
+        sub, "diagnose",
         help="find the physics a model misses in a recording (or which parameter is off), fit it, show the gain",
         description=(
             "Replay the recording through the model, locate where it disagrees, then fit every candidate "
@@ -37,14 +37,13 @@ def register(sub):
             "each signal's noise floor, and explain the winner. Friction-bench recordings (position, chamber pressure "
             "and force; no valve command) get a friction-model diagnosis instead."
         ),
-        epilog=(
-            "examples:\n"
-            "  govcheck diagnose models/plant-a.toml run.csv.gz --json diag.json\n"
-            "  govcheck diagnose plant-a run.csv.gz --effects heat_transfer,internal_leakage --save-model fitted.toml\n"
-            "  govcheck diagnose tests/data/practice/practice_valve_dynamics.csv.gz --report diag.html\n"
-            "  govcheck diagnose O-ring257_*bar.csv --column-map zillen-friction --friction-bore \"25.7 mm\" --report f.html"
-        ),
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        examples=[
+            "govcheck diagnose models/plant-a.toml run.csv.gz --json diag.json",
+            "govcheck diagnose plant-a run.csv.gz --effects heat_transfer,internal_leakage --save-model fitted.toml",
+            "govcheck diagnose tests/data/practice/practice_valve_dynamics.csv.gz --report diag.html",
+            "govcheck diagnose O-ring257_*bar.csv --column-map zillen-friction --friction-bore '25.7 mm' --report f.html",
+        ],
+        usage="govcheck diagnose [options] [CONFIG] RECORDING [RECORDING ...]",
     )
     p.add_argument("inputs", nargs="+", metavar="[CONFIG] RECORDING",
                    help="plant configuration (TOML file or reference name; default: the sidecar's 'plant') and the "

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from compliance.cli.common import (add_outputs, add_quiet, add_reproducible, check_args_outputs, check_sidecar_conditions,
+from compliance.cli.common import (add_parser, add_outputs, add_quiet, add_reproducible, check_args_outputs, check_sidecar_conditions,
                                    parse_param_overrides, sidecar_plant, split_config)
 from compliance.errors import InputError
 from compliance.files.atomic import write_json_atomic
@@ -19,8 +19,8 @@ _SCALE = {"position": (1e3, "mm"), "valve_command": (1.0, "V"), "pressure_a": (1
 
 
 def register(sub):
-    p = sub.add_parser(
-        "validate",
+    p = add_parser(
+        sub, "validate",
         help="replay a recording with a plant model: fit per signal, located misfit windows, windowed error limits",
         description=(
             "Simulate a recorded test with the model - closed loop (the model's controller follows the recorded "
@@ -29,15 +29,14 @@ def register(sub):
             "operating regimes they fall in), and IEC 61400-27-2-style windowed errors (max, mean, mean absolute, "
             "per unit) against limits. Exit 0 when every window is within its limits, 1 when one is not, 2 on bad input."
         ),
-        epilog=(
-            "examples:\n"
-            "  govcheck validate models/plant-a.toml run.csv.gz\n"
-            "  govcheck validate run.csv.gz                     (the plant named by the sidecar run.toml)\n"
-            "  govcheck validate plant-a log.txt --column-map bench.toml --mode plant_only --json val.json\n"
-            "  govcheck validate plant-a run.csv --setting limits.position.steady.max_error=0.005 --report val.html\n"
-            "  govcheck validate plant-a run.csv --param friction.bristle_stiffness=1e6"
-        ),
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        examples=[
+            "govcheck validate models/plant-a.toml run.csv.gz",
+            "govcheck validate run.csv.gz      # the plant named by the sidecar run.toml",
+            "govcheck validate plant-a log.txt --column-map bench.toml --mode plant_only --json val.json",
+            "govcheck validate plant-a run.csv --setting limits.position.steady.max_error=0.005 --report val.html",
+            "govcheck validate plant-a run.csv --param friction.bristle_stiffness=1e6",
+        ],
+        usage="govcheck validate [options] [CONFIG] RECORDING",
     )
     p.add_argument("inputs", nargs="+", metavar="[CONFIG] RECORDING",
                    help="plant configuration (TOML file or reference name; default: the sidecar's 'plant') and the "
