@@ -34,7 +34,8 @@ def register(subparsers):
         "valve", help="flow law from a fixed-volume charging/discharging recording",
         description=wrap_description("Fit the valve's mass-flow law to a recording of the pressure in a known fixed volume being "
                     "charged from the supply (or discharged to atmosphere) through the valve: the mass flow is "
-                    "V/(gamma R T) dp/dt (adiabatic filling of a rigid volume, seed 001 eq. 3; isentropic expansion when discharging). Laws are ranked by AIC; a law whose fitted conductance or area "
+                    "V/(gamma R T) dp/dt (adiabatic filling of a rigid volume, seed 001 eq. 3; isentropic expansion "
+                    "when discharging). Laws are ranked by AIC; a law whose fitted conductance or area "
                     "is not positive is physically impossible and never ranked best. --volume is required."),
         epilog="examples:\n"
                "  govcheck characterise valve charge.csv --volume '1 L' --supply-pressure '8 bar abs'\n"
