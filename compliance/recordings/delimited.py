@@ -51,7 +51,8 @@ def read_text_table(path: Path, cmap: ColumnMap | None) -> RecordingSource:
         else:
             text = path.read_text(encoding="utf-8")
     except (UnicodeDecodeError, OSError, EOFError) as exc:
-        raise InputError(f"{path}: cannot read as UTF-8 text ({exc.__class__.__name__}: {exc})") from None
+        what = "gzip-compressed UTF-8 text (the file is cut short or not gzip)" if path.name.lower().endswith(".gz") else "UTF-8 text"
+        raise InputError(f"{path}: cannot read as {what} ({exc.__class__.__name__}: {exc})") from None
     comment = cmap.comment if cmap else "#"
     skip = cmap.skip_rows if cmap else 0
     delim = cmap.delimiter if cmap else ","
