@@ -31,6 +31,9 @@ def register(subparsers):
     p.add_argument("--linear", action="store_true",
                    help="add the linear analysis to the results and report: every operating point, the stroke x load map, "
                         "the linear/nonlinear cross-check and the HYGOV parameters (adds ~20-40 s)")
+    p.add_argument("--remedies", nargs="?", const="default", metavar="SWEEP.toml",
+                   help="what would make it pass: sensitivities and the smallest verified change over the on-site settings "
+                        "(or the adjustable space of a sweep file); added to the results as 'remedies'")
     p.add_argument("--jobs", "-j", type=int, default=None, help="worker processes (default: available cores)")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bar; print only the verdict line")
     return p
@@ -86,11 +89,19 @@ def run(args) -> int:
         from compliance.linear.operating_points import linear_for_campaign
 
         results["linear"] = linear_for_campaign(cfg, reqset)
+    if args.remedies:
+        from compliance.sweep.check_remedies import remedies_for_check
+
+        results["remedies"] = remedies_for_check(cfg, reqset, args.remedies, workers=args.jobs, progress=not args.quiet)
     table = summary_table(results)
     if args.quiet:
         print(table.rstrip().splitlines()[-1])
     else:
         sys.stdout.write(table)
+        if args.remedies:
+            from compliance.sweep.summary_text import remedies_markdown
+
+            sys.stdout.write("\n" + remedies_markdown(results["remedies"]))
     if args.json:
         write_json(results, args.json)
     if args.junit:
