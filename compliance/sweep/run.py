@@ -4,7 +4,9 @@
 candidate), ``summary.json`` and ``summary.md`` (counts, executor statistics, the Pareto front
 of the two tightest requirements, the best candidate) and ``best-results.json`` (the best
 candidate's full campaign, schema ``govcheck-results/1``, which ``govcheck report`` renders).
-``run_yield_file`` does the same for a tolerance-yield run (``yield.json``, ``yield-units.*``).
+``run_yield_file`` does the same for a tolerance-yield run: ``yield.json``, ``yield.md``, the unit
+table (``results.parquet``/``.csv``, one row per unit) and ``results.json`` (the nominal
+candidate's full campaign with the yield under ``tolerance_yield``).
 """
 
 from __future__ import annotations
@@ -129,7 +131,10 @@ def run_yield_file(spec, out_dir, candidate: dict, label: str, *, scheduler=None
     y.update(name=spec.name, label=label, executor=stats.as_dict() if stats else None)
     df = table(draws, rows, [r.id for r in ctx.reqset.requirements])
     buf_files = write_table(df, out)
-    y["files"] = {"units": buf_files}
+    res = verify_settings(cfg, reqset, spec.paths, candidate, workers=workers)
+    res["tolerance_yield"] = y
+    y["files"] = {"units": buf_files, "results": str(out / "results.json")}
+    write_json(res, out / "results.json")  # the nominal candidate's campaign with the yield: govcheck report renders it
     write_json_atomic(out / "yield.json", y)
     write_text_atomic(out / "yield.md", yield_markdown(y))
     return y
