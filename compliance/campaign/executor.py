@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import copyreg
 import os
+from contextlib import contextmanager
 import sys
 import time
 import types
@@ -31,7 +32,7 @@ from compliance.errors import GovcheckError, InputError
 from compliance.procedures.registry import run as run_procedure
 from compliance.requirements.requirement_set import RequirementSet
 
-__all__ = ["RunStats", "available_cores", "execute", "map_tasks", "parse_scheduler", "warm_up"]
+__all__ = ["RunStats", "available_cores", "dask_session", "execute", "map_tasks", "parse_scheduler", "warm_up"]
 
 _CTX: dict = {}  # set before the pool forks: workers read the context without pickling it
 _PLAIN_EVERY = 15.0  # seconds between plain progress lines when stderr is not a terminal
@@ -194,6 +195,26 @@ def _dask_client(kind: str, target):
         return Client(target, timeout=30), None
     except OSError as exc:
         raise InputError(f"--scheduler {target}: cannot reach the Dask scheduler ({exc})") from None
+
+
+@contextmanager
+def dask_session(scheduler: str | None, client=None):
+    """One Dask client for a whole run of several ``map_tasks`` calls (a sweep and its remedies).
+
+    Yields ``client`` when one is given, None for the local pool, else a client connected to
+    ``scheduler`` (a ``LocalCluster`` started for ``local:N``), closed on exit.
+    """
+    kind, target = parse_scheduler(scheduler)
+    if client is not None or kind == "local":
+        yield client
+        return
+    own, cluster = _dask_client(kind, target)
+    try:
+        yield own
+    finally:
+        own.close()
+        if cluster is not None:
+            cluster.close()
 
 
 def _run_dask(client, fn, context, items, results, bar, stats, retries):

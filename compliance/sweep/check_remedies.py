@@ -67,8 +67,11 @@ def remedies_for_check(cfg, reqset, sweep_file: str | None, *, workers=None, pro
     paths = {a.param.path: a.param for a in adjust}
     ctx = make_context(cfg, reqset, paths, linear)
     base = nominal_values(cfg, paths)
-    run_kw = {"workers": workers, "progress": progress, "client": client, "scheduler": scheduler}
-    rem = find_remedy(ctx, adjust, base, iterations=iterations,
-                      verify=lambda v: verify_settings(cfg, reqset, paths, v, workers=workers), run_kw=run_kw)
+    from compliance.campaign.executor import dask_session
+
+    with dask_session(scheduler, client) as session:
+        run_kw = {"workers": workers, "progress": progress, "client": session, "scheduler": scheduler}
+        rem = find_remedy(ctx, adjust, base, iterations=iterations,
+                          verify=lambda v: verify_settings(cfg, reqset, paths, v, workers=workers), run_kw=run_kw)
     rem["space_source"] = sweep_file if sweep_file and sweep_file != "default" else "default on-site settings"
     return rem

@@ -69,16 +69,18 @@ def run_sweep(spec, out_dir, *, scheduler=None, workers=None, progress=True, cli
     cfg, reqset = load_inputs(spec)
     ctx = make_context(cfg, reqset, spec.paths, spec.linear)
     base = nominal_values(cfg, spec.paths)
-    run_kw = {"scheduler": scheduler, "workers": workers, "progress": progress, "client": client}
+    from compliance.campaign.executor import dask_session
     from compliance.sweep.runner import run_candidates
 
     cands = _candidates(spec)
-    rows, stats = run_candidates(ctx, cands, **run_kw)
     remedies = None
-    if spec.method == "optimise":
-        remedies = find_remedy(ctx, spec.adjust, base, iterations=spec.iterations, seeds=list(zip(cands, rows)),
-                               verify=lambda v: verify_settings(cfg, reqset, spec.paths, v, workers=workers),
-                               run_kw=run_kw)
+    with dask_session(scheduler, client) as session:
+        run_kw = {"scheduler": scheduler, "workers": workers, "progress": progress, "client": session}
+        rows, stats = run_candidates(ctx, cands, **run_kw)
+        if spec.method == "optimise":
+            remedies = find_remedy(ctx, spec.adjust, base, iterations=spec.iterations, seeds=list(zip(cands, rows)),
+                                   verify=lambda v: verify_settings(cfg, reqset, spec.paths, v, workers=workers),
+                                   run_kw=run_kw)
     ids = [r.id for r in ctx.reqset.requirements]
     df = table(cands, rows, ids, spec.adjust, base)
     files = write_table(df, out)
@@ -125,9 +127,12 @@ def run_yield_file(spec, out_dir, candidate: dict, label: str, *, scheduler=None
     out.mkdir(parents=True, exist_ok=True)
     cfg, reqset = load_inputs(spec)
     ctx = make_context(cfg, reqset, spec.paths, spec.linear)
-    run_kw = {"scheduler": scheduler, "workers": workers, "progress": progress, "client": client}
-    y, draws, rows, stats = run_yield(ctx, cfg, candidate, spec.uncertain, units=units or spec.yield_units,
-                                      seed=spec.yield_seed, confidence=spec.confidence, run_kw=run_kw)
+    from compliance.campaign.executor import dask_session
+
+    with dask_session(scheduler, client) as session:
+        run_kw = {"scheduler": scheduler, "workers": workers, "progress": progress, "client": session}
+        y, draws, rows, stats = run_yield(ctx, cfg, candidate, spec.uncertain, units=units or spec.yield_units,
+                                          seed=spec.yield_seed, confidence=spec.confidence, run_kw=run_kw)
     y.update(name=spec.name, label=label, executor=stats.as_dict() if stats else None)
     df = table(draws, rows, [r.id for r in ctx.reqset.requirements])
     buf_files = write_table(df, out)

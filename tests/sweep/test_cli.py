@@ -59,6 +59,7 @@ def test_yield_of_best_is_seeded_and_bounded(swept):
     again = main(["sweep", str(f), "--out", str(out), "--yield", "best", "-q", "-j", "1"])
     assert again == 0
     pd.testing.assert_frame_equal(units, pd.read_parquet(out / "yield-best" / "results.parquet"))
+    _render_partial(res["tolerance_yield"])  # the report section of both remedies and yield renders
 
 
 def test_yield_without_earlier_sweep_is_exit_2(tmp_path, swept, capsys):
@@ -74,16 +75,14 @@ def test_wilson_interval():
     assert (lo, hi) == (pytest.approx(0.404, abs=0.002), pytest.approx(0.596, abs=0.002))
 
 
-def test_remedies_partial_renders(swept):
-    _, _, out = swept
-    res = read_results(out / "yield-best" / "results.json")
+def _render_partial(tolerance_yield):
     rem = {"status": "none_found", "note": "no candidate passes", "evaluated": 3, "space": [],
            "sensitivities": [{"requirement": "TC", "margin_pct": -10.0,
                               "by_parameter": [{"path": "controller.kp", "unit": "V/m", "step": 30.0, "delta_margin_pct": 4.0}]}],
            "remedy": None, "closest": {"changes": [{"path": "controller.kp", "unit": "V/m", "from": 280.0, "to": 300.0}],
                                        "change": 0.1, "binding": "TC", "binding_margin_pct": -2.0, "failed_mandatory": ["TC"]}}
     env = jinja2.Environment(loader=jinja2.FileSystemLoader(TEMPLATES), autoescape=True, undefined=jinja2.StrictUndefined)
-    html = env.get_template("_remedies.html.j2").render(remedies=rem, tolerance_yield=res["tolerance_yield"])
+    html = env.get_template("_remedies.html.j2").render(remedies=rem, tolerance_yield=tolerance_yield)
     assert "What would make it pass" in html and "Closest candidate" in html and "controller.kp" in html
     assert "Tolerance yield" in html and html.count("<svg") == 2
     assert env.get_template("_remedies.html.j2").render(remedies=None, tolerance_yield=None).strip() == ""
