@@ -106,6 +106,10 @@ def main(argv=None) -> int:
     print(f"one candidate, CPU: stock campaign {stock:.2f} s, sweep evaluation {lean:.2f} s "
           f"-> {stock / lean:.1f}x less; {sim_s:.0f} s of plant time simulated ({sim_s / 3:.0f} x 3 s step tests)")
 
+    idle = 2 * 60 / lean
+    print(f"projection from CPU time (2 idle cores, no pool overhead): {idle:.0f} candidates/min = "
+          f"{idle * sim_s / 3:.0f} step tests/min; 1000 candidates {1000 / idle:.1f} min")
+
     cands = latin_hypercube(spec.adjust, args.candidates, spec.seed)
     t = time.perf_counter()
     local, stats = run_candidates(ctx, cands, workers=args.workers, progress=False)

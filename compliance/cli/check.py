@@ -82,6 +82,10 @@ def run(args) -> int:
     for path, flag in ((args.json, "--json"), (args.junit, "--junit"), (args.report, "--report"), (args.pdf, "--pdf")):
         _check_out(path, flag)
     render = renderer(args)
+    if args.remedies and args.remedies != "default":  # a bad sweep file is exit 2 before any simulation
+        from compliance.sweep.spec import load_sweep
+
+        load_sweep(args.remedies)
     cfg = load_plant(args.plant)
     reqset = load_requirements(args.requirements)
     results = run_campaign(cfg, reqset, workers=args.jobs, progress=not args.quiet, command_line=command_line(args))

@@ -51,3 +51,12 @@ def test_missing_spread_and_bad_method_are_exit_2(write_sweep, capsys):
 def test_bad_scheduler_is_exit_2(write_sweep, capsys):
     assert main(["sweep", str(write_sweep(sweep_text())), "--scheduler", "local:0"]) == 2
     assert "local:N" in capsys.readouterr().err
+
+
+def test_check_remedies_with_bad_sweep_file_is_exit_2_before_simulating(write_sweep, capsys):
+    from tests.sweep.conftest import SMALL_TC
+
+    bad = write_sweep(sweep_text(adjust='[adjust."controller.kp"]\nrange = ["1 s", "2 s"]'))
+    assert main(["check", "plant-a", "-r", str(SMALL_TC), "--remedies", str(bad)]) == 2
+    captured = capsys.readouterr()
+    assert 'adjust."controller.kp".range[0]' in captured.err and captured.out == ""
