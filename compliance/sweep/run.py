@@ -19,6 +19,7 @@ from compliance.sweep.evaluate import make_context
 from compliance.sweep.remedies import find_remedy
 from compliance.sweep.results import best_index, pareto_front, table, tightest, write_table
 from compliance.sweep.sampling import grid, latin_hypercube
+from compliance.sweep.section_html import section_html
 from compliance.sweep.summary_text import summary_markdown, yield_markdown
 from compliance.sweep.yield_mc import nominal_values, run_yield
 
@@ -111,6 +112,8 @@ def run_sweep(spec, out_dir, *, scheduler=None, workers=None, progress=True, cli
     }
     write_json_atomic(out / "summary.json", summary)
     write_text_atomic(out / "summary.md", summary_markdown(summary))
+    if remedies is not None:
+        write_text_atomic(out / "summary.html", section_html(f"{spec.title}: what would make it pass", remedies=remedies))
     return summary
 
 
@@ -142,4 +145,5 @@ def run_yield_file(spec, out_dir, candidate: dict, label: str, *, scheduler=None
     write_json(res, out / "results.json")  # the nominal candidate's campaign with the yield: govcheck report renders it
     write_json_atomic(out / "yield.json", y)
     write_text_atomic(out / "yield.md", yield_markdown(y))
+    write_text_atomic(out / "yield.html", section_html(f"{spec.title}: tolerance yield of '{label}'", tolerance_yield=y))
     return y

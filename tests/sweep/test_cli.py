@@ -59,7 +59,8 @@ def test_yield_of_best_is_seeded_and_bounded(swept):
     again = main(["sweep", str(f), "--out", str(out), "--yield", "best", "-q", "-j", "1"])
     assert again == 0
     pd.testing.assert_frame_equal(units, pd.read_parquet(out / "yield-best" / "results.parquet"))
-    _render_partial(res["tolerance_yield"])  # the report section of both remedies and yield renders
+    _render_partial(res["tolerance_yield"])
+    assert "Tolerance yield" in (out / "yield-best" / "yield.html").read_text()  # the report section of both remedies and yield renders
 
 
 def test_yield_without_earlier_sweep_is_exit_2(tmp_path, swept, capsys):
