@@ -66,7 +66,7 @@ def _dask_run(ctx, cands, workers):
 
     t0 = time.perf_counter()
     cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
-                           dashboard_address=None)
+                           dashboard_address="127.0.0.1:0")
     client = Client(cluster)
     try:
         run_candidates(ctx, cands[:workers], client=client, progress=False)  # workers load the numba cache

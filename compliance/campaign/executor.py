@@ -188,8 +188,13 @@ def _dask_client(kind: str, target):
     from distributed import Client, LocalCluster
 
     if kind == "dask-local":
-        cluster = LocalCluster(n_workers=target, threads_per_worker=1, processes=True, host="127.0.0.1",
-                               dashboard_address=None)
+        import dask
+
+        # a task whose worker dies comes straight back as KilledWorker, so that govcheck resubmits
+        # it and counts the retry (the scheduler's own silent rescheduling would hide it)
+        with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+            cluster = LocalCluster(n_workers=target, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                   dashboard_address="127.0.0.1:0")
         return Client(cluster), cluster
     try:
         return Client(target, timeout=30), None

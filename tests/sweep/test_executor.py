@@ -39,7 +39,7 @@ def dask_client():
     from distributed import Client, LocalCluster
 
     # in-process workers on the inproc:// transport: nothing leaves this process (loopback only)
-    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None)
+    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address="127.0.0.1:0")
     client = Client(cluster)
     yield client
     client.close()
@@ -94,3 +94,11 @@ def test_small_sweep_local_equals_dask(write_sweep, dask_client):
     # is overcome sooner), so along kp at kd = 10 V*s/m the time constant falls
     tc = a[a["controller.kd"] == 10.0].sort_values("controller.kp")["TC.value"].dropna().to_numpy()
     assert len(tc) >= 2 and all(tc[1:] < tc[:-1])
+
+
+@pytest.mark.slow
+def test_killed_dask_worker_process_is_retried_and_counted(tmp_path):
+    # a real LocalCluster of 2 worker processes on 127.0.0.1, started and stopped here (local:2)
+    out, stats = map_tasks(_die_first, str(tmp_path), list(range(5)), scheduler="local:2", progress=False)
+    assert out == [i + 100 for i in range(5)]
+    assert stats.backend == "dask" and stats.failed == 0 and stats.retried >= 1
