@@ -10,8 +10,13 @@
 3. Judge that candidate; if every mandatory requirement passes, verify it with a full
    campaign (``run_campaign``, traces and all); else re-linearise there (up to ``iterations``)
    with a smaller trust region when it did not improve.
-4. If nothing passes, the closest candidate judged (smallest shortfall) and the requirement
-   that binds it are reported: evidence, not a proof, that the declared space holds no pass.
+   A requirement the linearised margins cannot bring to the target anywhere in the box (it
+   hardly moves with any parameter) is set aside for the step, so the search still fixes
+   the others; it is named in the result as out of reach.
+4. If nothing passes, the closest candidate judged and the requirement that binds it are
+   reported: evidence, not a proof, that the declared space holds no pass. Closest = the
+   smallest worst shortfall (to 10 % of its limit), then the smallest sum of shortfalls,
+   then the smallest change.
 """
 
 from __future__ import annotations
@@ -24,7 +29,7 @@ from compliance.sweep.results import change
 from compliance.sweep.runner import run_candidates, shortfall
 from compliance.sweep.sampling import from_normalised, to_normalised
 
-__all__ = ["STEP", "TARGET", "binding", "find_remedy", "mandatory_margins"]
+__all__ = ["STEP", "TARGET", "binding", "closeness", "find_remedy", "mandatory_margins", "unreachable"]
 
 STEP = 0.1  # finite-difference step, fraction of each declared range
 TARGET = 0.02  # margin (fraction of the limit) the linear step aims for, against the model's curvature
@@ -68,23 +73,37 @@ def _probes(adjust, u0):
     return us, steps
 
 
+def unreachable(u0, m0, J) -> np.ndarray:
+    """Rows whose linearised margin stays below TARGET everywhere in the box [0, 1]."""
+    best = m0 + np.sum(np.maximum(J * (0.0 - u0), J * (1.0 - u0)), axis=1)
+    return best < TARGET
+
+
 def _least_change(ubase, u0, m0, J, radius):
-    """min ||u - ubase||^2 s.t. m0 + J (u - u0) >= TARGET, 0 <= u <= 1, |u - u0| <= radius."""
+    """min ||u - ubase||^2 s.t. m0 + J (u - u0) >= TARGET (reachable rows), 0 <= u <= 1, |u - u0| <= radius."""
     from scipy.optimize import minimize
 
+    keep = ~unreachable(u0, m0, J)
+    m0, J = m0[keep], J[keep]
     lo = np.maximum(0.0, u0 - radius)
     hi = np.minimum(1.0, u0 + radius)
-    cons = [{"type": "ineq", "fun": lambda u: m0 + J @ (u - u0) - TARGET, "jac": lambda u: J}]
+    cons = [{"type": "ineq", "fun": lambda u: m0 + J @ (u - u0) - TARGET, "jac": lambda u: J}] if len(m0) else []
     res = minimize(lambda u: float(np.sum((u - ubase) ** 2)), np.clip(u0, lo, hi), jac=lambda u: 2 * (u - ubase),
                    bounds=list(zip(lo, hi)), constraints=cons, method="SLSQP", options={"maxiter": 200})
-    if res.success:
+    if res.success or not len(m0):
         return res.x
-    # infeasible in the linear model: go as far as it allows toward the worst margin
-    worst = int(np.argmin(m0))
-    g = J[worst]
-    if not np.any(g):
-        return np.clip(u0, lo, hi)
+    # not reachable inside the trust region: go as far as it allows toward the worst reachable margin
+    g = J[int(np.argmin(m0))]
     return np.clip(u0 + radius * np.sign(g), lo, hi)
+
+
+def closeness(row: dict, values: dict, adjust, start: dict) -> tuple:
+    """Ranking key of a failing candidate (smaller is closer to passing)."""
+    worst = shortfall(row)
+    if not math.isfinite(worst):
+        return (math.inf, math.inf, math.inf)
+    total = sum(max(0.0, -m) for m in mandatory_margins(row).values())
+    return (round(worst, 1), total, change(adjust, start, values))
 
 
 def _sensitivity_table(adjust, ids, m0, J, failed):
@@ -151,26 +170,27 @@ def find_remedy(ctx, adjust, base: dict, *, verify, iterations: int = 4, seeds=(
     judged = [(start, row0)] + list(seeds)
     space = [{"path": a.param.path, "unit": a.param.unit, "low": a.low, "high": a.high, "base": float(base[a.param.path])}
              for a in adjust]
-    out = {"status": "already_passes", "space": space, "failed": [], "sensitivities": [], "remedy": None,
-           "closest": None, "evaluated": 1 + len(seeds), "note": ""}
+    out = {"status": "already_passes", "space": space, "failed": [], "sensitivities": [], "out_of_reach": [],
+           "remedy": None, "closest": None, "evaluated": 1 + len(seeds), "note": ""}
     if row0["status"] == "pass":
         out["note"] = "every mandatory requirement passes as configured: nothing to change"
         return out
     out["failed"] = sorted(k for k, r in row0["requirements"].items() if r["severity"] == "mandatory" and r["status"] != "pass"
                            and r["status"] not in ("open", "disabled"))
-    cur, cur_row, radius = start, row0, 0.5
-    best_seed = min(judged, key=lambda t: (shortfall(t[1]), change(adjust, start, t[0])))
-    if shortfall(best_seed[1]) < shortfall(row0):
-        cur, cur_row = best_seed
+
+    def key(t):
+        return closeness(t[1], t[0], adjust, start)
+
+    u0 = ubase
+    ids, m0, J = _linearise(ctx, adjust, u0, row0, run_kw, judged, out)
+    out["sensitivities"] = _sensitivity_table(adjust, ids, m0, J, set(out["failed"]))
+    out["out_of_reach"] = [rid for rid, bad in zip(ids, unreachable(u0, m0, J)) if bad]
+    cur, cur_row = min([(start, row0)] + list(seeds), key=key)
+    radius = 0.5
     for it in range(iterations + 1):
-        u0 = to_normalised(adjust, cur)
-        us, steps = _probes(adjust, u0)
-        probe_rows, _ = run_candidates(ctx, [from_normalised(adjust, u) for u in us], **run_kw)
-        out["evaluated"] += len(us)
-        ids, m0, J = _sensitivities(adjust, u0, cur_row, probe_rows, steps)
-        if it == 0:
-            out["sensitivities"] = _sensitivity_table(adjust, ids, m0, J, set(out["failed"]))
-        judged += list(zip([from_normalised(adjust, u) for u in us], probe_rows))
+        if it or cur is not start:  # at the base the probes are the sensitivities above
+            u0 = to_normalised(adjust, cur)
+            ids, m0, J = _linearise(ctx, adjust, u0, cur_row, run_kw, judged, out)
         u_new = _least_change(ubase, u0, m0, J, radius) if ids else u0
         cand = from_normalised(adjust, u_new)
         (row,), _ = run_candidates(ctx, [cand], **run_kw)
@@ -185,14 +205,29 @@ def find_remedy(ctx, adjust, base: dict, *, verify, iterations: int = 4, seeds=(
                 out.update(status="found", remedy=remedy,
                            note=f"verified by a full campaign of the changed configuration ({len(results['runs'])} runs)")
                 return out
-        if shortfall(row) < shortfall(cur_row):
+        if key((cand, row)) < key((cur, cur_row)):
             cur, cur_row = cand, row
         else:
             radius *= 0.5
-    close_values, close_row = min(judged, key=lambda t: (shortfall(t[1]), change(adjust, start, t[0])))
-    out.update(status="none_found", closest=_describe(adjust, start, close_values, close_row))
+    return _none_found(out, adjust, start, min(judged, key=key))
+
+
+def _linearise(ctx, adjust, u0, row, run_kw, judged, out):
+    """Judge the probes around ``u0``; finite-difference margins (ids, m0, J). Appends to ``judged``."""
+    us, steps = _probes(adjust, u0)
+    settings = [from_normalised(adjust, u) for u in us]
+    probe_rows, _ = run_candidates(ctx, settings, **run_kw)
+    out["evaluated"] += len(us)
+    judged += list(zip(settings, probe_rows))
+    return _sensitivities(adjust, u0, row, probe_rows, steps)
+
+
+def _none_found(out, adjust, start, closest):
+    out.update(status="none_found", closest=_describe(adjust, start, *closest))
     rid = out["closest"]["binding"]
+    reach = (f" Out of reach of every declared parameter by the local sensitivities: {', '.join(out['out_of_reach'])}."
+             if out["out_of_reach"] else "")
     out["note"] = (f"no candidate of the {out['evaluated']} judged in the declared space passes every mandatory requirement; "
-                   f"the closest is stopped by {rid} ({out['closest']['binding_margin_pct']:+.1f} % of its limit). "
+                   f"the closest is stopped by {rid} ({out['closest']['binding_margin_pct']:+.1f} % of its limit).{reach} "
                    "This is the evidence of a search, not a proof that no pass exists.")
     return out
