@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import shlex
-import sys
 from pathlib import Path
 
 from compliance.errors import InputError
@@ -76,6 +75,15 @@ def _yield_candidate(which: str, out: Path, spec) -> dict:
     return {a.param.path: float(row[a.param.path]) for a in spec.adjust}
 
 
+def _command_line(args) -> str:
+    parts = ["govcheck", "sweep", args.sweep]
+    for flag in ("out", "scheduler", "jobs", "samples"):
+        v = getattr(args, flag)
+        if v is not None:
+            parts += [f"--{flag}", str(v)]
+    return shlex.join(parts)
+
+
 def run(args) -> int:
     """Run the sweep (or yield run), print the summary, exit 0 / 1 / 2."""
     from dataclasses import replace
@@ -104,7 +112,7 @@ def run(args) -> int:
         return 0
     from compliance.sweep.summary_text import summary_markdown
 
-    s = run_sweep(spec, out, command_line=shlex.join(["govcheck", "sweep", *sys.argv[2:]]), **kw)
+    s = run_sweep(spec, out, command_line=_command_line(args), **kw)
     text = summary_markdown(s)
     print(text.splitlines()[3] if args.quiet else text)
     return 0 if s["best"] and s["best"]["verified_status"] == "pass" else 1
