@@ -102,3 +102,19 @@ def test_killed_dask_worker_process_is_retried_and_counted(tmp_path):
     out, stats = map_tasks(_die_first, str(tmp_path), list(range(5)), scheduler="local:2", progress=False)
     assert out == [i + 100 for i in range(5)]
     assert stats.backend == "dask" and stats.failed == 0 and stats.retried >= 1
+
+
+def _square(ctx, item):
+    return item * item
+
+
+def test_progress_is_plain_lines_when_not_a_terminal(monkeypatch, capsys):
+    import compliance.campaign.executor as ex
+
+    monkeypatch.setattr(ex, "_PLAIN_EVERY", 0.0)  # every completion prints (CI logs get one per interval)
+    out, _ = map_tasks(_square, None, [1, 2, 3], workers=1, progress=True, label="candidates")
+    err = capsys.readouterr().err
+    assert out == [1, 4, 9]
+    assert "candidates: 3/3 done" in err and "\r" not in err
+    map_tasks(_square, None, [1, 2, 3], workers=1, progress=False)
+    assert capsys.readouterr().err == ""
