@@ -26,7 +26,7 @@ import math
 import numpy as np
 
 from compliance.sweep.results import change
-from compliance.sweep.runner import run_candidates, shortfall
+from compliance.sweep.runner import run_candidates, shortfall, total_shortfall
 from compliance.sweep.sampling import from_normalised, to_normalised
 
 __all__ = ["STEP", "TARGET", "binding", "closeness", "find_remedy", "mandatory_margins", "unreachable"]
@@ -102,8 +102,7 @@ def closeness(row: dict, values: dict, adjust, start: dict) -> tuple:
     worst = shortfall(row)
     if not math.isfinite(worst):
         return (math.inf, math.inf, math.inf)
-    total = sum(max(0.0, -m) for m in mandatory_margins(row).values())
-    return (round(worst, 1), total, change(adjust, start, values))
+    return (round(worst, 1), total_shortfall(row), change(adjust, start, values))
 
 
 def _sensitivity_table(adjust, ids, m0, J, failed):

@@ -3,7 +3,8 @@
 Table columns (Parquet and CSV): ``candidate``; one column per adjusted (or drawn) parameter
 path in SI; per requirement ``ID.value``, ``ID.margin``, ``ID.margin_pct``, ``ID.status``;
 ``status`` (pass / fail / incomplete / invalid / failed), ``shortfall`` (worst mandatory
-margin short of passing, in fractions of its limit; 0 passes), ``change`` (distance from the
+margin short of passing, in fractions of its limit; 0 passes), ``total_shortfall`` (their
+sum), ``change`` (distance from the
 base settings in normalised units) and ``error``.
 """
 
@@ -16,7 +17,7 @@ import numpy as np
 import pandas as pd
 
 from compliance.files.atomic import write_bytes_atomic, write_text_atomic
-from compliance.sweep.runner import shortfall
+from compliance.sweep.runner import shortfall, total_shortfall
 
 __all__ = ["best_index", "change", "pareto_front", "table", "tightest", "write_table"]
 
@@ -44,6 +45,7 @@ def table(candidates: list[dict], rows: list[dict], req_ids: list[str], adjust=(
             rec[f"{rid}.status"] = r.get("status", row["status"] if row["status"] in ("invalid", "failed") else None)
         rec["status"] = row["status"]
         rec["shortfall"] = shortfall(row)
+        rec["total_shortfall"] = total_shortfall(row)
         rec["change"] = change(adjust, base, values) if base is not None else float("nan")
         rec["error"] = row.get("error")
         recs.append(rec)
@@ -82,10 +84,15 @@ def pareto_front(df: pd.DataFrame, a: str, b: str) -> list[int]:
 
 
 def best_index(df: pd.DataFrame) -> int | None:
-    """A passing candidate with the smallest change, else the smallest shortfall (then change)."""
+    """A passing candidate with the smallest change, else the closest to passing.
+
+    Closest (as the remedies search ranks it): the smallest worst shortfall to 10 % of its limit,
+    then the smallest sum of shortfalls, then the smallest change.
+    """
     if df.empty:
         return None
-    ranked = df.assign(_pass=(df["status"] != "pass")).sort_values(["_pass", "shortfall", "change", "candidate"])
+    ranked = df.assign(_pass=(df["status"] != "pass"), _worst=df["shortfall"].round(1)).sort_values(
+        ["_pass", "_worst", "total_shortfall", "change", "candidate"])
     top = ranked.iloc[0]
     return None if not math.isfinite(top["shortfall"]) else int(top["candidate"])
 

@@ -13,7 +13,7 @@ import math
 from compliance.campaign.executor import map_tasks, warm_up
 from compliance.sweep.evaluate import Context, evaluate_batch
 
-__all__ = ["batch_size", "run_candidates", "shortfall"]
+__all__ = ["batch_size", "run_candidates", "shortfall", "total_shortfall"]
 
 
 def batch_size(n: int, workers: int) -> int:
@@ -68,3 +68,11 @@ def shortfall(row: dict) -> float:
             continue
         worst = max(worst, -r["margin_pct"] / 100.0)
     return worst
+
+
+def total_shortfall(row: dict) -> float:
+    """Sum of the mandatory margins short of passing, in fractions of their limits (0 = passes)."""
+    if not math.isfinite(shortfall(row)):
+        return math.inf
+    return sum(max(0.0, -r["margin_pct"] / 100.0) for r in row["requirements"].values()
+               if r["severity"] == "mandatory" and r["status"] in ("pass", "fail") and r["margin_pct"] is not None)
