@@ -123,7 +123,7 @@ def _describe(adjust, base, values, row, index=None) -> dict:
         "values": {k: float(v) for k, v in values.items()},
         "changes": [{"path": a.param.path, "unit": a.param.unit, "from": float(base[a.param.path]),
                      "to": float(values[a.param.path])} for a in adjust
-                    if not math.isclose(values[a.param.path], base[a.param.path], rel_tol=1e-9, abs_tol=1e-15)],
+                    if abs(values[a.param.path] - base[a.param.path]) > 1e-6 * a.span],  # unchanged to round-off
         "change": change(adjust, base, values),
         "status": row["status"],
         "shortfall_pct": 100.0 * shortfall(row) if math.isfinite(shortfall(row)) else None,
