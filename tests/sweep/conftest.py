@@ -1,15 +1,15 @@
-"""Shared fixtures of the sweep tests: a one-requirement file (tests/sweep/small-tc.toml) and sweep files on it."""
+"""Shared fixtures of the sweep tests: a two-requirement file (tests/data/sweep-small-tc.toml) and sweep files on it."""
 
 from pathlib import Path
 
 import pytest
 
 HERE = Path(__file__).resolve().parent
-SMALL_TC = HERE / "small-tc.toml"
+SMALL_TC = HERE.parent / "data" / "sweep-small-tc.toml"
 
 
 def sweep_text(method="grid", extra="", adjust=None) -> str:
-    """A sweep of plant A's proportional and derivative gains against small-tc.toml."""
+    """A sweep of plant A's proportional and derivative gains against sweep-small-tc.toml."""
     adjust = adjust if adjust is not None else """
 [adjust."controller.kp"]
 range = ["200 V/m", "500 V/m"]
