@@ -45,8 +45,19 @@ def verify_settings(cfg, reqset, paths, values, *, command_line=None, workers=No
                         command_line=command_line)
 
 
+MAX_GRID = 100_000  # a grid beyond this is a typo in `steps`, not a plan (use latin_hypercube)
+
+
 def _candidates(spec):
     if spec.method == "grid":
+        import math
+
+        from compliance.errors import InputError
+
+        n = math.prod(len(a.values) if a.values is not None else a.steps for a in spec.adjust)
+        if n > MAX_GRID:
+            raise InputError(f"{spec.path}: search.method: a grid of {n} candidates is over {MAX_GRID}; "
+                             "use fewer steps or method = \"latin_hypercube\"")
         return grid(spec.adjust)
     return latin_hypercube(spec.adjust, spec.samples, spec.seed)
 
