@@ -28,6 +28,8 @@ def register(subparsers):
     p.add_argument("--junit", metavar="OUT.xml", help="write JUnit XML for CI")
     p.add_argument("--report", metavar="OUT.html", help="write the HTML report")
     p.add_argument("--pdf", metavar="OUT.pdf", help="write the PDF report")
+    p.add_argument("--appendix", choices=("none", "summary", "full"), default="summary",
+                   help="report appendix: none, summary (configuration, requirement file, versions; default) or full (+ every run)")
     p.add_argument("--linear", action="store_true",
                    help="add the linear analysis to the results and report: every operating point, the stroke x load map, "
                         "the linear/nonlinear cross-check and the HYGOV parameters (adds ~20-40 s)")
@@ -96,5 +98,5 @@ def run(args) -> int:
     if args.junit:
         write_junit(results, args.junit)
     if render is not None:
-        render(results, html_path=args.report, pdf_path=args.pdf)
+        render(results, html_path=args.report, pdf_path=args.pdf, appendix=getattr(args, "appendix", "summary"))
     return 0 if results["summary"]["status"] == "pass" else 1

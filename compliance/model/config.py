@@ -20,8 +20,9 @@ from compliance.errors import InputError
 from compliance.model.parameters import BASE_BY_KEY, BASE_PARAMS, OPTION_DEFAULTS, OPTIONS, SOURCES
 from compliance.files.atomic import write_text_atomic
 from compliance.units import parse_quantity
+from compliance.model.identity import parse_identity
 
-_TOP_KEYS = {"name", "description", "provenance", "effects"}
+_TOP_KEYS = {"name", "description", "provenance", "effects", "identity"}
 _SECTIONS = sorted({k.split(".")[0] for k in BASE_BY_KEY} | {k.split(".")[0] for k in OPTIONS})
 
 
@@ -63,6 +64,7 @@ class PlantConfig:
     load_curve: tuple[np.ndarray, np.ndarray] | None
     effects: Mapping[str, Mapping[str, float]]
     provenance: Mapping[str, str] = field(default_factory=dict)
+    identity: Mapping[str, Any] = field(default_factory=dict)  # optional [identity]: site, unit, equipment (model/identity.py)
 
     def p(self, key: str) -> float:
         """SI value of a base parameter."""
@@ -331,6 +333,7 @@ def plant_from_dict(data: dict[str, Any], where: str = "<configuration>", digest
         load_curve=load_curve,
         effects=MappingProxyType({k: MappingProxyType(v) for k, v in effects.items()}),
         provenance=MappingProxyType({str(k): str(v) for k, v in (data.get("provenance") or {}).items()}),
+        identity=parse_identity(data.get("identity"), where),
     )
     _check_physical(cfg, where)
     return cfg
