@@ -100,14 +100,15 @@ def trace_figure(trace: dict, marks: list, kind: str, prefix: str, *, tolerance=
     speed_limit : float, optional
         Speed limit [m/s] of a speed requirement: the second panel then shows the speed with
         the limit drawn (whatever the procedure).
-    compact : bool
-        Three panels (no chamber pressures) in a shorter figure: the worst case on a requirement page.
+    compact : bool or "short"
+        Three panels (no chamber pressures) in a shorter figure: the worst case on a requirement
+        page ("short": shorter still, for a page shared by several requirements).
     """
     label = trace.get("label")
     mk = _marks_of(marks, label) if label is not None else []
     t = _arr(trace, "time")
     if compact:
-        fig, axes = new_figure("trace_compact", 3, 1, sharex=True, gridspec_kw={"height_ratios": [1.5, 1.0, 1.0], "hspace": 0.12})
+        fig, axes = new_figure("trace_short" if compact == "short" else "trace_compact", 3, 1, sharex=True, gridspec_kw={"height_ratios": [1.5, 1.0, 1.0], "hspace": 0.12})
         (ax_x, ax_e, ax_u), ax_p = axes, None
     else:
         fig, axes = new_figure("trace", 4, 1, sharex=True, gridspec_kw={"height_ratios": [1.5, 1.0, 1.0, 1.0], "hspace": 0.12})

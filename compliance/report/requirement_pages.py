@@ -81,27 +81,42 @@ def _row_cells(e: dict, r: dict) -> dict:
     return {"req": e["id"], "procedure": r.get("procedure"), "ops": [r.get("operating_point")], "value": metric_text(r.get("value"), metric),
             "which": r.get("which"), "margin": margin, "margin_pct": fmt_margin_pct(r.get("margin_pct")),
             "status": r.get("status"), "reason": str(r.get("reason")).split(":")[0] if r.get("reason") else None,
+            "raw": r.get("value"), "raw_margin": r.get("margin"), "metric": metric,
             "steps": steps, "cannot_fail": cannot_fail,
             "run": r.get("run")}
 
 
 def _grouped(rows: list[dict]) -> list[dict]:
-    """Merge cases of one procedure that read the same (value, status, per-step values) at several points."""
+    """Merge similar cases of one procedure: same status and a value within two significant digits
+    (NOT EVALUATED: same reason) at several operating points -> one row with the value range and
+    the per-step details of its worst point."""
     out, index = [], {}
     for c in rows:
-        key = (c["procedure"], c["value"], c["status"], c["reason"], c["cannot_fail"],
-               tuple(s["text"] for s in c["steps"]))
-        if c["status"] == "not_evaluated":  # one row per procedure and reason: no value differs that is judged
-            key = (c["procedure"], c["status"], c["reason"])
-        if key in index:
-            index[key]["ops"].extend(c["ops"])
-            if c["status"] == "not_evaluated" and index[key]["steps"]:
-                index[key]["steps"] = [{"text": "per-step values as at the first point, similar at the others "
-                                                "(appendix E with --appendix full lists each)", "excluded": True}] \
-                    + [st for st in index[key]["steps"] if not st["text"].startswith("per-step values")]
+        v = c["raw"]
+        similar = f"{v:.2g}" if isinstance(v, (int, float)) else c["value"]
+        key = (c["procedure"], c["status"], c["reason"], c["cannot_fail"], similar)
+        if key not in index:
+            index[key] = dict(c, members=[c])
+            out.append(index[key])
             continue
-        index[key] = c
-        out.append(c)
+        g = index[key]
+        g["ops"] = g["ops"] + c["ops"]
+        g["members"].append(c)
+    for g in out:
+        ms = g.pop("members")
+        if len(ms) == 1:
+            continue
+        if g["status"] == "not_evaluated":
+            g["steps"] = [{"text": "first point shown; the others alike (each in appendix E, --appendix full):",
+                           "excluded": True}] + g["steps"]
+            continue
+        worst = min(ms, key=lambda c: c["raw_margin"] if c["raw_margin"] is not None else float("inf"))
+        vals = [c["raw"] for c in ms if isinstance(c["raw"], (int, float))]
+        if vals and min(vals) != max(vals):
+            lo, hi = metric_text(min(vals), g["metric"]), metric_text(max(vals), g["metric"])
+            g["value"] = lo if lo == hi else f"{lo.rsplit(' ', 1)[0]}\u2013{hi}"
+        g.update(margin=worst["margin"], margin_pct=worst["margin_pct"], which=worst["which"], run=worst["run"])
+        g["steps"] = [{"text": f"worst point {worst['ops'][0]}:", "excluded": False}] + worst["steps"]
     return out
 
 
@@ -188,7 +203,7 @@ def requirement_pages(results: dict, start: int = 1) -> tuple[list[dict], list[d
         if tr is not None and tr.get("kind") != "path3d":
             lim = w.get("limit") or ((lead.get("rows") or [{}])[0].get("limit"))
             spec = {"id": f"fig-{start + len(specs)}", "kind": "trace", "trace": tr, "marks": run.get("marks") or [],
-                    "run_kind": run["kind"], "compact": True, "tolerance": max(lim) if lim and lead["metric"] in TOLERANCE_METRICS else None,
+                    "run_kind": run["kind"], "compact": "short" if len(entries) > 2 else True, "tolerance": max(lim) if lim and lead["metric"] in TOLERANCE_METRICS else None,
                     "speed_limit": max(lim) if lim and lead["metric"] in SPEED_METRICS else None}
             specs.append(spec)
             page["figure"] = {"id": spec["id"], "run": run["id"], "procedure": run["procedure"],

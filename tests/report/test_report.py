@@ -443,3 +443,18 @@ def regenerate(path: Path = FIXTURE) -> None:  # pragma: no cover - run by hand
 if __name__ == "__main__":  # pragma: no cover
     if "--regenerate" in sys.argv:
         regenerate()
+
+
+def test_diagnosis_finding_states_verdict_parameters_with_errors_and_next_step():
+    from compliance.report.analysis_sections import diagnosis_finding
+
+    diag = {"verdict": "missing_physics", "winner": "valve_dynamics", "explanation": "the valve lags",
+            "effects_ranked": [
+                {"name": "valve_dynamics", "delta_bic": 0.0,
+                 "parameters": [{"name": "valve_dynamics.natural_frequency", "value": 37.8, "stderr": 1.2, "unit": "rad/s"}]},
+                {"name": "internal_leakage", "delta_bic": 4.0, "parameters": []}]}
+    f = diagnosis_finding(diag)
+    assert f["word"] == "MISSING PHYSICS FOUND" and f["effect"] == "valve_dynamics"
+    assert f["params"][0]["text"] == "37.8 ± 1.2 rad/s"
+    # BIC 4 apart: the data do not decide between the two; the report says so and asks for a separating test
+    assert f["next"].startswith("Ambiguous between valve_dynamics and internal_leakage")
