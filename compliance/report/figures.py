@@ -173,7 +173,7 @@ def trace_figure(trace: dict, marks: list, kind: str, prefix: str, *, tolerance=
                 where = f"{c0:.3g} \u00b1 {sat:.3g} V" if c0 else f"\u00b1{sat:.3g} V"
                 ax_u.plot([], [], color=COLORS["limit"], lw=0.6, ls=(0, (3, 2)), label=f"full opening {where}")
             if c0:
-                ax_u.axhline(c0, color="#777777", lw=0.6, label=f"valve null {c0:.3g} V")
+                ax_u.axhline(c0, color="#999999", lw=0.6, ls=(0, (1, 1)), zorder=0.5, label=f"valve null {c0:.3g} V")
             dz = valve.get("dead_zone")
             if dz:
                 ax_u.axhspan(c0 - dz[1], c0 + dz[0], color="#999999", alpha=0.15, lw=0, label="valve dead zone")
