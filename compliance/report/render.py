@@ -26,6 +26,7 @@ import jinja2
 
 from compliance import __version__
 from compliance.errors import InputError
+from compliance.files.display import display_path
 from compliance.report import content as C
 from compliance.report import signoff as S
 from compliance.report.analysis_sections import linear_section, validation_section
@@ -334,6 +335,8 @@ def render_validation_report(result: dict, html_path, pdf_path=None, *, workers:
     ctx, specs = validation_section(result, 1)
     svgs = draw_figures(specs, None, workers)
     plant = dict(result.get("plant") or {})
+    plant["path"] = display_path(plant.get("path"))  # never an installation's absolute path
+    ctx["recording"] = dict(ctx["recording"], path=display_path(ctx["recording"].get("path")))
     ctx = {**_common({"versions": {"govcheck": (result.get("tool") or {}).get("version", __version__)}}),
            "v": ctx, "plant": plant, "settings": result.get("settings") or {}, "windows": result.get("windows") or [],
            "created": fmt_date(result.get("created"))}

@@ -215,7 +215,7 @@ def requirement_pages(results: dict, start: int = 1) -> tuple[list[dict], list[d
                     page["facts"].append(
                         f"In this worst case the speed exceeds {metric_text(spec['speed_limit'], lead['metric'])} for "
                         f"{fmt_value(ex['duration'], 's', 3)} (from {fmt_value(ex['start'], 's', 3)} to {fmt_value(ex['end'], 's', 3)}), "
-                        f"peaking at {metric_text(ex['peak'], lead['metric'])}; the gate travels "
+                        f"peaking at {metric_text(w.get('value'), lead['metric'])}; the gate travels "
                         f"{metric_text(ex['extra_travel'], 'max_positioning_error')} more than it would at the limit speed.")
         elif tr is not None:
             spec = {"id": f"fig-{start + len(specs)}", "kind": "trace", "trace": tr, "marks": [], "run_kind": run["kind"]}
