@@ -87,14 +87,12 @@ def _row_cells(e: dict, r: dict) -> dict:
 
 
 def _grouped(rows: list[dict]) -> list[dict]:
-    """Merge similar cases of one procedure: same status and a value within two significant digits
-    (NOT EVALUATED: same reason) at several operating points -> one row with the value range and
-    the per-step details of its worst point."""
+    """Merge the cases of one procedure with the same status (NOT EVALUATED: the same reason) at several
+    operating points -> one row with the value range, the value at each point and the per-step
+    details of its worst point."""
     out, index = [], {}
     for c in rows:
-        v = c["raw"]
-        similar = f"{v:.2g}" if isinstance(v, (int, float)) else c["value"]
-        key = (c["procedure"], c["status"], c["reason"], c["cannot_fail"], similar)
+        key = (c["procedure"], c["status"], c["reason"], c["cannot_fail"])
         if key not in index:
             index[key] = dict(c, members=[c])
             out.append(index[key])
@@ -107,7 +105,7 @@ def _grouped(rows: list[dict]) -> list[dict]:
         if len(ms) == 1:
             continue
         if g["status"] == "not_evaluated":
-            g["steps"] = [{"text": "first point shown; the others alike (each in appendix E, --appendix full):",
+            g["steps"] = [{"text": "first point shown, the others alike (all in appendix E):",
                            "excluded": True}] + g["steps"]
             continue
         worst = min(ms, key=lambda c: c["raw_margin"] if c["raw_margin"] is not None else float("inf"))
@@ -116,7 +114,9 @@ def _grouped(rows: list[dict]) -> list[dict]:
             lo, hi = metric_text(min(vals), g["metric"]), metric_text(max(vals), g["metric"])
             g["value"] = lo if lo == hi else f"{lo.rsplit(' ', 1)[0]}\u2013{hi}"
         g.update(margin=worst["margin"], margin_pct=worst["margin_pct"], which=worst["which"], run=worst["run"])
-        g["steps"] = [{"text": f"worst point {worst['ops'][0]}:", "excluded": False}] + worst["steps"]
+        per_point = " \u00b7 ".join(f"{c['ops'][0]} {c['value']}" for c in ms)
+        g["steps"] = [{"text": f"per point: {per_point}", "excluded": False},
+                      {"text": f"worst point {worst['ops'][0]}:", "excluded": False}] + worst["steps"]
     return out
 
 
@@ -203,7 +203,7 @@ def requirement_pages(results: dict, start: int = 1) -> tuple[list[dict], list[d
         if tr is not None and tr.get("kind") != "path3d":
             lim = w.get("limit") or ((lead.get("rows") or [{}])[0].get("limit"))
             spec = {"id": f"fig-{start + len(specs)}", "kind": "trace", "trace": tr, "marks": run.get("marks") or [],
-                    "run_kind": run["kind"], "compact": "short" if len(entries) > 2 else True, "tolerance": max(lim) if lim and lead["metric"] in TOLERANCE_METRICS else None,
+                    "run_kind": run["kind"], "compact": "short" if len(entries) > 2 or sum(len(r["cases"]) for r in reqs) >= 3 else True, "tolerance": max(lim) if lim and lead["metric"] in TOLERANCE_METRICS else None,
                     "speed_limit": max(lim) if lim and lead["metric"] in SPEED_METRICS else None}
             specs.append(spec)
             page["figure"] = {"id": spec["id"], "run": run["id"], "procedure": run["procedure"],
