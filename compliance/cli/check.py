@@ -39,6 +39,8 @@ def register(subparsers):
     p.add_argument("--requirements", "-r", required=True, metavar="REQ",
                    help="requirement file: a TOML file or a shipped name (" + ", ".join(names) + ")")
     add_outputs(p, "json", "junit", "report", "pdf")
+    p.add_argument("--appendix", choices=("none", "summary", "full"), default="summary",
+                   help="report appendix: none, summary (configuration, requirement file, versions; default) or full (+ every run)")
     p.add_argument("--linear", action="store_true",
                    help="add the linear analysis to the results and report: every operating point, the stroke x load map, "
                         "the linear/nonlinear cross-check and the HYGOV parameters (adds ~20-40 s)")
@@ -120,7 +122,7 @@ def run(args) -> int:
         table = summary_table(results)
         if render is not None:
             bar.set_postfix_str("report", refresh=False)
-            render(results, html_path=args.report, pdf_path=args.pdf)
+            render(results, html_path=args.report, pdf_path=args.pdf, appendix=args.appendix)
             bar.update(1)
     if args.quiet:
         print(table.rstrip().splitlines()[-1])
