@@ -15,6 +15,9 @@ def register(sub):
     p.add_argument("plant", help="reference plant name or configuration file (only plant-a has a paper table)")
     p.add_argument("--no-explain", action="store_true", help="skip the sensitivity runs that name the driving parameter")
     p.add_argument("--json", help="also write the comparison as JSON")
+    p.add_argument("--calibrate", nargs="?", const="models/plant-a-calibrated.toml", metavar="OUT.toml",
+                   help="fit the parameters the paper leaves unstated to its figures, print before/after and save "
+                        "the calibrated configuration (default models/plant-a-calibrated.toml; docs/calibration.md)")
     return p
 
 
@@ -24,6 +27,10 @@ def run(args) -> int:
     cfg = load_plant(args.plant)
     if cfg.options["cylinder.arrangement"] != "tandem":
         raise InputError(f"{args.plant}: the paper comparison exists for the tandem gate servo (plant A) only")
+    if args.calibrate:
+        from compliance.papers.calibration_run import run_calibration
+
+        return run_calibration(cfg, args.calibrate, json_path=args.json)
     comp = compare(cfg, explain=not args.no_explain)
     print(format_table(comp))
     if args.json:

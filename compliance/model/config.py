@@ -26,6 +26,7 @@ _SECTIONS = sorted({k.split(".")[0] for k in BASE_BY_KEY} | {k.split(".")[0] for
 
 
 _suggest = did_you_mean
+CALIBRATED_PREFIX = "calibrated to "
 
 
 @dataclass(frozen=True)
@@ -193,8 +194,10 @@ def _param_value(entry, key: str, where: str, atmosphere: float):
         if "value" not in entry:
             raise InputError(f"{where}: missing 'value'")
         source = entry.get("source", "user")
-        if source not in SOURCES:
-            raise InputError(f"{where}.source: '{source}' is not one of {', '.join(SOURCES)}")
+        # a calibrated value names what it was calibrated to: "calibrated to <figures> ..."
+        if source not in SOURCES and not (isinstance(source, str) and source.startswith(CALIBRATED_PREFIX)):
+            raise InputError(f"{where}.source: '{source}' is not one of {', '.join(SOURCES)} "
+                             f"nor '{CALIBRATED_PREFIX} <what it was fitted to>'")
         entry = entry["value"]
     if spec.unit == "number":
         if isinstance(entry, bool) or not isinstance(entry, (int, float)):
@@ -388,7 +391,7 @@ def plant_to_toml(cfg: PlantConfig) -> str:
         else:
             unit = spec.unit
             val = f'"{_fmt(v)} {unit} abs"' if spec.pressure else (f'"{_fmt(v)} {unit}"' if unit else _fmt(v))
-        sections.setdefault(sec, []).append(f'{name} = {{ value = {val}, source = "{src}" }}')
+        sections.setdefault(sec, []).append(f'{name} = {{ value = {val}, source = {_toml_str(src)} }}')
     for sec, rows in sections.items():
         lines.append(f"[{sec}]")
         lines.extend(rows)
@@ -403,6 +406,8 @@ def plant_to_toml(cfg: PlantConfig) -> str:
     for ename, vals in cfg.effects.items():
         eff = EFFECTS[ename]
         lines.append(f"[effects.{ename}]")
+        if f"effects.{ename}" in cfg.provenance:  # where its values came from (a calibration, a diagnosis)
+            lines.append(f"source = {_toml_str(cfg.provenance[f'effects.{ename}'])}")
         for p in eff.params:
             v = vals[p.name]
             lines.append(f'{p.name} = "{_fmt(v)} {p.unit}"' if p.unit else f"{p.name} = {_fmt(v)}")

@@ -1,0 +1,209 @@
+"""Calibrate what seed 000 leaves unstated to the figures it reports (``reproduce plant-a --calibrate``).
+
+Search in the unit cube of the declared plausible ranges (``calibration_table``), objective
+``calibration_objective.cost`` over the simulated figures:
+
+1. a scrambled Sobol sample of the cube (plus the starting configuration), each point under
+   every combination of the open test conditions, evaluated on a forked process pool;
+2. a parallel compass search from the best point: all 2n axis moves are polled at once, the
+   best improving move is taken, the step halves when none improves (Kolda, Lewis & Torczon
+   2003, generating set search: derivative-free and robust to the kinks stick-slip puts in
+   settling times);
+3. pinning: a local 1-D profile of the objective along each parameter (the others held at the
+   optimum); the contiguous values around the optimum whose cost stays within ``PIN_DELTA`` of
+   it are what the figures allow.
+
+The test conditions are separable blocks of the objective (fig. 9's sequence touches only
+fig. 9, the stroke start only the strokes), so each point is scored under every condition set
+with its runs shared, and keeps the best.
+
+Deterministic: fixed Sobol seed, fixed polling order, ties broken by index.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import multiprocessing as mp
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from compliance.campaign.executor import available_cores, warm_up
+from compliance.errors import InputError
+from compliance.model.config import PlantConfig
+from compliance.papers.calibration_objective import best_conditions, cost, rows_of
+from compliance.papers.calibration_table import CONDITIONS, Unstated, apply_values, fit_param, unstated_for, value_of
+from compliance.papers.plant_a import Row, conditions_of
+
+SOBOL_POINTS = 32
+COMPASS_START = 0.1  # first step in the unit cube
+COMPASS_MIN = 1.0 / 64.0
+COMPASS_ITERATIONS = 10
+PROFILE_OFFSETS = (-0.3, -0.1, -0.03, 0.03, 0.1, 0.3)  # unit-cube offsets of the local profile
+PIN_DELTA = 1.0  # one scatter^2: a value that moves one figure by its whole scatter is excluded
+
+_CTX: dict = {}  # set before the pool forks (nothing large is pickled)
+
+
+@dataclass
+class Profile:
+    """How well the figures pin one parameter."""
+
+    path: str
+    values: list[float]
+    costs: list[float]
+    allowed: tuple[float, float]  # values with cost <= optimum + PIN_DELTA
+    share: float  # width of ``allowed`` as a fraction of the plausible range (in search coordinates)
+
+    @property
+    def verdict(self) -> str:
+        """``pinned`` (< 25 % of the range), ``loosely pinned`` (< 60 %) or ``not pinned``."""
+        return "pinned" if self.share < 0.25 else ("loosely pinned" if self.share < 0.6 else "not pinned")
+
+
+@dataclass
+class Calibration:
+    """Result of a calibration."""
+
+    start: PlantConfig
+    best: PlantConfig
+    table: tuple[Unstated, ...]
+    values: dict[str, float]
+    conditions: dict[str, str]
+    cost_before: float
+    cost_after: float
+    rows_before: list[Row]
+    rows_after: list[Row]
+    profiles: list[Profile] = field(default_factory=list)
+    evaluations: int = 0
+    workers: int = 1
+
+
+def _point_cost(u):
+    """Worker: unit-cube point -> (cost, index of the best condition set)."""
+    cfg = _configure(_CTX["cfg"], _CTX["params"], u)
+    try:
+        return best_conditions(cfg, _CTX["conds"])
+    except InputError:  # a point the loader's cross-checks refuse is outside the plant
+        return math.inf, 0
+
+
+def _configure(cfg: PlantConfig, params, u) -> PlantConfig:
+    return apply_values(cfg, {fp.key: fp.from_unit(x) for fp, x in zip(params, u)})
+
+
+def _map(tasks: list, workers: int) -> list[tuple[float, int]]:
+    if workers <= 1 or len(tasks) < 4:
+        return [_point_cost(t) for t in tasks]
+    from concurrent.futures import ProcessPoolExecutor
+
+    with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("fork")) as pool:
+        return list(pool.map(_point_cost, tasks, chunksize=max(1, len(tasks) // (4 * workers))))
+
+
+def _condition_sets(fixed: dict | None = None) -> list[dict]:
+    names = [c.name for c in CONDITIONS]
+    choices = [c.choices if not fixed or c.name not in fixed else (fixed[c.name],) for c in CONDITIONS]
+    return [dict(zip(names, combo)) for combo in itertools.product(*choices)]
+
+
+def _compass(u0: np.ndarray, best: tuple[float, int], workers: int):
+    """Parallel compass search in the unit cube from ``u0`` (its (cost, condition) ``best``)."""
+    u, step, n_eval = u0.copy(), COMPASS_START, 0
+    for _ in range(COMPASS_ITERATIONS):
+        if step < COMPASS_MIN:
+            break
+        trials = []
+        for i in range(u.size):
+            for s in (+1.0, -1.0):
+                t = u.copy()
+                t[i] = min(max(t[i] + s * step, 0.0), 1.0)
+                if t[i] != u[i]:
+                    trials.append(t)
+        results = _map(trials, workers)
+        n_eval += len(trials)
+        k = min(range(len(results)), key=lambda j: results[j][0]) if results else -1
+        if k >= 0 and results[k][0] < best[0] - 1e-9:
+            u, best = trials[k], results[k]
+        else:
+            step *= 0.5
+    return u, best, n_eval
+
+
+def _profiles(params, u_best: np.ndarray, c_best: float, workers: int) -> list[Profile]:
+    tasks = []
+    for i in range(len(params)):
+        for d in PROFILE_OFFSETS:
+            t = u_best.copy()
+            t[i] = min(max(t[i] + d, 0.0), 1.0)
+            tasks.append(t)
+    results = _map(tasks, workers)
+    out = []
+    n = len(PROFILE_OFFSETS)
+    for i, fp in enumerate(params):
+        us = [float(tasks[i * n + j][i]) for j in range(n)] + [float(u_best[i])]
+        cs = [results[i * n + j][0] for j in range(n)] + [c_best]
+        order = sorted(range(len(us)), key=lambda j: us[j])
+        us, cs = [us[j] for j in order], [cs[j] for j in order]
+        # the contiguous run of values around the optimum whose cost stays within PIN_DELTA
+        k = us.index(float(u_best[i]))
+        lo = hi = k
+        while lo > 0 and cs[lo - 1] <= c_best + PIN_DELTA:
+            lo -= 1
+        while hi < len(us) - 1 and cs[hi + 1] <= c_best + PIN_DELTA:
+            hi += 1
+        out.append(Profile(fp.key, [fp.from_unit(x) for x in us], cs,
+                           (fp.from_unit(us[lo]), fp.from_unit(us[hi])), us[hi] - us[lo]))
+    return out
+
+
+def calibrate(cfg: PlantConfig, *, workers: int | None = None, sobol_points: int = SOBOL_POINTS,
+              table: tuple[Unstated, ...] | None = None, conditions: dict | None = None,
+              profiles: bool = True) -> Calibration:
+    """Fit the unstated parameters and test conditions of ``cfg`` to the paper's figures.
+
+    Parameters
+    ----------
+    cfg : PlantConfig
+        Starting configuration (plant A, or a variant with effects switched on).
+    workers : int, optional
+        Processes (default: the cores available).
+    sobol_points : int
+        Size of the global sample (a power of two).
+    table : tuple of Unstated, optional
+        What may move (default ``unstated_for(cfg)``).
+    conditions : dict, optional
+        Test conditions to hold fixed (others are chosen by the fit).
+    profiles : bool
+        Compute the 1-D profiles that say how well each parameter is pinned.
+    """
+    workers = max(1, workers or available_cores())
+    table = table if table is not None else unstated_for(cfg)
+    params = [fit_param(u, cfg) for u in table]
+    warm_up(cfg)
+    conds = _condition_sets(conditions)
+    _CTX.update(cfg=cfg, params=params, conds=conds)
+    start_cond = dict(conditions_of(cfg), **(conditions or {}))
+    rows_before = rows_of(cfg, start_cond)
+    u0 = np.array([fp.to_unit(value_of(cfg, fp.key)) for fp in params])
+    from scipy.stats import qmc
+
+    sample = [u0] + list(qmc.Sobol(len(params), scramble=True, seed=17).random(sobol_points))
+    results = _map(sample, workers)
+    k = min(range(len(results)), key=lambda j: results[j][0])
+    u_best, best, n = _compass(np.asarray(sample[k]), results[k], workers)
+    n_eval = len(sample) + n
+    prof = _profiles(params, u_best, best[0], workers) if profiles else []
+    n_eval += len(params) * len(PROFILE_OFFSETS) if profiles else 0
+    cal = _configure(cfg, params, u_best)
+    cond = conds[best[1]]
+    rows_after = rows_of(cal, cond)
+    values = {fp.key: value_of(cal, fp.key) for fp in params}
+    return Calibration(cfg, cal, tuple(table), values, cond, cost(rows_before), cost(rows_after), rows_before,
+                       rows_after, prof, n_eval, workers)
+
+
+def cost_at(cfg: PlantConfig, values: dict[str, float], cond: dict) -> float:
+    """Objective of ``cfg`` with ``values`` set (for tests and the effect search)."""
+    return cost(rows_of(apply_values(cfg, values), cond))

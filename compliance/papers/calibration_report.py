@@ -1,0 +1,100 @@
+"""Calibration output: before/after per figure, fitted values with ranges and pinning, the saved file."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+from types import MappingProxyType
+
+from compliance.model.config import PlantConfig, save_plant
+from compliance.papers.calibration import Calibration
+from compliance.papers.calibration_objective import within
+from compliance.papers.calibration_table import CALIBRATED_SOURCE, CONDITIONS
+from compliance.papers.plant_a import TOLERANCES, scaled_miss
+
+_SCALE = {"mm": 1e3}
+
+
+def _fmt(v, unit: str) -> str:
+    if v is None:
+        return "-"
+    return f"{v * _SCALE.get(unit, 1.0):.3g}"
+
+
+def _scatter(metric: str, unit: str) -> str:
+    kind, width = TOLERANCES[metric]
+    return f"{width:.0%}" if kind == "rel" else f"{width * _SCALE.get(unit, 1.0):.2g} {unit}"
+
+
+def _si(v: float, unit: str) -> str:
+    return f"{v:.4g} {unit}".strip()
+
+
+def calibration_table(cal: Calibration) -> str:
+    """Before/after per figure, fitted values, pinning and test conditions, as plain text."""
+    nb, n = within(cal.rows_before)
+    na, _ = within(cal.rows_after)
+    lines = [
+        "Calibration to seed 000 figures 9-12 and section 5.2 (unstated parameters only)",
+        "  objective: sum over the paper's figures of (simulated - paper)^2 / scatter^2; "
+        "scatter: settling 35 %, steady error 0.3 mm, stroke times 5 %, peak speed 30 %",
+        f"  before: cost {cal.cost_before:.1f}, {nb} of {n} figures within the scatter;  "
+        f"after: cost {cal.cost_after:.1f}, {na} of {n}",
+        "",
+        f"{'test':42s} {'metric':17s} {'paper':>7s} {'before':>8s} {'after':>8s} {'scatter':>8s}  in",
+    ]
+    for b, a in zip(cal.rows_before, cal.rows_after):
+        if b.paper is None:
+            continue
+        r = scaled_miss(a)
+        ok = "yes" if r is not None and abs(r) <= 1.0 else "NO"
+        lines.append(f"{b.test:42s} {b.metric:17s} {_fmt(b.paper, b.unit):>7s} {_fmt(b.simulated, b.unit):>8s} "
+                     f"{_fmt(a.simulated, a.unit):>8s} {_scatter(b.metric, b.unit):>8s}  {ok}")
+    lines += ["", "Fitted values (plausible range; the values the figures allow: local profile, cost within +1)"]
+    prof = {p.path: p for p in cal.profiles}
+    for u in cal.table:
+        start = _value(cal.start, u.path)
+        got = cal.values[u.path]
+        p = prof.get(u.path)
+        pin = f"allowed {_si(p.allowed[0], '')}..{_si(p.allowed[1], u.unit)} ({p.verdict})" if p else ""
+        lines.append(f"  {u.path:44s} {_si(start, ''):>10s} -> {_si(got, u.unit):16s} range "
+                     f"{_si(u.low, '')}..{_si(u.high, u.unit)}; {pin}")
+        lines.append(f"  {'':44s} why open: {u.reason}")
+    lines += ["", "Test conditions (chosen by the fit)"]
+    for c in CONDITIONS:
+        lines.append(f"  {c.name} = {cal.conditions[c.name]}  ({' | '.join(c.choices)}): {c.reason}")
+    lines.append(f"\n{cal.evaluations} configurations evaluated on {cal.workers} process(es)")
+    return "\n".join(lines)
+
+
+def _value(cfg: PlantConfig, path: str) -> float:
+    if path.startswith("effects."):
+        _, eff, name = path.split(".")
+        return float(cfg.effects.get(eff, {}).get(name, math.nan))
+    return float(cfg.p(path))
+
+
+def calibrated_config(cal: Calibration) -> PlantConfig:
+    """The calibrated configuration with its provenance: parent, objective, test conditions."""
+    prov = dict(cal.start.provenance)
+    prov.update({
+        "calibrated_from": f"{cal.start.name} (sha256 {cal.start.digest[:16] or 'in memory'})",
+        "calibrated_to": "seed 000 figs. 9-12 settling times and steady errors, section 5.2 stroke times and peak speed",
+        "calibration_objective": f"sum of (miss/scatter)^2: {cal.cost_before:.2f} before, {cal.cost_after:.2f} after",
+        "calibration_command": "govcheck reproduce plant-a --calibrate",
+    })
+    for c in CONDITIONS:
+        prov[f"condition.{c.name}"] = f"{cal.conditions[c.name]} (calibrated test condition: {c.reason})"
+    for eff in cal.best.effects:
+        if any(u.path.startswith(f"effects.{eff}.") for u in cal.table):
+            prov[f"effects.{eff}"] = CALIBRATED_SOURCE
+    name = cal.start.name if cal.start.name.endswith("-calibrated") else f"{cal.start.name}-calibrated"
+    desc = (f"{cal.start.description} -- calibrated: the values seed 000 leaves unstated fitted to its reported "
+            f"figures (docs/calibration.md)")
+    return dataclasses.replace(cal.best, name=name, description=desc, provenance=MappingProxyType(prov))
+
+
+def save_calibrated(cal: Calibration, path: str | os.PathLike) -> str:
+    """Write the calibrated configuration (atomic; replaces an earlier calibration at ``path``)."""
+    return str(save_plant(calibrated_config(cal), path, overwrite=True))
