@@ -23,6 +23,7 @@ import numpy as np
 
 from compliance.model.config import PlantConfig
 from compliance.model.dead_zone_stall import stall_error
+from compliance.papers.plant_a_fig8 import fig8, format_fig8
 from compliance.metrics import find_steps, speed_extremes, step_response, stroke_time
 from compliance.simulation.profiles import Profile, steps
 from compliance.simulation import Scenario, simulate
@@ -102,6 +103,7 @@ class Comparison:
     rows: list[Row] = field(default_factory=list)
     stall_error: float = 0.0
     notes: list[str] = field(default_factory=list)
+    fig8: list = field(default_factory=list)  # plant_a_fig8.Fig8Step, with and without compensation
 
 
 def _step_metrics(cfg: PlantConfig, case: StepCase, memo: dict | None = None):
@@ -270,6 +272,7 @@ def compare(cfg: PlantConfig, explain: bool = True, conditions: dict | None = No
                           "throttle check valve dynamics) and the test's starting pressures set it")
         comp.rows.append(row)
     comp.rows.extend(_overall_rows(cfg))
+    comp.fig8 = fig8(cfg)
     comp.notes.append(
         f"With lc = {cfg.p('controller.compensation_width'):.2f} V and K_P = {cfg.p('controller.kp'):.0f} V/m the "
         f"compensated valve stays shut once |e| < {comp.stall_error * 1e3:.2f} mm: an ideal dead zone leaves steady "
@@ -321,5 +324,7 @@ def format_table(comp: Comparison) -> str:
         if r.flagged and r.driver:
             lines.append(f"{'':42s}   -> {r.driver}")
     lines.append("")
+    if comp.fig8:
+        lines += [format_fig8(comp.fig8), ""]
     lines.extend("Note: " + n for n in comp.notes)
     return "\n".join(lines)
