@@ -406,8 +406,8 @@ def plant_to_toml(cfg: PlantConfig) -> str:
     for ename, vals in cfg.effects.items():
         eff = EFFECTS[ename]
         lines.append(f"[effects.{ename}]")
-        if f"effects.{ename}" in cfg.provenance:  # where its values came from (a calibration, a diagnosis)
-            lines.append(f"source = {_toml_str(cfg.provenance[f'effects.{ename}'])}")
+        if f"effect_{ename}" in cfg.provenance:  # where its values came from (a calibration, a diagnosis)
+            lines.append(f"source = {_toml_str(cfg.provenance[f'effect_{ename}'])}")
         for p in eff.params:
             v = vals[p.name]
             lines.append(f'{p.name} = "{_fmt(v)} {p.unit}"' if p.unit else f"{p.name} = {_fmt(v)}")

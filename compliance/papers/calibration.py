@@ -56,10 +56,24 @@ class Profile:
     allowed: tuple[float, float]  # values with cost <= optimum + PIN_DELTA
     share: float  # width of ``allowed`` as a fraction of the plausible range (in search coordinates)
 
+    best: float = 0.0  # cost at the optimum
+
     @property
     def verdict(self) -> str:
-        """``pinned`` (< 25 % of the range), ``loosely pinned`` (< 60 %) or ``not pinned``."""
+        """How the figures constrain the parameter (see docs/calibration.md, "pinning").
+
+        ``pinned`` (allowed values < 25 % of the range), ``loosely pinned`` (< 60 %), ``not pinned``;
+        ``rough`` when even the nearest profile points (3 % of the range away) cost more than
+        ``PIN_DELTA``: stick-slip makes settling times jump, so the minimum is local and the
+        allowed interval is not a measure of how well the figures determine the value.
+        """
+        if self.share == 0.0:
+            return "rough: a 3 % move costs > 1 on both sides"
         return "pinned" if self.share < 0.25 else ("loosely pinned" if self.share < 0.6 else "not pinned")
+
+    def deltas(self) -> str:
+        """Cost above the optimum at the profile points, compact."""
+        return " ".join("0" if c == self.best else f"{c - self.best:+.1f}" for c in self.costs)
 
 
 @dataclass
@@ -80,11 +94,14 @@ class Calibration:
     workers: int = 1
 
 
-def _point_cost(u):
-    """Worker: unit-cube point -> (cost, index of the best condition set)."""
-    cfg = _configure(_CTX["cfg"], _CTX["params"], u)
+def _point_cost(task):
+    """Worker: a unit-cube point (or ("cfg", index) into a list of configurations) -> (cost, condition index)."""
+    if isinstance(task, tuple):
+        cfg = _CTX["cfgs"][task[1]]
+    else:
+        cfg = _configure(_CTX["cfg"], _CTX["params"], task)
     try:
-        return best_conditions(cfg, _CTX["conds"])
+        return best_conditions(cfg, _CTX["conds"], _CTX.get("targets"))
     except InputError:  # a point the loader's cross-checks refuse is outside the plant
         return math.inf, 0
 
@@ -94,6 +111,7 @@ def _configure(cfg: PlantConfig, params, u) -> PlantConfig:
 
 
 def _map(tasks: list, workers: int) -> list[tuple[float, int]]:
+    """Score tasks on a forked pool (workers read the configuration from ``_CTX``, nothing large pickled)."""
     if workers <= 1 or len(tasks) < 4:
         return [_point_cost(t) for t in tasks]
     from concurrent.futures import ProcessPoolExecutor
@@ -102,16 +120,22 @@ def _map(tasks: list, workers: int) -> list[tuple[float, int]]:
         return list(pool.map(_point_cost, tasks, chunksize=max(1, len(tasks) // (4 * workers))))
 
 
+def map_configs(cfgs: list[PlantConfig], conds: list[dict], workers: int) -> list[tuple[float, int]]:
+    """(cost, condition index) of each configuration, on the same pool as the search."""
+    _CTX.update(cfgs=cfgs, conds=conds, targets=None)
+    return _map([("cfg", i) for i in range(len(cfgs))], workers)
+
+
 def _condition_sets(fixed: dict | None = None) -> list[dict]:
     names = [c.name for c in CONDITIONS]
     choices = [c.choices if not fixed or c.name not in fixed else (fixed[c.name],) for c in CONDITIONS]
     return [dict(zip(names, combo)) for combo in itertools.product(*choices)]
 
 
-def _compass(u0: np.ndarray, best: tuple[float, int], workers: int):
+def _compass(u0: np.ndarray, best: tuple[float, int], workers: int, iterations: int = COMPASS_ITERATIONS):
     """Parallel compass search in the unit cube from ``u0`` (its (cost, condition) ``best``)."""
     u, step, n_eval = u0.copy(), COMPASS_START, 0
-    for _ in range(COMPASS_ITERATIONS):
+    for _ in range(iterations):
         if step < COMPASS_MIN:
             break
         trials = []
@@ -154,13 +178,14 @@ def _profiles(params, u_best: np.ndarray, c_best: float, workers: int) -> list[P
         while hi < len(us) - 1 and cs[hi + 1] <= c_best + PIN_DELTA:
             hi += 1
         out.append(Profile(fp.key, [fp.from_unit(x) for x in us], cs,
-                           (fp.from_unit(us[lo]), fp.from_unit(us[hi])), us[hi] - us[lo]))
+                           (fp.from_unit(us[lo]), fp.from_unit(us[hi])), us[hi] - us[lo], c_best))
     return out
 
 
 def calibrate(cfg: PlantConfig, *, workers: int | None = None, sobol_points: int = SOBOL_POINTS,
               table: tuple[Unstated, ...] | None = None, conditions: dict | None = None,
-              profiles: bool = True) -> Calibration:
+              profiles: bool = True, targets: dict | None = None,
+              compass_iterations: int = COMPASS_ITERATIONS) -> Calibration:
     """Fit the unstated parameters and test conditions of ``cfg`` to the paper's figures.
 
     Parameters
@@ -177,28 +202,32 @@ def calibrate(cfg: PlantConfig, *, workers: int | None = None, sobol_points: int
         Test conditions to hold fixed (others are chosen by the fit).
     profiles : bool
         Compute the 1-D profiles that say how well each parameter is pinned.
+    targets : dict, optional
+        (test, metric) -> figure to calibrate to instead of the paper's (``rows_of``).
+    compass_iterations : int
+        Iterations of the local search.
     """
     workers = max(1, workers or available_cores())
     table = table if table is not None else unstated_for(cfg)
     params = [fit_param(u, cfg) for u in table]
     warm_up(cfg)
     conds = _condition_sets(conditions)
-    _CTX.update(cfg=cfg, params=params, conds=conds)
+    _CTX.update(cfg=cfg, params=params, conds=conds, targets=targets)
     start_cond = dict(conditions_of(cfg), **(conditions or {}))
-    rows_before = rows_of(cfg, start_cond)
+    rows_before = rows_of(cfg, start_cond, targets=targets)
     u0 = np.array([fp.to_unit(value_of(cfg, fp.key)) for fp in params])
     from scipy.stats import qmc
 
     sample = [u0] + list(qmc.Sobol(len(params), scramble=True, seed=17).random(sobol_points))
     results = _map(sample, workers)
     k = min(range(len(results)), key=lambda j: results[j][0])
-    u_best, best, n = _compass(np.asarray(sample[k]), results[k], workers)
+    u_best, best, n = _compass(np.asarray(sample[k]), results[k], workers, compass_iterations)
     n_eval = len(sample) + n
     prof = _profiles(params, u_best, best[0], workers) if profiles else []
     n_eval += len(params) * len(PROFILE_OFFSETS) if profiles else 0
     cal = _configure(cfg, params, u_best)
     cond = conds[best[1]]
-    rows_after = rows_of(cal, cond)
+    rows_after = rows_of(cal, cond, targets=targets)
     values = {fp.key: value_of(cal, fp.key) for fp in params}
     return Calibration(cfg, cal, tuple(table), values, cond, cost(rows_before), cost(rows_after), rows_before,
                        rows_after, prof, n_eval, workers)

@@ -21,12 +21,21 @@ MISSING_COST = 25.0  # a figure that is not measured at all counts as 5 scatters
 CAP = 10.0  # |r| beyond 10 scatters adds no more: one wild figure must not hide the others
 
 
-def rows_of(cfg: PlantConfig, conditions: dict, memo: dict | None = None) -> list[Row] | None:
-    """The simulated figure rows, or None when the configuration does not simulate."""
+def rows_of(cfg: PlantConfig, conditions: dict, memo: dict | None = None,
+            targets: dict | None = None) -> list[Row] | None:
+    """The simulated figure rows, or None when the configuration does not simulate.
+
+    ``targets``: (test, metric) -> value replacing the paper's figure (None drops the row), for
+    calibrating to figures other than the paper's (e.g. figures the model itself generated).
+    """
     try:
-        return [row for _, _, row in figure_rows(cfg, conditions, memo)]
+        rows = [row for _, _, row in figure_rows(cfg, conditions, memo)]
     except (SimulationError, InputError, FloatingPointError):
         return None
+    if targets is not None:
+        for r in rows:
+            r.paper = targets.get((r.test, r.metric))
+    return rows
 
 
 def row_cost(row: Row) -> float:
@@ -53,12 +62,12 @@ def within(rows: list[Row]) -> tuple[int, int]:
     return sum(1 for r in rs if abs(r) <= 1.0), len(rs)
 
 
-def best_conditions(cfg: PlantConfig, condition_sets: list[dict]) -> tuple[float, int]:
+def best_conditions(cfg: PlantConfig, condition_sets: list[dict], targets: dict | None = None) -> tuple[float, int]:
     """(lowest cost, index of its condition set) of ``cfg`` over the condition sets (runs shared)."""
     memo: dict = {}
     best = (math.inf, 0)
     for i, cond in enumerate(condition_sets):
-        c = cost(rows_of(cfg, cond, memo))
+        c = cost(rows_of(cfg, cond, memo, targets))
         if c < best[0]:
             best = (c, i)
     return best

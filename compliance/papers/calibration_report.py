@@ -9,7 +9,7 @@ from types import MappingProxyType
 
 from compliance.model.config import PlantConfig, save_plant
 from compliance.papers.calibration import Calibration
-from compliance.papers.calibration_objective import within
+from compliance.papers.calibration_objective import cost, within
 from compliance.papers.calibration_table import CALIBRATED_SOURCE, CONDITIONS
 from compliance.papers.plant_a import TOLERANCES, scaled_miss
 
@@ -31,26 +31,30 @@ def _si(v: float, unit: str) -> str:
     return f"{v:.4g} {unit}".strip()
 
 
-def calibration_table(cal: Calibration) -> str:
-    """Before/after per figure, fitted values, pinning and test conditions, as plain text."""
-    nb, n = within(cal.rows_before)
-    na, _ = within(cal.rows_after)
+def calibration_table(cal: Calibration, columns: list[tuple[str, list]] | None = None) -> str:
+    """Figures per stage (default: before/after), fitted values, pinning and test conditions, as text.
+
+    ``columns``: (label, rows) per stage, e.g. published / parameters only / with the effect.
+    """
+    columns = columns or [("before", cal.rows_before), ("after", cal.rows_after)]
     lines = [
-        "Calibration to seed 000 figures 9-12 and section 5.2 (unstated parameters only)",
+        "Calibration to seed 000 figures 9-12 and section 5.2 (only what the paper leaves unstated moves)",
         "  objective: sum over the paper's figures of (simulated - paper)^2 / scatter^2; "
         "scatter: settling 35 %, steady error 0.3 mm, stroke times 5 %, peak speed 30 %",
-        f"  before: cost {cal.cost_before:.1f}, {nb} of {n} figures within the scatter;  "
-        f"after: cost {cal.cost_after:.1f}, {na} of {n}",
-        "",
-        f"{'test':42s} {'metric':17s} {'paper':>7s} {'before':>8s} {'after':>8s} {'scatter':>8s}  in",
     ]
-    for b, a in zip(cal.rows_before, cal.rows_after):
+    for label, rows in columns:
+        k, n = within(rows)
+        lines.append(f"  {label:>12s}: cost {cost(rows):6.1f}, {k} of {n} figures within the scatter")
+    head = "".join(f" {label[:10]:>10s}" for label, _ in columns)
+    lines += ["", f"{'test':42s} {'metric':17s} {'paper':>7s}{head} {'scatter':>8s}  in"]
+    for i, b in enumerate(columns[0][1]):
         if b.paper is None:
             continue
-        r = scaled_miss(a)
+        last = columns[-1][1][i]
+        r = scaled_miss(last)
         ok = "yes" if r is not None and abs(r) <= 1.0 else "NO"
-        lines.append(f"{b.test:42s} {b.metric:17s} {_fmt(b.paper, b.unit):>7s} {_fmt(b.simulated, b.unit):>8s} "
-                     f"{_fmt(a.simulated, a.unit):>8s} {_scatter(b.metric, b.unit):>8s}  {ok}")
+        vals = "".join(f" {_fmt(rows[i].simulated, b.unit):>10s}" for _, rows in columns)
+        lines.append(f"{b.test:42s} {b.metric:17s} {_fmt(b.paper, b.unit):>7s}{vals} {_scatter(b.metric, b.unit):>8s}  {ok}")
     lines += ["", "Fitted values (plausible range; the values the figures allow: local profile, cost within +1)"]
     prof = {p.path: p for p in cal.profiles}
     for u in cal.table:
@@ -60,6 +64,8 @@ def calibration_table(cal: Calibration) -> str:
         pin = f"allowed {_si(p.allowed[0], '')}..{_si(p.allowed[1], u.unit)} ({p.verdict})" if p else ""
         lines.append(f"  {u.path:44s} {_si(start, ''):>10s} -> {_si(got, u.unit):16s} range "
                      f"{_si(u.low, '')}..{_si(u.high, u.unit)}; {pin}")
+        if p:
+            lines.append(f"  {'':44s} profile (cost above optimum at offsets -30,-10,-3,0,+3,+10,+30 % of range): {p.deltas()}")
         lines.append(f"  {'':44s} why open: {u.reason}")
     lines += ["", "Test conditions (chosen by the fit)"]
     for c in CONDITIONS:
@@ -85,10 +91,10 @@ def calibrated_config(cal: Calibration) -> PlantConfig:
         "calibration_command": "govcheck reproduce plant-a --calibrate",
     })
     for c in CONDITIONS:
-        prov[f"condition.{c.name}"] = f"{cal.conditions[c.name]} (calibrated test condition: {c.reason})"
+        prov[f"condition_{c.name}"] = f"{cal.conditions[c.name]} (calibrated test condition: {c.reason})"
     for eff in cal.best.effects:
         if any(u.path.startswith(f"effects.{eff}.") for u in cal.table):
-            prov[f"effects.{eff}"] = CALIBRATED_SOURCE
+            prov[f"effect_{eff}"] = CALIBRATED_SOURCE
     name = cal.start.name if cal.start.name.endswith("-calibrated") else f"{cal.start.name}-calibrated"
     desc = (f"{cal.start.description} -- calibrated: the values seed 000 leaves unstated fitted to its reported "
             f"figures (docs/calibration.md)")

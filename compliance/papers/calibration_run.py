@@ -29,15 +29,42 @@ def _cpu_seconds() -> float:
     return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
 
 
+def calibrate_in_stages(cfg: PlantConfig, workers: int | None = None):
+    """Parameters first; then the effect search; then parameters again with the named valve effect.
+
+    Returns
+    -------
+    tuple
+        (final Calibration with ``rows_before`` of ``cfg``, parameters-only Calibration,
+        effect-search results or [])
+    """
+    from compliance.effects import EFFECTS
+    from compliance.papers.calibration import calibrate
+    from compliance.papers.calibration_effects import effect_search
+    from compliance.papers.calibration_table import NULL_FLOW_EFFECT
+
+    first = calibrate(cfg, workers=workers, profiles=NULL_FLOW_EFFECT not in EFFECTS or NULL_FLOW_EFFECT in cfg.effects)
+    if NULL_FLOW_EFFECT not in EFFECTS or NULL_FLOW_EFFECT in cfg.effects:
+        return first, first, []
+    found = effect_search(first.best, first.conditions, first.rows_after, first.workers)
+    null = next(r for r in found if r.name == NULL_FLOW_EFFECT)
+    start = first.best.replace(effects={NULL_FLOW_EFFECT: null.params})
+    final = calibrate(start, workers=workers, conditions=None)
+    final.start, final.rows_before, final.cost_before = cfg, first.rows_before, first.cost_before
+    final.evaluations += first.evaluations + sum(1 for _ in found)
+    return final, first, found
+
+
 def run_calibration(cfg: PlantConfig, out: str, json_path: str | None = None) -> int:
-    """Calibrate ``cfg`` to the paper's figures, print the before/after, save to ``out``.
+    """Calibrate ``cfg`` to the paper's figures, print the stages, save to ``out``.
 
     Returns
     -------
     int
         0 (the calibration reports; it does not judge).
     """
-    from compliance.papers.calibration import calibrate
+    from compliance.model.config import load_plant
+    from compliance.papers.calibration_effects import format_effect_search
     from compliance.papers.calibration_report import calibration_table, save_calibrated
     from compliance.papers.plant_a import compare, format_table
 
@@ -45,25 +72,31 @@ def run_calibration(cfg: PlantConfig, out: str, json_path: str | None = None) ->
     if json_path:
         _check_writable(json_path)
     t0, c0 = time.perf_counter(), _cpu_seconds()
-    cal = calibrate(cfg)
+    final, first, found = calibrate_in_stages(cfg)
     wall, cpu = time.perf_counter() - t0, _cpu_seconds() - c0
-    print(calibration_table(cal))
-    print(f"calibration: {wall:.1f} s wall, {cpu:.1f} s CPU over all processes "
-          f"(= {cpu / max(cal.workers, 1):.1f} s on {cal.workers} idle cores)")
-    saved = save_calibrated(cal, out)
+    columns = [("published", final.rows_before), ("parameters", first.rows_after)]
+    if found:
+        columns.append(("+ null flow", final.rows_after))
+    print(calibration_table(final, columns))
+    if found:
+        print("\n" + format_effect_search(found, first.cost_after))
+    print(f"\ncalibration: {wall:.1f} s wall, {cpu:.1f} s CPU over all processes "
+          f"(= {cpu / max(final.workers, 1):.1f} s on {final.workers} idle cores)")
+    saved = save_calibrated(final, out)
     print(f"saved {saved}: every changed value has source = \"calibrated to seed 000 figures ...\"\n")
-    from compliance.model.config import load_plant
-
     best = load_plant(saved)
     print(format_table(compare(best, explain=False)))
     if json_path:
         from compliance.files.atomic import write_json_atomic
 
         write_json_atomic(json_path, {
-            "plant": best.name, "calibrated_file": saved, "conditions": cal.conditions,
-            "cost_before": cal.cost_before, "cost_after": cal.cost_after,
-            "values": cal.values, "evaluations": cal.evaluations, "wall_s": wall, "cpu_s": cpu,
-            "before": [r.__dict__ for r in cal.rows_before], "after": [r.__dict__ for r in cal.rows_after],
-            "profiles": [p.__dict__ for p in cal.profiles],
+            "plant": best.name, "calibrated_file": saved, "conditions": final.conditions,
+            "cost_published": final.cost_before, "cost_parameters_only": first.cost_after,
+            "cost_final": final.cost_after, "values": final.values, "evaluations": final.evaluations,
+            "wall_s": wall, "cpu_s": cpu,
+            "columns": {label: [r.__dict__ for r in rows] for label, rows in columns},
+            "profiles": [p.__dict__ for p in final.profiles],
+            "effect_search": [{"name": r.name, "cost": r.cost, "params": r.params, "closes": r.closes,
+                               "opens": r.opens} for r in found],
         })
     return 0

@@ -86,8 +86,9 @@ EFFECT_UNSTATED: tuple[Unstated, ...] = (
     Unstated(f"effects.{NULL_FLOW_EFFECT}.null_opening", 0.001, 0.05, True,
              "section 3: the valve has 'a region where there is no flow' only nominally; a real spool leaks "
              "across its lands, 0.1-5 % of the rated opening"),
-    Unstated(f"effects.{NULL_FLOW_EFFECT}.null_width", 0.2, 1.5, False,
-             "command over which a covered land stops leaking: of the order of the dead zone (0.61/0.69 V)"),
+    Unstated(f"effects.{NULL_FLOW_EFFECT}.null_width", 0.05, 1.5, True,
+             "pressure gain at null: servo valves swing a port from exhaust to supply within 0.5-15 % of the "
+             "rated command (0.05-1.5 V)"),
 )
 
 CONDITIONS: tuple[Condition, ...] = (

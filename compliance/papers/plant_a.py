@@ -154,7 +154,7 @@ def conditions_of(cfg: PlantConfig) -> dict:
     """Test conditions recorded in a calibrated configuration's provenance (defaults otherwise)."""
     out = dict(DEFAULT_CONDITIONS)
     for k in out:
-        v = cfg.provenance.get(f"condition.{k}")
+        v = cfg.provenance.get(f"condition_{k}")
         if v:
             out[k] = v.split()[0]
     return out
