@@ -11,7 +11,8 @@ Search in the unit cube of the declared plausible ranges (``calibration_table``)
    settling times);
 3. pinning: a local 1-D profile of the objective along each parameter (the others held at the
    optimum); the contiguous values around the optimum whose cost stays within ``PIN_DELTA`` of
-   it are what the figures allow.
+   it are what the figures allow. A profile point that beats the optimum restarts the compass
+   there with a finer step (``POLISH_ROUNDS``): stick-slip makes the objective rough.
 
 The test conditions are separable blocks of the objective (fig. 9's sequence touches only
 fig. 9, the stroke start only the strokes), so each point is scored under every condition set
@@ -36,11 +37,12 @@ from compliance.papers.calibration_objective import best_conditions, cost, rows_
 from compliance.papers.calibration_table import CONDITIONS, Unstated, apply_values, fit_param, unstated_for, value_of
 from compliance.papers.plant_a import Row, conditions_of
 
-SOBOL_POINTS = 32
+SOBOL_POINTS = 128
 COMPASS_START = 0.1  # first step in the unit cube
 COMPASS_MIN = 1.0 / 64.0
-COMPASS_ITERATIONS = 10
+COMPASS_ITERATIONS = 20
 PROFILE_OFFSETS = (-0.3, -0.1, -0.03, 0.03, 0.1, 0.3)  # unit-cube offsets of the local profile
+POLISH_ROUNDS = 2  # restarts of the compass from a profile point that beat it
 PIN_DELTA = 1.0  # one scatter^2: a value that moves one figure by its whole scatter is excluded
 
 _CTX: dict = {}  # set before the pool forks (nothing large is pickled)
@@ -132,9 +134,10 @@ def _condition_sets(fixed: dict | None = None) -> list[dict]:
     return [dict(zip(names, combo)) for combo in itertools.product(*choices)]
 
 
-def _compass(u0: np.ndarray, best: tuple[float, int], workers: int, iterations: int = COMPASS_ITERATIONS):
+def _compass(u0: np.ndarray, best: tuple[float, int], workers: int, iterations: int = COMPASS_ITERATIONS,
+             start: float = COMPASS_START):
     """Parallel compass search in the unit cube from ``u0`` (its (cost, condition) ``best``)."""
-    u, step, n_eval = u0.copy(), COMPASS_START, 0
+    u, step, n_eval = u0.copy(), start, 0
     for _ in range(iterations):
         if step < COMPASS_MIN:
             break
@@ -155,7 +158,8 @@ def _compass(u0: np.ndarray, best: tuple[float, int], workers: int, iterations: 
     return u, best, n_eval
 
 
-def _profiles(params, u_best: np.ndarray, c_best: float, workers: int) -> list[Profile]:
+def _profiles(params, u_best: np.ndarray, c_best: float, workers: int):
+    """Local profiles around ``u_best``; also the best profile point if it beats the optimum (or None)."""
     tasks = []
     for i in range(len(params)):
         for d in PROFILE_OFFSETS:
@@ -163,6 +167,8 @@ def _profiles(params, u_best: np.ndarray, c_best: float, workers: int) -> list[P
             t[i] = min(max(t[i] + d, 0.0), 1.0)
             tasks.append(t)
     results = _map(tasks, workers)
+    j = min(range(len(results)), key=lambda m: results[m][0])
+    better = (tasks[j], results[j]) if results[j][0] < c_best - 1e-9 else None
     out = []
     n = len(PROFILE_OFFSETS)
     for i, fp in enumerate(params):
@@ -179,13 +185,13 @@ def _profiles(params, u_best: np.ndarray, c_best: float, workers: int) -> list[P
             hi += 1
         out.append(Profile(fp.key, [fp.from_unit(x) for x in us], cs,
                            (fp.from_unit(us[lo]), fp.from_unit(us[hi])), us[hi] - us[lo], c_best))
-    return out
+    return out, better
 
 
 def calibrate(cfg: PlantConfig, *, workers: int | None = None, sobol_points: int = SOBOL_POINTS,
               table: tuple[Unstated, ...] | None = None, conditions: dict | None = None,
               profiles: bool = True, targets: dict | None = None,
-              compass_iterations: int = COMPASS_ITERATIONS) -> Calibration:
+              compass_iterations: int = COMPASS_ITERATIONS, seeds: tuple[PlantConfig, ...] = ()) -> Calibration:
     """Fit the unstated parameters and test conditions of ``cfg`` to the paper's figures.
 
     Parameters
@@ -206,6 +212,8 @@ def calibrate(cfg: PlantConfig, *, workers: int | None = None, sobol_points: int
         (test, metric) -> figure to calibrate to instead of the paper's (``rows_of``).
     compass_iterations : int
         Iterations of the local search.
+    seeds : tuple of PlantConfig
+        Further starting points for the global sample (e.g. an earlier stage's optimum).
     """
     workers = max(1, workers or available_cores())
     table = table if table is not None else unstated_for(cfg)
@@ -218,13 +226,21 @@ def calibrate(cfg: PlantConfig, *, workers: int | None = None, sobol_points: int
     u0 = np.array([fp.to_unit(value_of(cfg, fp.key)) for fp in params])
     from scipy.stats import qmc
 
-    sample = [u0] + list(qmc.Sobol(len(params), scramble=True, seed=17).random(sobol_points))
+    extra = [np.array([fp.to_unit(value_of(s, fp.key)) for fp in params]) for s in (seeds or ())]
+    sample = [u0] + extra + list(qmc.Sobol(len(params), scramble=True, seed=17).random(sobol_points))
     results = _map(sample, workers)
     k = min(range(len(results)), key=lambda j: results[j][0])
     u_best, best, n = _compass(np.asarray(sample[k]), results[k], workers, compass_iterations)
     n_eval = len(sample) + n
-    prof = _profiles(params, u_best, best[0], workers) if profiles else []
-    n_eval += len(params) * len(PROFILE_OFFSETS) if profiles else 0
+    prof = []
+    for _ in range(POLISH_ROUNDS + 1 if profiles else 0):
+        prof, better = _profiles(params, u_best, best[0], workers)
+        n_eval += len(params) * len(PROFILE_OFFSETS)
+        if better is None:
+            break
+        # a profile point beat the optimum (a rough objective fools the compass): restart there, finer
+        u_best, best, n = _compass(better[0], better[1], workers, compass_iterations, start=COMPASS_START / 4)
+        n_eval += n
     cal = _configure(cfg, params, u_best)
     cond = conds[best[1]]
     rows_after = rows_of(cal, cond, targets=targets)

@@ -19,7 +19,12 @@ from compliance.papers.calibration import map_configs
 from compliance.papers.calibration_objective import rows_of
 from compliance.papers.plant_a import Row, scaled_miss
 
-MAX_POINTS = 8  # grid points per effect (evenly thinned): enough to see whether it can move a figure
+MAX_POINTS = 9  # grid points per effect (evenly thinned): enough to see whether it can move a figure
+# starting points for an effect the diagnosis has no grid for yet (null leakage 0.1-1 % of full opening,
+# pressure gain at null over 0.1-0.65 V)
+FALLBACK_GRIDS = {
+    "valve_null_flow": tuple({"null_opening": a, "null_width": w} for a in (0.001, 0.003, 0.01) for w in (0.1, 0.3, 0.65)),
+}
 
 
 @dataclass
@@ -32,6 +37,8 @@ class EffectResult:
     closes: list[str] = field(default_factory=list)  # figures brought inside the scatter
     opens: list[str] = field(default_factory=list)  # figures pushed outside it
     rows: list[Row] = field(default_factory=list)
+    points: list[tuple[float, dict]] = field(default_factory=list)  # every grid point tried, best first
+    evaluations: int = 0
 
 
 def _label(r: Row) -> str:
@@ -69,18 +76,24 @@ def effect_search(cfg: PlantConfig, conditions: dict, base_rows: list[Row], work
     names = names or tuple(n for n in EFFECTS if n not in cfg.effects)
     cfgs, owners = [], []
     for name in names:
-        for point in _thin(effect_candidate(name).grid):
+        grid = effect_candidate(name).grid
+        if grid == ({},) and name in FALLBACK_GRIDS:
+            grid = FALLBACK_GRIDS[name]
+        for point in _thin(grid):
             cfgs.append(cfg.replace(effects={name: point}))
             owners.append((name, dict(point)))
     costs = map_configs(cfgs, [conditions], workers)
     best: dict[str, tuple[float, int]] = {}
-    for i, ((name, _), (c, _)) in enumerate(zip(owners, costs)):
+    tried: dict[str, list[tuple[float, dict]]] = {}
+    for i, ((name, point), (c, _)) in enumerate(zip(owners, costs)):
+        tried.setdefault(name, []).append((c, point))
         if name not in best or c < best[name][0]:
             best[name] = (c, i)
     out = []
     for name, (c, i) in best.items():
         rows = rows_of(cfgs[i], conditions) or []
-        res = EffectResult(name, c, dict(cfgs[i].effects[name]), rows=rows)
+        res = EffectResult(name, c, dict(cfgs[i].effects[name]), rows=rows,
+                           points=sorted(tried[name], key=lambda cp: cp[0]), evaluations=len(tried[name]))
         for b, a in zip(base_rows, rows):
             if not _inside(b) and _inside(a):
                 res.closes.append(_label(a))

@@ -11,6 +11,11 @@ from compliance.errors import InputError
 from compliance.model.config import PlantConfig
 
 
+FIRST_STAGE_SOBOL = 16  # parameters only: what they can reach, and the base of the effect search
+FIRST_STAGE_COMPASS = 6
+SECOND_STAGE_SEEDS = 4  # best effect-search points that start the second stage
+
+
 def _check_writable(path: str) -> None:
     """Refuse an output path that cannot be written before any work starts."""
     folder = Path(path).resolve().parent
@@ -43,15 +48,19 @@ def calibrate_in_stages(cfg: PlantConfig, workers: int | None = None):
     from compliance.papers.calibration_effects import effect_search
     from compliance.papers.calibration_table import NULL_FLOW_EFFECT
 
-    first = calibrate(cfg, workers=workers, profiles=NULL_FLOW_EFFECT not in EFFECTS or NULL_FLOW_EFFECT in cfg.effects)
-    if NULL_FLOW_EFFECT not in EFFECTS or NULL_FLOW_EFFECT in cfg.effects:
+    with_effect = NULL_FLOW_EFFECT in EFFECTS and NULL_FLOW_EFFECT not in cfg.effects
+    first = calibrate(cfg, workers=workers, profiles=not with_effect,
+                      **({"sobol_points": FIRST_STAGE_SOBOL, "compass_iterations": FIRST_STAGE_COMPASS} if with_effect else {}))
+    if not with_effect:
         return first, first, []
     found = effect_search(first.best, first.conditions, first.rows_after, first.workers)
     null = next(r for r in found if r.name == NULL_FLOW_EFFECT)
+    # start from the parameters-only optimum with the effect at its best starting points
     start = first.best.replace(effects={NULL_FLOW_EFFECT: null.params})
-    final = calibrate(start, workers=workers, conditions=None)
+    seeds = tuple(first.best.replace(effects={NULL_FLOW_EFFECT: p}) for _, p in null.points[1:SECOND_STAGE_SEEDS])
+    final = calibrate(start, workers=workers, seeds=seeds)
     final.start, final.rows_before, final.cost_before = cfg, first.rows_before, first.cost_before
-    final.evaluations += first.evaluations + sum(1 for _ in found)
+    final.evaluations += first.evaluations + sum(r.evaluations for r in found)
     return final, first, found
 
 
