@@ -207,10 +207,11 @@ def _param_value(entry, key: str, where: str, atmosphere: float):
         value = parse_quantity(entry, spec.unit, where, pressure=spec.pressure, atmosphere=atmosphere)
     if not math.isfinite(value):
         raise InputError(f"{where}: value is not finite")
-    bad = value < spec.low or value > spec.high or (spec.low_open and value <= spec.low)
+    low, high = spec.bounds
+    bad = value < low or value > high or (spec.low_open and value <= low)
     if bad:
-        lo = f"> {spec.low:g}" if spec.low_open else f">= {spec.low:g}"
-        raise InputError(f"{where}: {value:g} {spec.unit} is not physical; expected {lo} and <= {spec.high:g} ({spec.meaning})")
+        lo = f"> {low:g}" if spec.low_open else f">= {low:g}"
+        raise InputError(f"{where}: {value:g} {spec.unit} is not physical; expected {lo} and <= {high:g} ({spec.meaning})")
     return value, source
 
 
@@ -268,16 +269,16 @@ def plant_from_dict(data: dict[str, Any], where: str = "<configuration>", digest
                 options[key] = val
                 continue
             if key not in BASE_BY_KEY:
-                choices = [b.key.split(".", 1)[1] for b in BASE_PARAMS if b.key.startswith(section + ".")]
+                choices = [b.name.split(".", 1)[1] for b in BASE_PARAMS if b.name.startswith(section + ".")]
                 choices += [o.split(".", 1)[1] for o in OPTIONS if o.startswith(section + ".")]
                 raise InputError(f"{kw}: unknown key '{k}' in [{section}]{_suggest(k, choices)}")
             params[key], sources[key] = _param_value(entry, key, kw, atmosphere)
     for spec in BASE_PARAMS:
-        if spec.key not in params:
+        if spec.name not in params:
             if spec.default is None:
-                raise InputError(f"{where}: missing value {spec.key} ({spec.meaning}, unit {spec.unit})")
-            params[spec.key] = float(spec.default)
-            sources[spec.key] = "assumed"
+                raise InputError(f"{where}: missing value {spec.name} ({spec.meaning}, unit {spec.unit})")
+            params[spec.name] = float(spec.default)
+            sources[spec.name] = "assumed"
     load_curve = None
     if load_curve_raw is not None:
         kw = f"{where}: load.curve"
@@ -383,9 +384,9 @@ def plant_to_toml(cfg: PlantConfig) -> str:
         val = v if v not in ("true", "false") else v
         sections.setdefault(sec, []).append(f"{name} = {val}" if v in ("true", "false") else f'{name} = "{val}"')
     for spec in BASE_PARAMS:
-        sec, name = spec.key.split(".", 1)
-        v = cfg.params[spec.key]
-        src = cfg.sources.get(spec.key, "user")
+        sec, name = spec.name.split(".", 1)
+        v = cfg.params[spec.name]
+        src = cfg.sources.get(spec.name, "user")
         if spec.unit == "number":
             val = _fmt(v)
         else:

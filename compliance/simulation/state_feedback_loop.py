@@ -16,6 +16,7 @@ import numpy as np
 import pandas as pd
 from numba import njit
 
+from compliance.effects import EFFECTS
 from compliance.model.config import PlantConfig
 from compliance.model.pid_controller import dead_zone_compensation, pid_step, saturate
 from compliance.errors import InputError, SimulationError
@@ -192,9 +193,6 @@ class AxisReference:
         object.__setattr__(self, "acceleration", arrays[2])
 
 
-_UNSUPPORTED_EFFECTS = ("sensor_lag",)
-
-
 def simulate_axis(cfg: PlantConfig, reference: AxisReference, *, mode: str | None = None, compensation: bool | None = None,
                   feedforward: bool | None = None, load: float | None = None, design: ControllerDesign | None = None,
                   compensation_form: str = "inverse", position_noise: float = 0.0, position_quantum: float = 0.0, pressure_noise: float = 0.0,
@@ -239,11 +237,11 @@ def simulate_axis(cfg: PlantConfig, reference: AxisReference, *, mode: str | Non
         Non-physical state.
     """
     where = cfg.path or cfg.name
-    for e in _UNSUPPORTED_EFFECTS:
-        if e in cfg.effects:
+    for e, values in cfg.effects.items():  # the declarations say what this loop can run (Effect.plant_b, input_delay)
+        if not EFFECTS[e].plant_b:
             raise InputError(f"{where}: effect {e} is not supported by the tracking loop (use govcheck simulate)")
-    if "valve_dynamics" in cfg.effects and cfg.effects["valve_dynamics"].get("delay", 0.0) > 0.0:
-        raise InputError(f"{where}: a valve_dynamics delay is not supported by the tracking loop")
+        if EFFECTS[e].input_delay and values.get(EFFECTS[e].input_delay, 0.0) > 0.0:
+            raise InputError(f"{where}: a {e} delay is not supported by the tracking loop")
     stroke = cfg.p("cylinder.stroke")
     r = reference
     if np.min(r.position) < 0.0 or np.max(r.position) > stroke:
