@@ -277,7 +277,7 @@ def compare(cfg: PlantConfig, explain: bool = True, conditions: dict | None = No
         f"With lc = {cfg.p('controller.compensation_width'):.2f} V and K_P = {cfg.p('controller.kp'):.0f} V/m the "
         f"compensated valve stays shut once |e| < {comp.stall_error * 1e3:.2f} mm: an ideal dead zone leaves steady "
         f"errors up to that value, and stick-slip can end anywhere inside it. The paper measured 0.24-0.32 mm (up to "
-        f"0.8 mm): flow through the real valve near its null, or a narrower lc, closes that gap (reference-plant.md)."
+        f"0.8 mm): flow through the real valve near its null, or a narrower lc, closes that gap (effect valve_null_flow; docs/calibration.md)."
     )
     return comp
 
