@@ -5,7 +5,7 @@ Search in the unit cube of the declared plausible ranges (``calibration_table``)
 
 1. a scrambled Sobol sample of the cube (plus the starting configuration), each point under
    every combination of the open test conditions, evaluated on a forked process pool;
-2. a parallel compass search from the best point: all 2n axis moves are polled at once, the
+2. parallel compass searches from the ``STARTS`` best points: all 2n axis moves are polled at once, the
    best improving move is taken, the step halves when none improves (Kolda, Lewis & Torczon
    2003, generating set search: derivative-free and robust to the kinks stick-slip puts in
    settling times);
@@ -40,7 +40,8 @@ from compliance.papers.plant_a import Row, conditions_of
 SOBOL_POINTS = 128
 COMPASS_START = 0.1  # first step in the unit cube
 COMPASS_MIN = 1.0 / 64.0
-COMPASS_ITERATIONS = 20
+COMPASS_ITERATIONS = 12
+STARTS = 3  # compass searches from the best distinct points of the global sample
 PROFILE_OFFSETS = (-0.3, -0.1, -0.03, 0.03, 0.1, 0.3)  # unit-cube offsets of the local profile
 POLISH_ROUNDS = 2  # restarts of the compass from a profile point that beat it
 PIN_DELTA = 1.0  # one scatter^2: a value that moves one figure by its whole scatter is excluded
@@ -191,7 +192,8 @@ def _profiles(params, u_best: np.ndarray, c_best: float, workers: int):
 def calibrate(cfg: PlantConfig, *, workers: int | None = None, sobol_points: int = SOBOL_POINTS,
               table: tuple[Unstated, ...] | None = None, conditions: dict | None = None,
               profiles: bool = True, targets: dict | None = None,
-              compass_iterations: int = COMPASS_ITERATIONS, seeds: tuple[PlantConfig, ...] = ()) -> Calibration:
+              compass_iterations: int = COMPASS_ITERATIONS, seeds: tuple[PlantConfig, ...] = (),
+              starts: int = STARTS) -> Calibration:
     """Fit the unstated parameters and test conditions of ``cfg`` to the paper's figures.
 
     Parameters
@@ -214,6 +216,8 @@ def calibrate(cfg: PlantConfig, *, workers: int | None = None, sobol_points: int
         Iterations of the local search.
     seeds : tuple of PlantConfig
         Further starting points for the global sample (e.g. an earlier stage's optimum).
+    starts : int
+        Compass searches from that many best points of the sample.
     """
     workers = max(1, workers or available_cores())
     table = table if table is not None else unstated_for(cfg)
@@ -229,9 +233,13 @@ def calibrate(cfg: PlantConfig, *, workers: int | None = None, sobol_points: int
     extra = [np.array([fp.to_unit(value_of(s, fp.key)) for fp in params]) for s in (seeds or ())]
     sample = [u0] + extra + list(qmc.Sobol(len(params), scramble=True, seed=17).random(sobol_points))
     results = _map(sample, workers)
-    k = min(range(len(results)), key=lambda j: results[j][0])
-    u_best, best, n = _compass(np.asarray(sample[k]), results[k], workers, compass_iterations)
-    n_eval = len(sample) + n
+    n_eval = len(sample)
+    u_best, best = None, (math.inf, 0)
+    for k in sorted(range(len(results)), key=lambda j: results[j][0])[:starts]:  # the landscape has several basins
+        u, b, n = _compass(np.asarray(sample[k]), results[k], workers, compass_iterations)
+        n_eval += n
+        if b[0] < best[0]:
+            u_best, best = u, b
     prof = []
     for _ in range(POLISH_ROUNDS + 1 if profiles else 0):
         prof, better = _profiles(params, u_best, best[0], workers)

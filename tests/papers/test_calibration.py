@@ -26,7 +26,7 @@ def test_calibration_recovers_hidden_parameters_from_model_figures():
     targets = {(r.test, r.metric): r.simulated for r in rows if r.paper is not None}
     table = tuple(u for u in UNSTATED if u.path in truth)
     cal = calibrate(cfg, workers=1, sobol_points=8, table=table, conditions=DEFAULT_CONDITIONS, profiles=False,
-                    targets=targets, compass_iterations=12)
+                    targets=targets, compass_iterations=12, starts=1)
     assert cal.cost_before > 10.0  # the published values are far from the hidden ones
     for key, value in truth.items():
         assert cal.values[key] == pytest.approx(value, rel=0.05), key
@@ -35,7 +35,7 @@ def test_calibration_recovers_hidden_parameters_from_model_figures():
 def test_calibrated_file_validates_and_records_provenance(tmp_path):
     cfg = load_plant("plant-a")
     table = tuple(u for u in UNSTATED if u.path == "valve.saturation_voltage")
-    cal = calibrate(cfg, workers=1, sobol_points=2, table=table, profiles=False, compass_iterations=1,
+    cal = calibrate(cfg, workers=1, sobol_points=2, table=table, profiles=False, compass_iterations=1, starts=1,
                     conditions={"fig9_sequence": "staircase", "full_stroke_start": "end_stop"})
     path = save_calibrated(cal, tmp_path / "plant-a-calibrated.toml")
     back = load_plant(path)
