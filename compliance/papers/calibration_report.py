@@ -62,7 +62,8 @@ def calibration_table(cal: Calibration, columns: list[tuple[str, list]] | None =
         got = cal.values[u.path]
         p = prof.get(u.path)
         pin = f"allowed {_si(p.allowed[0], '')}..{_si(p.allowed[1], u.unit)} ({p.verdict})" if p else ""
-        lines.append(f"  {u.path:44s} {_si(start, ''):>10s} -> {_si(got, u.unit):16s} range "
+        start_txt = "off" if math.isnan(start) else _si(start, "")
+        lines.append(f"  {u.path:44s} {start_txt:>10s} -> {_si(got, u.unit):16s} range "
                      f"{_si(u.low, '')}..{_si(u.high, u.unit)}; {pin}")
         if p:
             lines.append(f"  {'':44s} profile (cost above optimum at offsets -30,-10,-3,0,+3,+10,+30 % of range): {p.deltas()}")

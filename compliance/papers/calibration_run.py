@@ -13,7 +13,7 @@ from compliance.model.config import PlantConfig
 
 FIRST_STAGE_SOBOL = 16  # parameters only: what they can reach, and the base of the effect search
 FIRST_STAGE_COMPASS = 6
-SECOND_STAGE_SEEDS = 4  # best effect-search points that start the second stage
+SECOND_STAGE_SEEDS = 2  # best effect-search points that seed the second stage
 
 
 def _check_writable(path: str) -> None:
@@ -55,9 +55,10 @@ def calibrate_in_stages(cfg: PlantConfig, workers: int | None = None):
         return first, first, []
     found = effect_search(first.best, first.conditions, first.rows_after, first.workers)
     null = next(r for r in found if r.name == NULL_FLOW_EFFECT)
-    # start from the parameters-only optimum with the effect at its best starting points
-    start = first.best.replace(effects={NULL_FLOW_EFFECT: null.params})
-    seeds = tuple(first.best.replace(effects={NULL_FLOW_EFFECT: p}) for _, p in null.points[1:SECOND_STAGE_SEEDS])
+    # start from the published plant with the effect at its declared defaults; the parameters-only optimum with
+    # the effect at its best starting points seeds the global sample (the landscape has several basins)
+    start = cfg.replace(effects={NULL_FLOW_EFFECT: {}})
+    seeds = tuple(first.best.replace(effects={NULL_FLOW_EFFECT: p}) for _, p in null.points[:SECOND_STAGE_SEEDS])
     final = calibrate(start, workers=workers, seeds=seeds)
     final.start, final.rows_before, final.cost_before = cfg, first.rows_before, first.cost_before
     final.evaluations += first.evaluations + sum(r.evaluations for r in found)

@@ -59,3 +59,29 @@ def test_unknown_source_text_is_still_refused(tmp_path):
     text.write_text(open(src).read().replace('source = "assumed" }', 'source = "guessed" }', 1))
     with pytest.raises(InputError, match="source"):
         load_plant(text)
+
+
+def test_committed_calibrated_plant_records_what_changed():
+    """models/plant-a-calibrated.toml: every fitted value (all that differ from plant A among them) says it was
+    calibrated; the rest keeps its source; the test conditions and the null-flow effect's origin are recorded."""
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    base = load_plant(root / "models" / "plant-a.toml")
+    cal = load_plant(root / "models" / "plant-a-calibrated.toml")
+    changed = [k for k in base.params if abs(cal.params[k] - base.params[k]) > 1e-9 * max(1.0, abs(base.params[k]))]
+    assert changed, "the calibration changed nothing"
+    fitted = {u.path for u in UNSTATED}
+    for k in base.params:
+        if k in changed:
+            assert cal.sources[k].startswith(PREFIX), k
+        if k in fitted:  # a fitted value is calibrated even where the fit confirmed the published one
+            assert cal.sources[k].startswith(PREFIX), k
+        else:
+            assert cal.sources[k] == base.sources[k], k
+    for k in ("cylinder.stroke", "controller.kp", "controller.compensation_width", "valve.dead_zone_positive"):
+        assert k not in changed  # stated by the paper
+    assert set(conditions_of(cal)) == set(DEFAULT_CONDITIONS)
+    assert all(f"condition_{c}" in cal.provenance for c in DEFAULT_CONDITIONS)
+    if "valve_null_flow" in cal.effects:
+        assert cal.provenance["effect_valve_null_flow"].startswith(PREFIX)
