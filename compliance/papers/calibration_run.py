@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import os
 import resource
 import time
 from pathlib import Path
@@ -17,15 +16,18 @@ SECOND_STAGE_SEEDS = 2  # best effect-search points that seed the second stage
 
 
 def _check_writable(path: str) -> None:
-    """Refuse an output path that cannot be written before any work starts."""
-    folder = Path(path).resolve().parent
-    probe = folder
-    while not probe.exists():
-        probe = probe.parent
-    if not probe.is_dir() or not os.access(probe, os.W_OK):
-        raise InputError(f"{path}: cannot write the calibrated configuration there (folder {probe} is not writable)")
+    """Refuse an output path that cannot be written, before any work starts (a probe file is created and removed)."""
+    import tempfile
+
     if Path(path).is_dir():
         raise InputError(f"{path}: is a folder; give a .toml file name")
+    folder = Path(path).resolve().parent
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile(dir=folder, prefix=".govcheck-probe-"):
+            pass
+    except OSError as exc:
+        raise InputError(f"{path}: cannot write there ({exc.strerror or exc})") from None
 
 
 def _cpu_seconds() -> float:

@@ -223,7 +223,7 @@ def full_stroke(cfg: PlantConfig, load: float = 5700.0, start: str = "balanced")
         pressures = None
         if start == "end_stop":  # closing ended at x = 0 with B at supply; opening ended at L with A at supply
             pressures = (1.001 * patm, ps) if direction > 0 else (ps, 1.001 * patm)
-        df = simulate(cfg, Scenario(duration=8.0, initial_position=x0, command=cmd, load=load, flow_control=True,
+        df = simulate(cfg, Scenario(duration=12.0, initial_position=x0, command=cmd, load=load, flow_control=True,
                                     initial_pressures=pressures))
         t = df.time.to_numpy()
         x = df.position_true.to_numpy()

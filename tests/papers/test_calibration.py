@@ -85,3 +85,10 @@ def test_committed_calibrated_plant_records_what_changed():
     assert all(f"condition_{c}" in cal.provenance for c in DEFAULT_CONDITIONS)
     if "valve_null_flow" in cal.effects:
         assert cal.provenance["effect_valve_null_flow"].startswith(PREFIX)
+
+
+def test_unwritable_output_is_refused_before_any_work(capsys):
+    from compliance.cli import main
+
+    assert main(["reproduce", "plant-a", "--calibrate", "/proc/no-such-folder/plant.toml"]) == 2
+    assert "cannot write" in capsys.readouterr().err
