@@ -50,7 +50,7 @@ _CTX: dict = {}  # set before the pool forks (nothing large is pickled)
 
 
 @dataclass
-class Profile:
+class ParameterProfile:
     """How well the figures pin one parameter."""
 
     path: str
@@ -92,7 +92,7 @@ class Calibration:
     cost_after: float
     rows_before: list[Row]
     rows_after: list[Row]
-    profiles: list[Profile] = field(default_factory=list)
+    profiles: list[ParameterProfile] = field(default_factory=list)
     evaluations: int = 0
     workers: int = 1
 
@@ -184,7 +184,7 @@ def _profiles(params, u_best: np.ndarray, c_best: float, workers: int):
             lo -= 1
         while hi < len(us) - 1 and cs[hi + 1] <= c_best + PIN_DELTA:
             hi += 1
-        out.append(Profile(fp.key, [fp.from_unit(x) for x in us], cs,
+        out.append(ParameterProfile(fp.key, [fp.from_unit(x) for x in us], cs,
                            (fp.from_unit(us[lo]), fp.from_unit(us[hi])), us[hi] - us[lo], c_best))
     return out, better
 
@@ -255,8 +255,3 @@ def calibrate(cfg: PlantConfig, *, workers: int | None = None, sobol_points: int
     values = {fp.key: value_of(cal, fp.key) for fp in params}
     return Calibration(cfg, cal, tuple(table), values, cond, cost(rows_before), cost(rows_after), rows_before,
                        rows_after, prof, n_eval, workers)
-
-
-def cost_at(cfg: PlantConfig, values: dict[str, float], cond: dict) -> float:
-    """Objective of ``cfg`` with ``values`` set (for tests and the effect search)."""
-    return cost(rows_of(apply_values(cfg, values), cond))
