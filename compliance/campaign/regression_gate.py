@@ -3,6 +3,10 @@
 The gate trips when
 - a requirement that passed in the baseline does not pass in the candidate (fail, or no
   longer evaluated: a check that silently stops running must not look like a pass),
+- a mandatory requirement that was evaluated in the baseline (pass or fail) cannot be
+  evaluated in the candidate (a change that makes a failing requirement unmeasurable must not
+  turn a known failure into silence), unless the user allows it explicitly for that id
+  (``allow_not_evaluated``); the reason it could not be evaluated is in the row,
 - a requirement present in the baseline is missing from the candidate,
 - a requirement new in the candidate fails,
 - a requirement's worst-case margin shrinks by more than ``max_margin_loss`` percentage
@@ -22,7 +26,33 @@ def _worst(entry: dict | None):
     return w.get("margin_pct"), w.get("value"), (w.get("display") or {}).get("value", "-")
 
 
-def compare(baseline: dict, candidate: dict, max_margin_loss: float | None = None) -> dict:
+def not_evaluated_reason(entry: dict | None) -> str | None:
+    """Why a requirement could not be evaluated (the distinct reasons of its rows), or None."""
+    if not entry or entry.get("status") != "not_evaluated":
+        return None
+    reasons = sorted({r["reason"] for r in entry.get("rows") or [] if r.get("reason")})
+    return "; ".join(reasons) if reasons else "no reason recorded"
+
+
+def _status_reasons(rid: str, b: dict | None, c: dict | None, why: str | None, allowed: bool):
+    """Why a status change trips the gate (list), and the note of an explicitly allowed one (or None)."""
+    bs = b["status"] if b else "absent"
+    cs = c["status"] if c else "absent"
+    if b is not None and c is None:
+        return ["requirement removed in the candidate"], None
+    if b is None and cs == "fail":
+        return ["new requirement fails"], None
+    if cs == "not_evaluated" and (bs == "pass" or (bs == "fail" and c["severity"] == "mandatory")):
+        if allowed:
+            return [], f"{bs} -> not_evaluated allowed explicitly (--allow-not-evaluated {rid}): {why}"
+        return [f"{bs} -> not_evaluated: could not be evaluated: {why}"], None
+    if bs == "pass" and cs != "pass":
+        return [f"{bs} -> {cs}"], None
+    return [], None
+
+
+def compare(baseline: dict, candidate: dict, max_margin_loss: float | None = None,
+            allow_not_evaluated: tuple[str, ...] | list[str] = ()) -> dict:
     """Compare two results dicts.
 
     Parameters
@@ -31,6 +61,8 @@ def compare(baseline: dict, candidate: dict, max_margin_loss: float | None = Non
         Results of ``govcheck check`` (schema govcheck-results/1).
     max_margin_loss : float, optional
         Largest allowed loss of worst-case margin [percentage points]; None: not checked.
+    allow_not_evaluated : sequence of str
+        Requirement ids allowed to become not evaluated (the row says so; the gate does not trip).
 
     Returns
     -------
@@ -40,6 +72,10 @@ def compare(baseline: dict, candidate: dict, max_margin_loss: float | None = Non
     base = {e["id"]: e for e in baseline["requirements"]}
     cand = {e["id"]: e for e in candidate["requirements"]}
     rows, tripped, notes = [], [], []
+    allowed = set(allow_not_evaluated)
+    unknown = sorted(allowed - set(base) - set(cand))
+    if unknown:
+        notes.append(f"--allow-not-evaluated names requirements not in either result: {', '.join(unknown)}")
     bset, cset = baseline["requirement_set"], candidate["requirement_set"]
     if bset.get("digest") != cset.get("digest"):
         notes.append(f"requirement files differ: baseline {bset.get('name')} ({str(bset.get('digest'))[:12]}), "
@@ -51,13 +87,8 @@ def compare(baseline: dict, candidate: dict, max_margin_loss: float | None = Non
         bs = b["status"] if b else "absent"
         cs = c["status"] if c else "absent"
         delta = None if bm is None or cm is None else cm - bm
-        reasons = []
-        if b is not None and c is None:
-            reasons.append("requirement removed in the candidate")
-        elif b is None and cs == "fail":
-            reasons.append("new requirement fails")
-        elif bs == "pass" and cs != "pass":
-            reasons.append(f"{bs} -> {cs}")
+        why = not_evaluated_reason(c)
+        reasons, allowed_note = _status_reasons(rid, b, c, why, rid in allowed)
         if max_margin_loss is not None and delta is not None and -delta > max_margin_loss:
             reasons.append(f"margin lost {-delta:.1f} pp > {max_margin_loss:g} pp allowed")
         if reasons:
@@ -74,6 +105,8 @@ def compare(baseline: dict, candidate: dict, max_margin_loss: float | None = Non
             "margin_change_pp": delta,
             "tripped": bool(reasons),
             "reasons": reasons,
+            "not_evaluated_reason": why,
+            "allowed": allowed_note,
             "preexisting_failure": bs == "fail" and cs == "fail",
         })
     return {
@@ -81,6 +114,7 @@ def compare(baseline: dict, candidate: dict, max_margin_loss: float | None = Non
         "status": "fail" if tripped else "pass",
         "tripped": tripped,
         "max_margin_loss": max_margin_loss,
+        "allow_not_evaluated": sorted(allowed),
         "baseline": {"plant": baseline["plant"]["name"], "digest": baseline["plant"].get("digest"),
                      "path": baseline["plant"].get("path"), "verdict": baseline["summary"]["status"]},
         "candidate": {"plant": candidate["plant"]["name"], "digest": candidate["plant"].get("digest"),
@@ -97,14 +131,25 @@ def _cell(side: dict) -> str:
     return f"{word} {side['display']}{m}" if side["display"] not in (None, "-") else word
 
 
+def _gate_cell(row: dict, tripped_word: str) -> str:
+    """The gate column: why it tripped, an explicit allowance, or ok; with the not-evaluated reason."""
+    if row["tripped"]:
+        return f"{tripped_word}: " + "; ".join(row["reasons"])
+    if row.get("allowed"):
+        return f"allowed: {row['allowed']}"
+    text = "still failing" if row["preexisting_failure"] else "ok"
+    if row.get("not_evaluated_reason"):
+        text += f" (not evaluated: {row['not_evaluated_reason']})"
+    return text
+
+
 def gate_table(result: dict) -> str:
     """Side-by-side terminal table of a gate result."""
     head = ("requirement", "limit", "baseline", "candidate", "margin change", "gate")
     rows = []
     for r in result["rows"]:
         d = "-" if r["margin_change_pp"] is None else f"{r['margin_change_pp']:+.1f} pp"
-        g = "TRIPPED: " + "; ".join(r["reasons"]) if r["tripped"] else ("still failing" if r["preexisting_failure"] else "ok")
-        rows.append((r["id"], r["limit_text"], _cell(r["baseline"]), _cell(r["candidate"]), d, g))
+        rows.append((r["id"], r["limit_text"], _cell(r["baseline"]), _cell(r["candidate"]), d, _gate_cell(r, "TRIPPED")))
     widths = [max(len(str(x[i])) for x in rows + [head]) for i in range(len(head))]
     line = lambda x: "  ".join(str(c).ljust(widths[i]) for i, c in enumerate(x)).rstrip()  # noqa: E731
     out = [line(head), line(tuple("-" * w for w in widths))] + [line(x) for x in rows]
@@ -131,7 +176,7 @@ def gate_markdown(result: dict) -> str:
     ]
     for r in result["rows"]:
         d = "-" if r["margin_change_pp"] is None else f"{r['margin_change_pp']:+.1f} pp"
-        g = "**tripped**: " + "; ".join(r["reasons"]) if r["tripped"] else ("still failing" if r["preexisting_failure"] else "ok")
+        g = _gate_cell(r, "**tripped**").replace("|", "\\|")
         lines.append(f"| `{r['id']}` {r['title']} | {r['limit_text']} | {_cell(r['baseline'])} | {_cell(r['candidate'])} | {d} | {g} |")
     for n in result["notes"]:
         lines += ["", f"> note: {n}"]

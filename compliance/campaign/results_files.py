@@ -7,42 +7,21 @@ so a CI job never reads half a file.
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 from xml.sax.saxutils import escape, quoteattr
 
 from compliance.errors import InputError
 from compliance.files.atomic import write_text_atomic
+from compliance.files.jsonable import json_text
 
 RESULTS_SCHEMA = "govcheck-results/1"
 _STATUS_WORD = {"pass": "PASS", "fail": "FAIL", "not_evaluated": "NOT EVALUATED", "open": "OPEN", "disabled": "DISABLED"}
 
 
-def _plain(obj):
-    """JSON default: numpy scalars/arrays to Python; non-finite floats to None."""
-    import numpy as np
-
-    if isinstance(obj, np.generic):
-        return obj.item()
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    raise TypeError(f"not JSON serialisable: {type(obj).__name__}")
-
-
-def _finite(obj):
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    if isinstance(obj, dict):
-        return {k: _finite(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_finite(v) for v in obj]
-    return obj
-
-
 def results_json(results: dict) -> str:
-    """Serialise a results dict (non-finite numbers become null)."""
+    """Serialise a results dict with the one JSON cleaner (non-finite numbers become null)."""
     # compact: the traces make up most of the file; tools, not people, read it
-    return json.dumps(_finite(json.loads(json.dumps(results, default=_plain))), separators=(",", ":"), allow_nan=False) + "\n"
+    return json_text(results, compact=True)
 
 
 def write_json(results: dict, path) -> None:
@@ -63,6 +42,8 @@ def read_results(path) -> dict:
         data = json.loads(p.read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise InputError(f"{p}: results file not found") from None
+    except IsADirectoryError:
+        raise InputError(f"{p}: is a folder; expected a results JSON file written by 'govcheck check --json'") from None
     except (UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise InputError(f"{p}: not a JSON results file ({exc.__class__.__name__}: {exc})") from None
     if not isinstance(data, dict) or "schema" not in data:

@@ -138,6 +138,7 @@ class FlowFit:
     n: int
     n_eff: float
     extra: dict = field(default_factory=dict)
+    implausible: str | None = None  # why the fitted values are physically impossible (never ranked best)
 
     def predict(self, p_up, p_down, t_up):
         """Mass flow of this fit at the given pressures [Pa abs] and temperature [K] [kg/s]."""
@@ -212,10 +213,24 @@ def fit_flow_law(name: str, p_up, p_down, t_up, mass_flow, *, correlation_length
     values = list(map(float, coefs)) + ([shape] if law.shape else [])
     n_eff = n / correlation_length
     aic = n_eff * math.log(max(rss, 1e-300) / n) + 2 * k  # Akaike (1974), Gaussian residuals
+    params = dict(zip(names, values))
     return FlowFit(
-        law=name, equation=law.equation, params=dict(zip(names, values)), stderr=dict(zip(names, map(float, se))),
-        units=units, rms=math.sqrt(rss / n), aic=aic, n=n, n_eff=n_eff,
+        law=name, equation=law.equation, params=params, stderr=dict(zip(names, map(float, se))),
+        units=units, rms=math.sqrt(rss / n), aic=aic, n=n, n_eff=n_eff, implausible=implausibility(name, params),
     )
+
+
+# the flow through a valve goes from high to low pressure: its conductance, area or coefficient is > 0
+_POSITIVE = {"iso6358": ("conductance",), "sanville": ("area",), "bobrow": ("coefficient",), "power": ("cf1",),
+             "power-0.25": ("cf1",)}
+_NON_NEGATIVE = {"power-0.25": ("cf2",)}
+
+
+def implausibility(name: str, params: dict) -> str | None:
+    """Why a fitted law is physically impossible (a conductance or area <= 0), or None when it is plausible."""
+    bad = [f"{k} = {params[k]:.3g}" for k in _POSITIVE.get(name, ()) if not params[k] > 0]
+    bad += [f"{k} = {params[k]:.3g}" for k in _NON_NEGATIVE.get(name, ()) if not params[k] >= 0]
+    return f"{', '.join(bad)} (must be positive: flow goes from high to low pressure)" if bad else None
 
 
 def _stderr(jac: np.ndarray, rss: float, flow_noise) -> np.ndarray:
@@ -233,9 +248,20 @@ def _stderr(jac: np.ndarray, rss: float, flow_noise) -> np.ndarray:
 
 
 def rank_flow_laws(p_up, p_down, t_up, mass_flow, laws=tuple(LAWS), *, correlation_length: float = 1.0, flow_noise=None):
-    """Fit every law in ``laws`` and return the fits sorted by AIC (best first)."""
+    """Fit every law in ``laws`` and return the fits sorted by AIC (best first), physically impossible fits last.
+
+    Raises
+    ------
+    InputError
+        No law gives physically possible values (e.g. a negative conductance: the recording is
+        not a charging or discharging test of the volume through the valve).
+    """
     fits = [
         fit_flow_law(n, p_up, p_down, t_up, mass_flow, correlation_length=correlation_length, flow_noise=flow_noise)
         for n in laws
     ]
-    return sorted(fits, key=lambda f: f.aic)
+    if all(f.implausible for f in fits):
+        worst = "; ".join(f"{f.law}: {f.implausible}" for f in fits)
+        raise InputError(f"no flow law fits with physically possible values ({worst}); the pressure does not behave "
+                         "like a fixed volume charged or discharged through the valve - is this a charging test?")
+    return sorted(fits, key=lambda f: (f.implausible is not None, f.aic))

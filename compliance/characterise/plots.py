@@ -20,8 +20,10 @@ def _figure(rows: int):
 
 def _save(plt, fig, path) -> None:
     try:
+        from compliance.files.atomic import write_atomic_with
+
         fig.tight_layout()
-        fig.savefig(Path(path), dpi=120)
+        write_atomic_with(Path(path), lambda tmp: fig.savefig(tmp, dpi=120))  # format from the suffix, atomic
     except (OSError, ValueError) as exc:
         raise InputError(f"--plot {path}: cannot write the figure ({exc})") from None
     finally:

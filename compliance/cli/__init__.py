@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 
 from compliance.errors import GovcheckError
@@ -40,7 +41,7 @@ def build_parser() -> argparse.ArgumentParser:
             "governors: simulate, check against IEC 61362 / IEEE 125 requirement files, "
             "linearise, validate against recordings and diagnose missing physics."
         ),
-        epilog="Exit codes: 0 all pass, 1 a requirement failed, 2 invalid input.",
+        epilog="Exit codes: 0 all pass, 1 a requirement failed (or a gate tripped), 2 invalid input, 3 an internal error.",
     )
     parser.add_argument("--version", action="version", version=f"govcheck {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
@@ -61,7 +62,10 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``govcheck`` console script."""
     parser = build_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # argparse: usage error (2) or --help/--version (0)
+        return int(exc.code or 0) if not isinstance(exc.code, str) else 2
     if not getattr(args, "command", None):
         parser.print_help()
         return 2
@@ -73,6 +77,16 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("govcheck: interrupted", file=sys.stderr)
         return 130
+    except OSError as exc:  # a file the checks could not foresee (disk full, removed meanwhile)
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"govcheck {args.command}: error: {where}{exc.strerror or exc}", file=sys.stderr)
+        return 2
+    except Exception as exc:  # a bug: one line, never exit 1 (which CI reads as a failed requirement)
+        if os.environ.get("GOVCHECK_DEBUG"):
+            raise
+        print(f"govcheck {args.command}: internal error: {type(exc).__name__}: {exc} "
+              "(a bug in govcheck; set GOVCHECK_DEBUG=1 for the traceback and please report it)", file=sys.stderr)
+        return 3
     return int(code or 0)
 
 

@@ -6,10 +6,11 @@
 
 from __future__ import annotations
 
-import json
+import argparse
 import math
 from pathlib import Path
 
+from compliance.cli.common import add_outputs, check_args_outputs
 from compliance.errors import InputError
 from compliance.units import parse_quantity
 
@@ -22,10 +23,24 @@ def register(subparsers):
         description="Characterise the bench: valve flow law from charging/discharging a known volume "
         "(ISO 6358, Sanville, Bobrow, power laws ranked by AIC), or the friction-velocity map from "
         "constant-speed runs (Coulomb, static, Stribeck velocity, viscous; optional pressure-dependent Coulomb).",
+        epilog="examples:\n"
+               "  govcheck characterise valve charge.csv --volume '1 L' --supply-pressure '8 bar abs' --json valve.json\n"
+               "  govcheck characterise friction O-ring257_*bar.csv --column-map zillen-friction --bore '25.7 mm' --plot f.png",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     sub = p.add_subparsers(dest="target", metavar="TARGET", required=True)
 
-    v = sub.add_parser("valve", help="flow law from a fixed-volume charging/discharging recording")
+    v = sub.add_parser(
+        "valve", help="flow law from a fixed-volume charging/discharging recording",
+        description="Fit the valve's mass-flow law to a recording of the pressure in a known fixed volume being "
+                    "charged from the supply (or discharged to atmosphere) through the valve: the mass flow is "
+                    "V/(R T) dp/dt (isothermal vessel). Laws are ranked by AIC; a law whose fitted conductance or area "
+                    "is not positive is physically impossible and never ranked best. --volume is required.",
+        epilog="examples:\n"
+               "  govcheck characterise valve charge.csv --volume '1 L' --supply-pressure '8 bar abs'\n"
+               "  govcheck characterise valve bench.txt --column-map bench.toml --volume '0.5 L' --mode discharge --json v.json --plot v.svg",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     v.add_argument("recording", help="recording with time and the volume's pressure")
     v.add_argument("--volume", required=True, help='the fixed volume incl. pipe, e.g. "1 L"')
     v.add_argument("--column-map", help="column map TOML (or a shipped map name) for a non-canonical file")
@@ -36,10 +51,19 @@ def register(subparsers):
     v.add_argument("--mode", choices=("auto", "charge", "discharge"), default="auto")
     v.add_argument("--window", type=int, help="Savitzky-Golay window [samples, odd] (default 4%% of the transient)")
     v.add_argument("--laws", help="comma-separated subset of iso6358,sanville,bobrow,power,power-0.25")
-    v.add_argument("--json", help="write the results as JSON here")
-    v.add_argument("--plot", help="write a figure (PNG/SVG/PDF) here")
+    add_outputs(v, "json")
+    v.add_argument("--plot", metavar="FILE.png", help="write a figure here (.png, .svg or .pdf)")
 
-    f = sub.add_parser("friction", help="friction-velocity map from constant-speed runs (one seal, any pressures)")
+    f = sub.add_parser(
+        "friction", help="friction-velocity map from constant-speed runs (one seal, any pressures)",
+        description="Fit the friction-velocity map of one seal to constant-speed runs: friction = F - p_gauge A "
+                    "(drive force minus pressure force), binned by velocity; Coulomb, static, Stribeck velocity and "
+                    "viscous terms per direction, optionally a pressure-dependent Coulomb term across runs.",
+        epilog="examples:\n"
+               "  govcheck characterise friction O-ring257_*bar.csv --column-map zillen-friction --bore '25.7 mm'\n"
+               "  govcheck characterise friction run1.csv run2.csv --area '518.8 mm^2' --symmetric --json f.json",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     f.add_argument("recordings", nargs="+", help="recordings with time, position, force, pressure_a")
     f.add_argument("--column-map", help="column map TOML or shipped name, e.g. zillen-friction")
     f.add_argument("--area", help='piston area, e.g. "518.8 mm^2" (else --bore, else the metadata)')
@@ -47,13 +71,17 @@ def register(subparsers):
     f.add_argument("--symmetric", action="store_true", help="one set of parameters for both directions")
     f.add_argument("--min-speed", default="1 mm/s", help="speeds below are not map points (default 1 mm/s)")
     f.add_argument("--window", default="0.2 s", help="velocity derivative window (default 0.2 s)")
-    f.add_argument("--json", help="write the results as JSON here")
-    f.add_argument("--plot", help="write a figure (PNG/SVG/PDF) here")
+    add_outputs(f, "json")
+    f.add_argument("--plot", metavar="FILE.png", help="write a figure here (.png, .svg or .pdf)")
     return p
+
+
+_PLOT_SUFFIXES = (".png", ".svg", ".pdf")
 
 
 def run(args) -> int:
     """Run ``govcheck characterise TARGET``; returns the exit code (0)."""
+    check_args_outputs(args, (args.plot, "--plot", _PLOT_SUFFIXES))
     if args.target == "valve":
         return _run_valve(args)
     return _run_friction(args)
@@ -81,13 +109,23 @@ def _run_valve(args) -> int:
         supply = meta["conditions"]["supply_pressure"]
     if args.window is not None and (args.window < 5 or args.window % 2 == 0):
         raise InputError(f"--window: must be an odd number of samples >= 5, got {args.window}")
-    result = characterise_valve(
-        frame, volume, supply_pressure=supply, exhaust_pressure=exhaust, temperature=temperature,
-        pressure_column=args.pressure_column, mode=args.mode, window=args.window, laws=laws, source=args.recording,
-    )
+    if not volume > 0:
+        raise InputError(f"--volume {args.volume!r}: expected a positive volume such as '1 L'")
+    try:
+        result = characterise_valve(
+            frame, volume, supply_pressure=supply, exhaust_pressure=exhaust, temperature=temperature,
+            pressure_column=args.pressure_column, mode=args.mode, window=args.window, laws=laws, source=args.recording,
+        )
+    except InputError as exc:
+        if args.recording in str(exc):
+            raise
+        raise InputError(f"{args.recording}: {exc}") from None
     print(_valve_table(result))
     if args.json:
-        _write_json(args.json, result.to_dict())
+        data = result.to_dict()
+        for row, fit in zip(data["ranking"], result.fits):
+            row["implausible"] = fit.implausible  # never ranked best (compliance.characterise.flow_law)
+        _write_json(args.json, data)
     if args.plot:
         from compliance.characterise.plots import plot_valve
 
@@ -113,7 +151,8 @@ def _valve_table(r) -> str:
     ]
     for i, fit in enumerate(r.fits, 1):
         params = ", ".join(f"{k} = {_fmt(v, fit.stderr.get(k))} {fit.units.get(k, '').strip('-')}".rstrip() for k, v in fit.params.items())
-        lines.append(f"{i:<5}{fit.law:<12}{fit.aic:>10.1f}{fit.rms * 1e3:>12.4g}  {params}")
+        lines.append(f"{i:<5}{fit.law:<12}{fit.aic:>10.1f}{fit.rms * 1e3:>12.4g}  {params}"
+                     + (f"  NOT PHYSICAL: {fit.implausible}" if fit.implausible else ""))
     best = r.best
     if best.law == "iso6358":
         c = best.params["conductance"]
@@ -199,20 +238,7 @@ def _friction_table(r) -> str:
     return "\n".join(lines)
 
 
-def _clean(obj):
-    if isinstance(obj, dict):
-        return {str(k): _clean(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_clean(v) for v in obj]
-    if hasattr(obj, "item"):
-        obj = obj.item()
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    return obj
-
-
 def _write_json(path: str, data: dict) -> None:
-    try:
-        Path(path).write_text(json.dumps(_clean(data), indent=2) + "\n", encoding="utf-8")
-    except OSError as exc:
-        raise InputError(f"--json {path}: cannot write ({exc.strerror})") from None
+    from compliance.files.atomic import write_json_atomic
+
+    write_json_atomic(path, data)

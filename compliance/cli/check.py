@@ -4,44 +4,48 @@ from __future__ import annotations
 
 import shlex
 import sys
-from pathlib import Path
+from importlib import resources
 
-from compliance.errors import InputError
+from compliance.cli.common import (add_jobs, add_outputs, add_parser, add_plant_argument, add_quiet, add_reproducible,
+                                   check_args_outputs, plant_source)
+
+
+def shipped_requirements() -> list[str]:
+    """Names of the requirement files shipped with govcheck (usable as ``-r NAME``)."""
+    folder = resources.files("compliance") / "data" / "requirements"
+    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
 
 
 def register(subparsers):
     """Add the ``check`` sub-command."""
-    p = subparsers.add_parser(
-        "check",
+    names = shipped_requirements()
+    p = add_parser(
+        subparsers, "check",
         help="check a plant configuration against a requirement file",
         description=(
             "Run the procedures a requirement file names at its operating points, measure the metrics, "
             "judge every requirement (value, limit, margin) and print a summary. "
             "Exit 0 when every mandatory requirement passes, 1 when one fails or could not be evaluated, "
-            "2 on invalid input."
+            "2 on invalid input (every output path is checked before anything runs).\n\n"
+            "shipped requirement files (-r NAME): " + ", ".join(names)
         ),
+        examples=[
+            "govcheck check models/plant-a.toml -r shpp-400kw",
+            "govcheck check plant-a -r iec61362 --json r.json --junit r.xml --report r.html --pdf r.pdf",
+            "govcheck check models/plant-a.toml -r requirements/shpp-400kw.toml --linear -q --reproducible --json r.json",
+        ],
     )
-    p.add_argument("plant", help="plant configuration: a TOML file or a reference name (plant-a)")
-    p.add_argument("--requirements", "-r", required=True,
-                   help="requirement file: a TOML file or a reference name (iec61362, ieee125, iec60308, shpp-400kw)")
-    p.add_argument("--json", metavar="OUT.json", help="write the results JSON (docs/results-schema.md)")
-    p.add_argument("--junit", metavar="OUT.xml", help="write JUnit XML for CI")
-    p.add_argument("--report", metavar="OUT.html", help="write the HTML report")
-    p.add_argument("--pdf", metavar="OUT.pdf", help="write the PDF report")
+    add_plant_argument(p)
+    p.add_argument("--requirements", "-r", required=True, metavar="REQ",
+                   help="requirement file: a TOML file or a shipped name (" + ", ".join(names) + ")")
+    add_outputs(p, "json", "junit", "report", "pdf")
     p.add_argument("--linear", action="store_true",
                    help="add the linear analysis to the results and report: every operating point, the stroke x load map, "
                         "the linear/nonlinear cross-check and the HYGOV parameters (adds ~20-40 s)")
-    p.add_argument("--jobs", "-j", type=int, default=None, help="worker processes (default: available cores)")
-    p.add_argument("--quiet", "-q", action="store_true", help="no progress bar; print only the verdict line")
+    add_jobs(p)
+    add_quiet(p, "no progress bar; print only the verdict line")
+    add_reproducible(p)
     return p
-
-
-def _check_out(path: str | None, flag: str):
-    if path is None:
-        return
-    folder = Path(path).parent
-    if str(folder) and not folder.is_dir():
-        raise InputError(f"{flag} {path}: folder '{folder}' does not exist")
 
 
 def renderer(args):
@@ -53,40 +57,60 @@ def renderer(args):
     return render_report
 
 
-def command_line(args, name: str = "check") -> str:
-    """The command as given (reconstructed from the parsed arguments)."""
-    parts = ["govcheck", name, args.plant, "--requirements", args.requirements]
+def command_line(args, name: str = "check", outputs: bool = True) -> str:
+    """The command as given (reconstructed from the parsed arguments); without output paths if not ``outputs``."""
+    parts = ["govcheck", name, plant_source(args), "--requirements", args.requirements]
     for flag in ("json", "junit", "report", "pdf", "jobs"):
         v = getattr(args, flag, None)
-        if v is not None:
+        if v is not None and outputs:
             parts += [f"--{flag}", str(v)]
-    if getattr(args, "linear", False):
-        parts.append("--linear")
-    if getattr(args, "quiet", False):
-        parts.append("--quiet")
+    for flag in ("linear", "quiet", "reproducible"):
+        if getattr(args, flag, False):
+            parts.append(f"--{flag}")
     return shlex.join(parts)
 
 
+def finish_results(results: dict, args, name: str = "check") -> dict:
+    """Results as written: reproducible (fixed ``created``, no timings) with --reproducible / SOURCE_DATE_EPOCH."""
+    from compliance.files.reproducible import is_reproducible, make_reproducible
+
+    if not is_reproducible(getattr(args, "reproducible", False)):
+        return results
+    return make_reproducible(results, command_line(args, name, outputs=False))
+
+
 def run(args) -> int:
-    """Run the campaign, print the table, write the outputs; exit code from the verdict."""
-    from compliance.model.config import load_plant
-    from compliance.campaign.run import run_campaign
-    from compliance.requirements.loading import load_requirements
+    """Check outputs and inputs, run the campaign, print the table, write the outputs; exit code from the verdict."""
     from compliance.campaign.results_files import summary_table, write_json, write_junit
+    from compliance.campaign.run import run_campaign
+    from compliance.cli.common import plant_from_args
+    from compliance.cli.progress import progress
+    from compliance.files.reproducible import fixed_created, is_reproducible
+    from compliance.requirements.loading import load_requirements
 
-    if args.jobs is not None and args.jobs < 1:
-        raise InputError(f"--jobs {args.jobs}: expected a positive number of processes")
-    for path, flag in ((args.json, "--json"), (args.junit, "--junit"), (args.report, "--report"), (args.pdf, "--pdf")):
-        _check_out(path, flag)
+    check_args_outputs(args)
+    if is_reproducible(args.reproducible):
+        fixed_created()  # a malformed SOURCE_DATE_EPOCH is refused before the work
     render = renderer(args)
-    cfg = load_plant(args.plant)
+    cfg = plant_from_args(args)
     reqset = load_requirements(args.requirements)
-    results = run_campaign(cfg, reqset, workers=args.jobs, progress=not args.quiet, command_line=command_line(args))
-    if args.linear:
-        from compliance.linear.operating_points import linear_for_campaign
+    stages = 1 + bool(args.linear) + (render is not None)
+    # the campaign reports its runs itself on a terminal; in a CI log these stage lines (and a heartbeat) show progress
+    with progress(stages, "check", quiet=args.quiet or sys.stderr.isatty(), unit="stage", first="campaign") as bar:
+        results = run_campaign(cfg, reqset, workers=args.jobs, progress=not args.quiet, command_line=command_line(args))
+        bar.update(1)
+        if args.linear:
+            from compliance.linear.operating_points import linear_for_campaign
 
-        results["linear"] = linear_for_campaign(cfg, reqset)
-    table = summary_table(results)
+            bar.set_postfix_str("linear analysis", refresh=False)
+            results["linear"] = linear_for_campaign(cfg, reqset)
+            bar.update(1)
+        results = finish_results(results, args)
+        table = summary_table(results)
+        if render is not None:
+            bar.set_postfix_str("report", refresh=False)
+            render(results, html_path=args.report, pdf_path=args.pdf)
+            bar.update(1)
     if args.quiet:
         print(table.rstrip().splitlines()[-1])
     else:
@@ -95,6 +119,4 @@ def run(args) -> int:
         write_json(results, args.json)
     if args.junit:
         write_junit(results, args.junit)
-    if render is not None:
-        render(results, html_path=args.report, pdf_path=args.pdf)
     return 0 if results["summary"]["status"] == "pass" else 1

@@ -1,25 +1,123 @@
-"""Argument helpers shared by the CLI commands (units at the edge, plant resolution)."""
+"""The one CLI convention, shared by every sub-command.
+
+- The plant configuration is positional (a TOML path or a reference name such as ``plant-a``).
+  ``--plant`` is still read for old scripts, but giving both is an error, never a silent choice.
+- The same output options everywhere: ``--json FILE.json``, ``--junit FILE.xml``,
+  ``--report FILE.html``, ``--pdf FILE.pdf``; the same ``--quiet/-q``, ``--jobs/-j`` and
+  ``--reproducible``.
+- Every output path is checked (folder, writability, suffix) before any work starts
+  (:func:`compliance.files.outputs.check_outputs`).
+"""
 
 from __future__ import annotations
 
-from compliance.model.config import PlantConfig, load_plant
+import argparse
+import os
+
 from compliance.errors import InputError
 from compliance.units import parse_quantity
 
+OUTPUT_SUFFIXES = {"json": (".json",), "junit": (".xml",), "report": (".html", ".htm"), "pdf": (".pdf",)}
+_OUTPUT_HELP = {
+    "json": "write the results as JSON to FILE.json",
+    "junit": "write JUnit XML for CI to FILE.xml",
+    "report": "write the HTML report to FILE.html",
+    "pdf": "write the PDF report to FILE.pdf",
+}
+_METAVAR = {"json": "FILE.json", "junit": "FILE.xml", "report": "FILE.html", "pdf": "FILE.pdf"}
 
-def add_plant_argument(parser, positional: bool = True) -> None:
-    """Add the plant argument: a TOML path, or a reference name via --plant."""
-    if positional:
-        parser.add_argument("config", nargs="?", help="plant configuration file (TOML), e.g. models/plant-a.toml")
-    parser.add_argument("--plant", help="plant configuration file or reference name (see 'govcheck plants')")
+
+def add_parser(sub, name: str, *, help: str, description: str, examples: list[str]):
+    """A sub-command parser with its description and an ``examples:`` epilog (kept verbatim)."""
+    return sub.add_parser(
+        name, help=help, description=description,
+        epilog="examples:\n" + "\n".join(f"  {e}" for e in examples),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
 
 
-def plant_from_args(args) -> PlantConfig:
-    """Load the plant named by a positional path or --plant."""
-    src = getattr(args, "config", None) or getattr(args, "plant", None)
+def add_plant_argument(parser, *, help: str | None = None) -> None:
+    """The positional plant configuration (and the old ``--plant`` spelling, hidden).
+
+    Optional for argparse so the old spelling still parses; :func:`plant_source` says when none is given.
+    """
+    parser.add_argument("config", metavar="CONFIG", nargs="?",
+                        help=help or "plant configuration: a TOML file (models/plant-a.toml) or a reference name (plant-a)")
+    parser.add_argument("--plant", help=argparse.SUPPRESS)
+
+
+def plant_source(args, fallback: str | None = None, where: str = "") -> str:
+    """The configuration named on the command line (positional or the old ``--plant``), else ``fallback``.
+
+    Raises
+    ------
+    InputError
+        Both spellings name different configurations, or none is given and there is no fallback.
+    """
+    pos, old = getattr(args, "config", None), getattr(args, "plant", None)
+    if pos and old and os.path.normpath(pos) != os.path.normpath(old):
+        raise InputError(f"two plant configurations given: '{pos}' and --plant '{old}'; give one (positional CONFIG)")
+    src = pos or old or fallback
     if not src:
-        raise InputError("no plant given: pass a configuration file (models/plant-a.toml) or --plant NAME")
-    return load_plant(src)
+        raise InputError(f"{where + ': ' if where else ''}no plant configuration given: pass CONFIG "
+                         "(a TOML file such as models/plant-a.toml, or a reference name such as plant-a)")
+    return src
+
+
+def plant_from_args(args, fallback: str | None = None, where: str = ""):
+    """Load the plant named by :func:`plant_source`."""
+    from compliance.model.config import load_plant
+
+    return load_plant(plant_source(args, fallback, where))
+
+
+def add_outputs(parser, *names: str, help: dict | None = None) -> None:
+    """Add the standard output options ``--json/--junit/--report/--pdf`` (those named)."""
+    for name in names:
+        text = (help or {}).get(name, _OUTPUT_HELP[name])
+        parser.add_argument(f"--{name}", metavar=_METAVAR[name], default=None, help=text)
+
+
+def add_jobs(parser, what: str = "worker processes") -> None:
+    """``--jobs/-j N``."""
+    parser.add_argument("--jobs", "-j", type=int, default=None, help=f"{what} (default: the available cores)")
+
+
+def add_quiet(parser, what: str = "no progress; print only the verdict line") -> None:
+    """``--quiet/-q``."""
+    parser.add_argument("--quiet", "-q", action="store_true", help=what)
+
+
+def add_reproducible(parser) -> None:
+    """``--reproducible``: byte-identical outputs (also switched on by SOURCE_DATE_EPOCH)."""
+    parser.add_argument("--reproducible", action="store_true",
+                        help="byte-identical output files across runs: fixed 'created' (SOURCE_DATE_EPOCH, else "
+                             "1970-01-01), no timings (also on when SOURCE_DATE_EPOCH is set)")
+
+
+def check_jobs(args) -> None:
+    """``--jobs`` must be a positive count."""
+    jobs = getattr(args, "jobs", None)
+    if jobs is not None and jobs < 1:
+        raise InputError(f"--jobs {jobs}: expected a positive number of processes")
+
+
+def standard_outputs(args, *extra) -> list:
+    """``(path, flag, suffixes)`` of the standard outputs set in ``args``, plus ``extra`` ones."""
+    out = []
+    for name, suffixes in OUTPUT_SUFFIXES.items():
+        path = getattr(args, name, None)
+        if isinstance(path, str):
+            out.append((path, f"--{name}", suffixes))
+    return out + [e for e in extra if e[0] is not None]
+
+
+def check_args_outputs(args, *extra) -> None:
+    """Check ``--jobs`` and every output path before any work (nothing written on failure)."""
+    from compliance.files.outputs import check_outputs
+
+    check_jobs(args)
+    check_outputs(*standard_outputs(args, *extra))
 
 
 def quantity(text: str | None, si_unit: str, option: str, default: float | None = None) -> float | None:
@@ -27,6 +125,111 @@ def quantity(text: str | None, si_unit: str, option: str, default: float | None 
     if text is None:
         return default
     try:
-        return float(text)
+        value = float(text)
     except ValueError:
         return parse_quantity(text, si_unit, option)
+    if value != value or value in (float("inf"), float("-inf")):
+        raise InputError(f"{option} {text!r}: expected a finite number")
+    return value
+
+
+def cylinder_force_limit(cfg) -> float:
+    """Largest force the cylinder can produce: (p_s - p_atm) x the pressurised area [N] (docs/reference-plant.md)."""
+    import math
+
+    cap = math.pi / 4.0 * cfg.p("cylinder.piston_diameter") ** 2
+    rod = cap - math.pi / 4.0 * cfg.p("cylinder.rod_diameter") ** 2
+    area = cap + rod if cfg.options.get("cylinder.arrangement") == "tandem" else cap  # tandem: A_cap + A_rod per side
+    return (cfg.p("air.supply_pressure") - cfg.p("air.atmospheric_pressure")) * area
+
+
+def check_load_force(cfg, load, where: str) -> None:
+    """Refuse a constant load the cylinder cannot possibly hold (more than twice its force at supply).
+
+    Such a load is not a test condition but a typo (1e9 N for 11.4 kN); the solver would only
+    report a non-physical state much later.
+    """
+    if load is None or isinstance(load, str):
+        return
+    limit = cylinder_force_limit(cfg)
+    if not abs(load) <= 2.0 * limit:
+        raise InputError(f"{where}: load {load:.4g} N is more than twice the largest force the cylinder of {cfg.name} "
+                         f"can produce ({limit:.4g} N = (p_s - p_atm) x piston area); expected a load in N such as 11400")
+
+
+def parse_param_overrides(items, option: str = "--param") -> dict:
+    """``KEY=VALUE`` (SI) overrides, each checked against the parameter table's admissible range."""
+    from compliance.errors import did_you_mean
+    from compliance.model.parameters import BASE_BY_KEY
+
+    out = {}
+    for item in items:
+        if "=" not in item:
+            raise InputError(f"{option}: '{item}' must look like KEY=VALUE (SI), e.g. friction.bristle_stiffness=1e6")
+        k, v = (s.strip() for s in item.split("=", 1))
+        spec = BASE_BY_KEY.get(k)
+        if spec is None:
+            raise InputError(f"{option} {k}: not a plant parameter{did_you_mean(k, BASE_BY_KEY)}")
+        try:
+            value = float(v)
+        except ValueError:
+            raise InputError(f"{option} {k}: '{v}' is not a number (give SI units, {spec.unit or 'dimensionless'})") from None
+        low, high = spec.bounds
+        low_ok = value > low if spec.low_open else value >= low
+        if not (low_ok and value <= high):
+            bracket = "(" if spec.low_open else "["
+            raise InputError(f"{option} {k}={v}: outside the admissible range {bracket}{low:g}, {high:g}] "
+                             f"{spec.unit} ({spec.meaning})")
+        out[k] = value
+    return out
+
+
+def looks_like_config(text: str) -> bool:
+    """A plant configuration on the command line: a ``.toml`` file or a shipped reference name."""
+    from compliance.model.config import reference_plants
+
+    return text.lower().endswith(".toml") or (text in reference_plants() and not os.path.exists(text))
+
+
+def split_config(args, inputs: list[str], what: str = "RECORDING") -> tuple[str | None, list[str]]:
+    """``[CONFIG] INPUT...`` -> (configuration or None, inputs); the old ``--plant`` is honoured.
+
+    Raises
+    ------
+    InputError
+        No input left, or two different configurations (positional and ``--plant``).
+    """
+    config = inputs[0] if len(inputs) > 1 and looks_like_config(inputs[0]) else None
+    rest = inputs[1:] if config else list(inputs)
+    if not rest:
+        raise InputError(f"no {what} given: the arguments are [CONFIG] {what}")
+    for item in rest:
+        if looks_like_config(item):
+            raise InputError(f"{item}: a plant configuration in the place of a {what}; the order is [CONFIG] {what}")
+    args.config = config
+    return plant_source(args, fallback="", where="") if (config or getattr(args, "plant", None)) else None, rest
+
+
+def sidecar_plant(meta: dict, recording) -> str | None:
+    """The sidecar's ``plant``: a reference name, or a file path taken relative to the recording's folder."""
+    from pathlib import Path
+
+    src = meta.get("plant")
+    if not isinstance(src, str) or not src.strip():
+        return None
+    if looks_like_config(src) and src.lower().endswith(".toml"):
+        p = Path(src)
+        if not p.is_absolute():
+            beside = Path(recording).parent / p
+            if beside.is_file() or not p.is_file():
+                return str(beside)
+    return src
+
+
+def check_sidecar_conditions(cfg, meta: dict, recording) -> None:
+    """The sidecar's load must be one the plant could hold (a 1e9 N typo is named, not simulated)."""
+    from compliance.recordings.metadata import sidecar_path
+
+    cond = meta.get("conditions")
+    if isinstance(cond, dict) and isinstance(cond.get("load_force"), (int, float)) and not isinstance(cond.get("load_force"), bool):
+        check_load_force(cfg, float(cond["load_force"]), f"{sidecar_path(recording)}: conditions.load_force")

@@ -1,6 +1,6 @@
 """``govcheck diagnose``: name the physics a model misses in a recording, model it, refit, show the gain.
 
-    govcheck diagnose RECORDING --plant models/plant-a.toml [--column-map MAP] [--json out.json]
+    govcheck diagnose [CONFIG] RECORDING [--column-map MAP] [--json out.json]
                       [--report diag.html] [--save-model fitted.toml] [--effects a,b,c] [--jobs N]
     govcheck diagnose FILE1 FILE2 ... --column-map zillen-friction --friction-bore "25.7 mm"
 
@@ -16,6 +16,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from compliance.cli.common import (add_jobs, add_outputs, add_quiet, add_reproducible, check_args_outputs,
+                                   check_sidecar_conditions, sidecar_plant, split_config)
 from compliance.errors import InputError
 from compliance.files.atomic import write_json_atomic
 
@@ -37,23 +39,28 @@ def register(sub):
         ),
         epilog=(
             "examples:\n"
-            "  govcheck diagnose run.csv.gz --plant models/plant-a.toml --json diag.json\n"
-            "  govcheck diagnose run.csv.gz --plant plant-a --effects heat_transfer,internal_leakage --save-model fitted.toml\n"
+            "  govcheck diagnose models/plant-a.toml run.csv.gz --json diag.json\n"
+            "  govcheck diagnose plant-a run.csv.gz --effects heat_transfer,internal_leakage --save-model fitted.toml\n"
+            "  govcheck diagnose tests/data/practice/practice_valve_dynamics.csv.gz --report diag.html\n"
             "  govcheck diagnose O-ring257_*bar.csv --column-map zillen-friction --friction-bore \"25.7 mm\" --report f.html"
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("recordings", nargs="+", metavar="RECORDING", help="recording file(s); several only for friction runs")
-    p.add_argument("--plant", help="plant configuration file or reference name (default: the sidecar's 'plant')")
+    p.add_argument("inputs", nargs="+", metavar="[CONFIG] RECORDING",
+                   help="plant configuration (TOML file or reference name; default: the sidecar's 'plant') and the "
+                        "recording file(s); several only for friction runs")
+    p.add_argument("--plant", help=argparse.SUPPRESS)
     p.add_argument("--column-map", help="column map (TOML path or shipped name) for a logger's own names and units")
     p.add_argument("--effects", help="comma-separated candidate effects (default: every declared effect)")
     p.add_argument("--no-recalibration", action="store_true", help="do not consider recalibrating base parameters")
-    p.add_argument("--jobs", type=int, help="worker processes (default: the available cores)")
+    add_jobs(p)
     p.add_argument("--friction-bore", help='friction bench: piston bore, e.g. "25.7 mm" (else the column map\'s metadata)')
-    p.add_argument("--json", dest="json_out", help="write the diagnosis (docs/diagnosis-schema.md) to this JSON file")
-    p.add_argument("--report", help="write an HTML report with the before/after figures")
-    p.add_argument("--save-model", help="write the fitted plant configuration here (never overwrites)")
-    p.add_argument("--quiet", action="store_true", help="print only the verdict line")
+    add_outputs(p, "json", "report", help={"json": "write the diagnosis (docs/diagnosis-schema.md) to FILE.json",
+                                           "report": "write an HTML report with the before/after figures to FILE.html"})
+    p.add_argument("--save-model", metavar="FILE.toml", help="write the fitted plant configuration here (never overwrites; "
+                                                            "nothing is saved when the diagnosis finds no mismatch)")
+    add_quiet(p, "print only the verdict line")
+    add_reproducible(p)
     return p
 
 
@@ -65,8 +72,8 @@ def run(args) -> int:
     """Run ``govcheck diagnose``; returns 0 when the diagnosis ran."""
     from compliance.recordings.reader import read_recording
 
-    if args.jobs is not None and args.jobs < 1:
-        raise InputError(f"--jobs {args.jobs}: expected a positive number of worker processes")
+    plant_arg, args.recordings = split_config(args, args.inputs)
+    check_args_outputs(args, (args.save_model, "--save-model", (".toml",)))
     if args.save_model and Path(args.save_model).exists():
         raise InputError(f"--save-model {args.save_model}: exists already; choose another name (nothing is overwritten)")
     effects = None
@@ -83,20 +90,37 @@ def run(args) -> int:
     from compliance.model.config import load_plant
     from compliance.diagnosis.engine import diagnose, save_fitted
 
-    plant = args.plant or meta.get("plant")
+    plant = plant_arg or sidecar_plant(meta, args.recordings[0])
     if not plant:
-        raise InputError(f"{args.recordings[0]}: no --plant given and the sidecar names no 'plant'")
+        raise InputError(f"{args.recordings[0]}: no CONFIG given and the sidecar names no 'plant'")
     cfg = load_plant(plant)
-    diag = diagnose(cfg, frame, meta, effects=effects, jobs=args.jobs, recalibrate=not args.no_recalibration)
+    check_sidecar_conditions(cfg, meta, args.recordings[0])
+    from compliance.cli.progress import progress
+
+    with progress(1, "diagnose", quiet=args.quiet, unit="stage", first="replay, locate, fit every candidate") as bar:
+        diag = diagnose(cfg, frame, meta, effects=effects, jobs=args.jobs, recalibrate=not args.no_recalibration)
+        bar.update(1)
+    unsaved = None
     if args.save_model:
-        save_fitted(diag, args.save_model)
+        if diag.fitted_cfg is None:
+            unsaved = f"--save-model {args.save_model}: not written: the verdict is '{diag.verdict}', so there is no fitted model to save"
+        else:
+            save_fitted(diag, args.save_model)
     data = diag.to_dict()
-    if args.json_out:
-        write_json_atomic(args.json_out, data)
+    if args.json:
+        write_json_atomic(args.json, _finish(data, args))
     if args.report:
         _render_servo_report(cfg, frame, meta, diag, data, args.report)
     _print_servo(data, args.quiet)
+    if unsaved:
+        print(f"note: {unsaved}")
     return 0
+
+
+def _finish(data: dict, args) -> dict:
+    from compliance.files.reproducible import is_reproducible, make_reproducible
+
+    return make_reproducible(data) if is_reproducible(args.reproducible) else data
 
 
 def _print_servo(d: dict, quiet: bool) -> None:
@@ -153,6 +177,8 @@ def _run_friction(args, first, meta) -> int:
     from compliance.recordings.reader import read_recording
     from compliance.units import parse_quantity
 
+    if args.save_model:
+        raise InputError("--save-model: a friction-bench diagnosis fits a friction law, not a plant configuration; use --json")
     runs = [(first, meta)]
     for path in args.recordings[1:]:
         f, m = read_recording(path, args.column_map, required=("time",))
@@ -162,10 +188,8 @@ def _run_friction(args, first, meta) -> int:
     bore = parse_quantity(args.friction_bore, "m", "--friction-bore") if args.friction_bore else None
     result = diagnose_friction(runs, bore=bore)
     data = result.to_dict()
-    if args.save_model:
-        raise InputError("--save-model: a friction-bench diagnosis fits a friction law, not a plant configuration; use --json")
-    if args.json_out:
-        write_json_atomic(args.json_out, data)
+    if args.json:
+        write_json_atomic(args.json, _finish(data, args))
     if args.report:
         from compliance.diagnosis.friction_report import write_friction_report
 

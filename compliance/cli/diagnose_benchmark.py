@@ -1,6 +1,6 @@
 """``govcheck diagnose-benchmark``: prove the diagnosis on generated concealed-effect recordings.
 
-    govcheck diagnose-benchmark [--cases N] [--seed S] [--effects a,b] [--library a,b] [--jobs N]
+    govcheck diagnose-benchmark [CONFIG] [--cases N] [--seed S] [--effects a,b] [--library a,b] [--jobs N]
                                 [--no-null] [--no-miscalibrations] [--practice DIR] [--json out.json]
 
 Generates N concealed cases per effect (plus null and miscalibrated-parameter cases) from the
@@ -13,9 +13,9 @@ directory instead and scores them against its ANSWERS.json. Exit 0 when the targ
 from __future__ import annotations
 
 import argparse
-import json
-from pathlib import Path
 
+from compliance.cli.common import (add_jobs, add_outputs, add_plant_argument, add_quiet, add_reproducible,
+                                   check_args_outputs, plant_from_args)
 from compliance.errors import InputError
 
 TOP1_TARGET = 0.9
@@ -36,20 +36,22 @@ def register(sub):
             "examples:\n"
             "  govcheck diagnose-benchmark --cases 3 --seed 1 --json bench.json\n"
             "  govcheck diagnose-benchmark --effects heat_transfer,internal_leakage --cases 2 --jobs 2\n"
-            "  govcheck diagnose-benchmark --practice /work/shared/practice-recordings"
+            "  govcheck diagnose-benchmark models/plant-a.toml --practice tests/data/practice"
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("--plant", default="plant-a", help="plant the cases are generated from and diagnosed against (default plant-a)")
+    add_plant_argument(p, help="plant configuration the cases are generated from and diagnosed against (default plant-a)")
     p.add_argument("--cases", type=int, default=3, help="cases per effect and null cases (default 3)")
     p.add_argument("--seed", type=int, default=1, help="seed of the case generator (default 1)")
     p.add_argument("--effects", help="effects to generate cases of (default: all declared)")
     p.add_argument("--library", help="candidate effects the diagnosis chooses from (default: all declared)")
-    p.add_argument("--jobs", type=int, default=None, help="cases diagnosed in parallel (default: the available cores)")
+    add_jobs(p, "cases diagnosed in parallel")
     p.add_argument("--no-null", action="store_true", help="no null cases")
     p.add_argument("--no-miscalibrations", action="store_true", help="no miscalibrated-parameter cases")
     p.add_argument("--practice", help="diagnose the recordings of this directory and score them against its ANSWERS.json")
-    p.add_argument("--json", dest="json_out", help="write every case and the summary to this JSON file")
+    add_outputs(p, "json", help={"json": "write every case and the summary to FILE.json"})
+    add_quiet(p, "no per-case lines; print only the summary")
+    add_reproducible(p)
     return p
 
 
@@ -65,31 +67,25 @@ def _names(text: str | None, option: str):
     return names
 
 
-def _write(path: str, data: dict) -> None:
-    target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    target.write_text(json.dumps(data, indent=1, default=_plain) + "\n", encoding="utf-8")
+def _write(args, data: dict) -> None:
+    from compliance.files.atomic import write_json_atomic
+    from compliance.files.reproducible import is_reproducible, make_reproducible
 
-
-def _plain(x):
-    try:
-        return float(x)
-    except (TypeError, ValueError):
-        return str(x)
+    write_json_atomic(args.json, make_reproducible(data) if is_reproducible(args.reproducible) else data)
 
 
 def run(args) -> int:
     """Run the benchmark; 0 when the targets are met, 1 when not."""
-    from compliance.model.config import load_plant
     from compliance.diagnosis.benchmark import format_summary, run_benchmark, run_practice
     from compliance.diagnosis.engine import default_jobs
 
+    check_args_outputs(args)
     if args.cases < 1:
         raise InputError(f"--cases {args.cases}: expected at least 1")
     jobs = default_jobs() if args.jobs is None else args.jobs
     if jobs < 1:
         raise InputError(f"--jobs {jobs}: expected a positive number of worker processes")
-    cfg = load_plant(args.plant)
+    cfg = plant_from_args(args, fallback="plant-a")
     library = _names(args.library, "--library")
     if args.practice:
         rep = run_practice(args.practice, cfg, library=library, jobs=jobs)
@@ -98,21 +94,26 @@ def run(args) -> int:
             print(f"{mark} {row['name']:32s} truth {row['truth']:18s} -> {row['verdict']:16s} {row['winner'] or '-':28s} "
                   f"{row['seconds']:5.1f} s  {row['parameters']}")
         print(f"\n{rep['correct']}/{len(rep['recordings'])} practice recordings diagnosed correctly")
-        if args.json_out:
-            _write(args.json_out, rep)
+        if args.json:
+            _write(args, rep)
         return 0 if rep["correct"] == len(rep["recordings"]) else 1
 
-    def progress(r):
-        mark = "OK " if r.correct else "BAD"
-        err = "" if r.main_error is None else f" main-parameter error {100*r.main_error:.1f} %"
-        print(f"{mark} {r.kind:14s} {r.truth:28s} -> {r.predicted:28s} {r.seconds:5.1f} s{err}", flush=True)
+    from compliance.cli.progress import progress as progress_bar
 
-    rep = run_benchmark(cfg, effects=_names(args.effects, "--effects"), cases=args.cases, seed=args.seed, library=library,
-                        jobs=jobs, null=not args.no_null, miscalibrations=not args.no_miscalibrations, progress=progress)
+    with progress_bar(None, "diagnose-benchmark", quiet=args.quiet, unit="case") as bar:
+        def progress(r):
+            mark = "OK " if r.correct else "BAD"
+            err = "" if r.main_error is None else f" main-parameter error {100*r.main_error:.1f} %"
+            if not args.quiet:
+                print(f"{mark} {r.kind:14s} {r.truth:28s} -> {r.predicted:28s} {r.seconds:5.1f} s{err}", flush=True)
+            bar.update(1)
+
+        rep = run_benchmark(cfg, effects=_names(args.effects, "--effects"), cases=args.cases, seed=args.seed, library=library,
+                            jobs=jobs, null=not args.no_null, miscalibrations=not args.no_miscalibrations, progress=progress)
     print()
     print(format_summary(rep))
-    if args.json_out:
-        _write(args.json_out, rep)
+    if args.json:
+        _write(args, rep)
     s = rep["summary"]
     ok = (s["top1_accuracy"] is None or s["top1_accuracy"] >= TOP1_TARGET) and (s["null_accuracy"] is None or s["null_accuracy"] >= NULL_TARGET)
     return 0 if ok else 1

@@ -3,9 +3,8 @@
 from __future__ import annotations
 
 import argparse
-import json
-from pathlib import Path
 
+from compliance.cli.common import add_outputs, add_parser, add_plant_argument, add_quiet, add_reproducible, check_args_outputs
 from compliance.errors import InputError
 
 _PLOT_SUFFIXES = (".png", ".svg", ".pdf")
@@ -13,18 +12,24 @@ _PLOT_SUFFIXES = (".png", ".svg", ".pdf")
 
 def register(subparsers):
     """Add the ``linear`` sub-command."""
-    p = subparsers.add_parser(
-        "linear",
+    p = add_parser(
+        subparsers, "linear",
         help="linearise the plant: time constant, margins, bandwidth, maps, HYGOV parameters",
         description=(
             "Trim the nonlinear plant at rest at a position and load, linearise it (numerical Jacobians of the "
             "simulator's own right-hand side), close the loop with the configured PID and report the pneumatic "
             "natural frequency, time constant, bandwidth and gain/phase margins. Options add operating maps over "
             "stroke x load, a cross-check against nonlinear step responses and HYGOV-style governor parameters. "
-            "Quantities accept units ('136 mm', '11.4 kN', '85 %' of stroke); bare numbers are SI."
+            "Quantities accept units ('136 mm', '11.4 kN', '85 %' of stroke); bare numbers are SI. "
+            "For python-control objects in your own scripts see compliance.linear.nlsys (docs/python-control.md)."
         ),
+        examples=[
+            "govcheck linear models/plant-a.toml --at '136 mm' --load '11.4 kN'",
+            "govcheck linear plant-a --map --crosscheck --governor --json lin.json --plot lin.png",
+            "govcheck linear plant-a --at '85 %' --load curve --governor-json hygov.json",
+        ],
     )
-    p.add_argument("plant", help="plant configuration (TOML path or reference name such as plant-a)")
+    add_plant_argument(p)
     p.add_argument("--at", default="50 %", help="operating position, e.g. '136 mm', 0.136 or '85 %%' (default: mid stroke)")
     p.add_argument("--load", default="none", help="closing load, e.g. '11.4 kN', 11400, 'curve' or 'none' (default)")
     p.add_argument("--gain", choices=("mean", "opening", "closing"), default="mean",
@@ -36,9 +41,11 @@ def register(subparsers):
     p.add_argument("--governor", action="store_true", help="equivalent HYGOV parameters (Tg, VELM, UO/UC, GMAX/GMIN)")
     p.add_argument("--stroke-load", default="default",
                    help="load during the governor's full-stroke runs: a force, 'curve' or 'none' (default: the stroke average of the load curve)")
-    p.add_argument("--json", metavar="OUT.json", help="write everything as JSON")
-    p.add_argument("--governor-json", metavar="OUT.json", help="write only the HYGOV parameters as JSON (implies --governor)")
-    p.add_argument("--plot", metavar="OUT.png", help="write Bode, Nyquist, pole-zero and step plots (.png, .svg or .pdf)")
+    add_outputs(p, "json", help={"json": "write everything as JSON to FILE.json"})
+    p.add_argument("--governor-json", metavar="FILE.json", help="write only the HYGOV parameters as JSON (implies --governor)")
+    p.add_argument("--plot", metavar="FILE.png", help="write Bode, Nyquist, pole-zero and step plots (.png, .svg or .pdf)")
+    add_quiet(p, "print only the headline figures")
+    add_reproducible(p)
     return p
 
 
@@ -72,16 +79,6 @@ def parse_load(text, flag: str = "--load"):
         return parse_quantity(t, "N", f"{flag} {text!r}")
 
 
-def _check_out(path, flag, suffixes=None):
-    if not path:
-        return
-    pth = Path(path)
-    if str(pth.parent) and not pth.parent.is_dir():
-        raise InputError(f"{flag} {path}: folder '{pth.parent}' does not exist")
-    if suffixes and pth.suffix.lower() not in suffixes:
-        raise InputError(f"{flag} {path}: expected a file ending in {', '.join(suffixes)}")
-
-
 def _fmt(v, scale=1.0, digits=3, unit=""):
     return "-" if v is None else f"{v*scale:.{digits}f} {unit}".rstrip()
 
@@ -112,18 +109,18 @@ def _summary(cfg, a) -> str:
 
 def run(args) -> int:
     """Run the analysis, print a summary, write JSON / plots."""
-    from compliance.model.config import load_plant
-    from compliance.linear.analysis import analyse, jsonable
+    from compliance.cli.common import plant_from_args
+    from compliance.files.jsonable import jsonable
+    from compliance.linear.analysis import analyse
 
-    _check_out(args.json, "--json")
-    _check_out(args.governor_json, "--governor-json")
-    _check_out(args.plot, "--plot", _PLOT_SUFFIXES)
-    cfg = load_plant(args.plant)
+    check_args_outputs(args, (args.governor_json, "--governor-json", (".json",)), (args.plot, "--plot", _PLOT_SUFFIXES))
+    cfg = plant_from_args(args)
     L = cfg.p("cylinder.stroke")
     x = _position(args.at, L)
     load = parse_load(args.load)
     a = analyse(cfg, x, load, flow_control=args.flow_control, gain=args.gain)
-    print(_summary(cfg, a))
+    summary = _summary(cfg, a)
+    print(summary.splitlines()[0] if args.quiet else summary)
     out = {"schema": "govcheck-linear/1", "plant": cfg.name, "path": cfg.path, "digest": cfg.digest, "analysis": a.to_dict()}
     omap = None
     if args.map:
@@ -155,13 +152,14 @@ def run(args) -> int:
         print(gov.table())
         out["governor"] = gov.to_dict()
         if args.governor_json:
-            from compliance.files.atomic import write_text_atomic
+            from compliance.files.atomic import write_json_atomic
 
-            write_text_atomic(args.governor_json, gov.to_json() + "\n")
+            write_json_atomic(args.governor_json, gov.to_dict())
     if args.json:
-        from compliance.files.atomic import write_text_atomic
+        from compliance.files.atomic import write_json_atomic
+        from compliance.files.reproducible import is_reproducible, make_reproducible
 
-        write_text_atomic(args.json, json.dumps(jsonable(out), indent=1) + "\n")
+        write_json_atomic(args.json, make_reproducible(out) if is_reproducible(args.reproducible) else out)
         print(f"\nwrote {args.json}")
     if args.plot:
         _plot(a, args.plot, omap)
@@ -220,5 +218,12 @@ def _plot(a, path, omap=None) -> None:
     fig.suptitle(f"{a.op.position*1e3:.1f} mm, load {a.op.load_force/1e3:.2f} kN: "
                  f"tau {a.figures['time_constant']*1e3:.0f} ms" if a.figures["time_constant"] else "")
     fig.tight_layout()
-    fig.savefig(path)
+    import io
+
+    from compliance.files.atomic import write_bytes_atomic
+
+    buf = io.BytesIO()
+    fmt = path.rsplit(".", 1)[-1].lower()
+    fig.savefig(buf, format=fmt, metadata={"Date": None} if fmt == "svg" else ({"CreationDate": None} if fmt == "pdf" else {}))
     plt.close(fig)
+    write_bytes_atomic(path, buf.getvalue())

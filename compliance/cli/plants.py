@@ -6,8 +6,12 @@ from compliance.model.config import load_plant, reference_plants
 
 
 def register(sub):
-    p = sub.add_parser("plants", help="list the reference plant configurations",
-                       description="List the reference configurations usable as --plant NAME or by path.")
+    from compliance.cli.common import add_parser
+
+    p = add_parser(sub, "plants", help="list the reference plant configurations",
+                   description="List the reference configurations shipped with govcheck, usable as CONFIG by name "
+                               "(govcheck check plant-a ...) or copied from models/ and edited.",
+                   examples=["govcheck plants", "govcheck simulate plant-a --duration 5 -o run.csv"])
     return p
 
 

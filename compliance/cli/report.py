@@ -5,32 +5,36 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from compliance.cli.common import add_jobs, add_parser, check_args_outputs
 from compliance.errors import InputError
 
 
 def register(subparsers):
     """Add the ``report`` sub-command."""
-    p = subparsers.add_parser(
-        "report",
+    p = add_parser(
+        subparsers, "report",
         help="render the HTML/PDF report from a saved results JSON (no simulation)",
         description=(
             "Render the compliance report of a results file written by 'govcheck check --json' (or the "
             "validation report of a file written by 'govcheck validate --json') as one self-contained HTML "
-            "file and/or an A4 PDF. Nothing is simulated. Without --html and --pdf the HTML is written next "
+            "file and/or an A4 PDF. Nothing is simulated. Without --report and --pdf the HTML is written next "
             "to the results with the suffix .html. Exit 0 when written, 2 on invalid input."
         ),
-        epilog="example: govcheck report /tmp/r.json --html reports/plant-a.html --pdf reports/plant-a.pdf",
+        examples=[
+            "govcheck report reports/plant-a.json --report reports/plant-a.html --pdf reports/plant-a.pdf",
+            "govcheck report r.json --linear lin.json --validation val.json --report full.html",
+        ],
     )
-    p.add_argument("results", help="results JSON (schema govcheck-results/1 or govcheck.validation/1)")
-    p.add_argument("--html", metavar="OUT.html", help="write the HTML report here")
-    p.add_argument("--pdf", metavar="OUT.pdf", help="write the PDF report here")
+    p.add_argument("results", metavar="RESULTS.json", help="results JSON (schema govcheck-results/1 or govcheck.validation/1)")
+    p.add_argument("--report", "--html", dest="report", metavar="FILE.html", help="write the HTML report here")
+    p.add_argument("--pdf", metavar="FILE.pdf", help="write the PDF report here")
     p.add_argument("--linear", metavar="LINEAR.json", action="append",
                    help="add the linear analysis written by 'govcheck linear --map --crosscheck --governor --json'; "
                         "repeat for more critical points (their Bode diagrams and poles are overlaid; map, "
                         "cross-check and governor parameters are taken from the first file that has them)")
     p.add_argument("--validation", metavar="VALIDATION.json",
                    help="add a model validation written by 'govcheck validate --json'")
-    p.add_argument("--jobs", "-j", type=int, default=None, help="processes drawing figures (default: available cores)")
+    add_jobs(p, "processes drawing figures")
     return p
 
 
@@ -70,18 +74,17 @@ def run(args) -> int:
     from compliance.report.content import check_results
     from compliance.report.render import VALIDATION_SCHEMA, check_validation, render_report, render_validation_report
 
-    if args.jobs is not None and args.jobs < 1:
-        raise InputError(f"--jobs {args.jobs}: expected a positive number of processes")
-    data = read_json(args.results, "results")
-    html = args.html
+    html = args.report
     if not html and not args.pdf:
         html = str(Path(args.results).with_suffix(".html"))
+    check_args_outputs(args, (None if args.report else html, "--report (default, beside the results)", (".html",)))
+    data = read_json(args.results, "results")
     if data.get("schema") == VALIDATION_SCHEMA:
         if args.linear or args.validation:
             raise InputError(f"{args.results}: a validation results file takes no --linear / --validation")
         check_validation(data, str(args.results))
         if not html:
-            raise InputError("a validation report needs --html (the PDF is made from it)")
+            raise InputError("a validation report needs --report (the PDF is made from it)")
         render_validation_report(data, html, args.pdf, workers=args.jobs)
     else:
         check_results(data, str(args.results))

@@ -2,19 +2,26 @@
 
 from __future__ import annotations
 
-
-from compliance.model.config import load_plant
+from compliance.cli.common import add_outputs, add_parser, add_plant_argument, check_args_outputs, plant_from_args
 from compliance.errors import InputError
 
 
 def register(sub):
-    p = sub.add_parser("reproduce", help="run the seed paper's tests and compare with its measured figures",
-                       description="Run every test of the reference sheet's table 'Results the model must be compared with' "
-                                   "and print simulated settling time and steady error beside the paper's, with the metric "
-                                   "definitions; flagged rows name the assumed parameter that drives the difference.")
-    p.add_argument("plant", help="reference plant name or configuration file (only plant-a has a paper table)")
+    """Add the ``reproduce`` sub-command."""
+    p = add_parser(
+        sub, "reproduce",
+        help="run the seed paper's tests and compare with its measured figures",
+        description="Run every test of the reference plant's table of measured results (docs/reference-plant.md) "
+                    "and print simulated settling time and steady error beside the paper's, with the metric "
+                    "definitions; flagged rows name the assumed parameter that drives the difference.",
+        examples=[
+            "govcheck reproduce plant-a",
+            "govcheck reproduce models/plant-a.toml --no-explain --json paper.json",
+        ],
+    )
+    add_plant_argument(p, help="reference plant name or configuration file (only the tandem plant A has a paper table)")
     p.add_argument("--no-explain", action="store_true", help="skip the sensitivity runs that name the driving parameter")
-    p.add_argument("--json", help="also write the comparison as JSON")
+    add_outputs(p, "json", help={"json": "also write the comparison as JSON to FILE.json"})
     p.add_argument("--calibrate", nargs="?", const="models/plant-a-calibrated.toml", metavar="OUT.toml",
                    help="fit the parameters the paper leaves unstated to its figures, print before/after and save "
                         "the calibrated configuration (default models/plant-a-calibrated.toml; docs/calibration.md)")
@@ -22,11 +29,15 @@ def register(sub):
 
 
 def run(args) -> int:
+    """Compare with the paper; print the table, write the JSON."""
     from compliance.papers.plant_a import compare, format_table
 
-    cfg = load_plant(args.plant)
+    check_args_outputs(args)
+    cfg = plant_from_args(args)
     if cfg.options["cylinder.arrangement"] != "tandem":
-        raise InputError(f"{args.plant}: the paper comparison exists for the tandem gate servo (plant A) only")
+        from compliance.files.display import display_path
+
+        raise InputError(f"{display_path(cfg.path) or cfg.name}: the paper comparison exists for the tandem gate servo (plant A) only")
     if args.calibrate:
         from compliance.papers.calibration_run import run_calibration
 

@@ -1,32 +1,40 @@
-"""``govcheck simulate``: one nonlinear simulation of a plant, written to CSV/Parquet (+ optional plot)."""
+"""``govcheck simulate``: one nonlinear simulation of a plant, written to CSV/Parquet with its sidecar."""
 
 from __future__ import annotations
 
+import io
+import json
 import os
-import tempfile
 from pathlib import Path
 
+from compliance.cli.common import (add_parser, add_plant_argument, check_load_force, plant_from_args, plant_source,
+                                   quantity)
 from compliance.errors import InputError
 from compliance.simulation.profiles import Profile, parse_sine, steps
-from compliance.simulation import Scenario, SensorNoise, simulate
-from compliance.cli.common import add_plant_argument, plant_from_args, quantity
+
+MAX_DURATION = 3600.0  # [s] one simulation; longer is a typo (1e9 s would need TiB of memory)
+MAX_SAMPLES = 4_000_000  # output rows (~0.5 GB of columns)
+PLOT_SUFFIXES = (".png", ".svg", ".pdf")
+SIDECAR_MARK = "# govcheck simulate sidecar"
 
 
 def register(sub):
-    p = sub.add_parser(
-        "simulate",
-        help="simulate a plant with a reference profile and write the traces",
+    """Add the ``simulate`` sub-command."""
+    p = add_parser(
+        sub, "simulate",
+        help="simulate a plant with a reference profile and write the traces (+ sidecar)",
         description=(
             "Simulate a plant configuration in closed loop (PID with dead-zone compensation) and write "
             "the canonical recording columns (time, position, reference, valve_command, pressure_a, "
-            "pressure_b, supply_pressure) plus internal states. Quantities accept units: '136 mm', '11.4 kN'."
+            "pressure_b, supply_pressure) plus internal states, and the NAME.toml sidecar with the plant and "
+            "the test conditions, so 'govcheck validate' and 'govcheck diagnose' replay the file as it is. "
+            "Quantities accept units: '136 mm', '11.4 kN'. Nothing is written when an input is refused."
         ),
-        epilog=(
-            "examples:\n"
-            "  govcheck simulate models/plant-a.toml --x0 '136 mm' --load '11.4 kN' --steps '2%@1s,-2%@4s' --duration 7 -o run.csv\n"
-            "  govcheck simulate --plant plant-a --x0 80mm --sine 8mm,0.05Hz --duration 40 -o sine.parquet --plot sine.png"
-        ),
-        formatter_class=__import__("argparse").RawDescriptionHelpFormatter,
+        examples=[
+            "govcheck simulate models/plant-a.toml --x0 '136 mm' --load '11.4 kN' --steps '2%@1s,-2%@4s' --duration 7 -o run.csv",
+            "govcheck simulate plant-a --x0 80mm --sine 8mm,0.05Hz --duration 40 -o sine.parquet --plot sine.png",
+            "govcheck simulate plant-a --command '3V@0.5s,0V@2s' --duration 3 -o open.csv",
+        ],
     )
     add_plant_argument(p)
     p.add_argument("--x0", default=None, help="initial position (default: mid-stroke), e.g. '136 mm'")
@@ -35,24 +43,26 @@ def register(sub):
     g.add_argument("--steps", help="step sequence of increments, e.g. '2%%@1s,-2%%@4s' or '5mm@1s'")
     g.add_argument("--sine", help="sinusoid AMPLITUDE,FREQUENCY[,START] about x0, e.g. '8mm,0.05Hz'")
     g.add_argument("--command", dest="open_loop_command", help="open-loop valve command steps 'VOLTS@TIME,...' (plant only, no controller), e.g. '3V@0.5s,0V@2s'")
-    p.add_argument("--duration", default="10 s", help="simulated time (default 10 s)")
+    p.add_argument("--duration", default="10 s", help=f"simulated time (default 10 s, at most {MAX_DURATION:g} s)")
     p.add_argument("--flow-control", choices=("on", "off"), help="install/remove the 2V2/2V3 flow-control valves (default: as configured)")
     p.add_argument("--noise", action="store_true", help="add seeded sensor noise (20 um position, 300 Pa pressures, 16-bit)")
-    p.add_argument("--seed", type=int, default=0, help="noise seed (default 0)")
-    p.add_argument("-o", "--output", required=True, help="output file: .csv or .parquet")
-    p.add_argument("--plot", help="also write a PNG plot of position, command and pressures")
+    p.add_argument("--seed", type=int, default=0, help="noise seed, a whole number >= 0 (default 0)")
+    p.add_argument("-o", "--output", required=True, metavar="FILE.csv", help="output file: .csv, .csv.gz or .parquet (the sidecar FILE.toml goes beside it)")
+    p.add_argument("--plot", metavar="FILE.png", help="also write a plot of position, command and pressures (.png, .svg or .pdf)")
     return p
 
 
-def _command_profile(spec: str) -> Profile:
-    times = [0.0]
-    values = [0.0]
+def _command_profile(spec: str, limit: float) -> Profile:
+    times, values = [0.0], [0.0]
     for item in [s for s in spec.split(",") if s.strip()]:
         if "@" not in item:
             raise InputError(f"--command: item '{item}' must look like '3V@0.5s'")
         v, t = item.split("@", 1)
         volts = quantity(v.strip(), "V", "--command")
         tt = quantity(t.strip(), "s", "--command")
+        if not abs(volts) <= limit:
+            raise InputError(f"--command: '{item.strip()}' asks for {volts:g} V; the valve's command limit "
+                             f"(valve.command_limit) is +/-{limit:g} V")
         if tt < times[-1]:
             raise InputError("--command: times must not go backwards")
         times += [tt, tt]
@@ -60,50 +70,130 @@ def _command_profile(spec: str) -> Profile:
     return Profile(times, values)
 
 
-def build_scenario(cfg, args) -> Scenario:
+def _duration(cfg, text: str) -> float:
+    duration = quantity(text, "s", "--duration")
+    if not duration > 0:
+        raise InputError(f"--duration {text!r}: must be a positive time")
+    ts = cfg.p("controller.sample_time")
+    if duration < 2 * ts:
+        raise InputError(f"--duration {text!r}: shorter than two controller samples ({2 * ts * 1e3:g} ms); nothing would be simulated")
+    if duration > MAX_DURATION:
+        raise InputError(f"--duration {text!r}: longer than the {MAX_DURATION:g} s one simulation may cover; split the test")
+    samples = duration / cfg.p("controller.sample_time")
+    if samples > MAX_SAMPLES:
+        raise InputError(f"--duration {text!r}: {samples:.3g} samples at the controller sample time "
+                         f"{cfg.p('controller.sample_time')*1e3:g} ms; at most {MAX_SAMPLES:g}")
+    return duration
+
+
+def _check_within(profile: Profile | None, duration: float, option: str) -> None:
+    if profile is None:
+        return
+    last = float(max(profile.times))
+    if last > duration * (1 + 1e-12) + 1e-9:
+        raise InputError(f"{option}: an event at t = {last:g} s is later than --duration {duration:g} s; "
+                         "lengthen --duration or drop the event")
+
+
+def build_scenario(cfg, args):
+    """The :class:`~compliance.simulation.Scenario` the arguments describe (every guard before any work)."""
+    from compliance.simulation import Scenario, SensorNoise
+
     stroke = cfg.p("cylinder.stroke")
     x0 = quantity(args.x0, "m", "--x0", 0.5 * stroke)
     if not 0.0 <= x0 <= stroke:
         raise InputError(f"--x0: {x0*1e3:.1f} mm is outside the stroke 0..{stroke*1e3:.0f} mm")
-    duration = quantity(args.duration, "s", "--duration")
-    if duration <= 0:
-        raise InputError("--duration must be positive")
+    duration = _duration(cfg, args.duration)
     load = "curve" if str(args.load).strip() == "curve" else quantity(args.load, "N", "--load")
+    check_load_force(cfg, load, "--load")
     ref = cmd = None
     if args.steps:
         ref = steps(args.steps, x0, stroke)
+        _check_within(ref, duration, "--steps")
     elif args.sine:
         ref = parse_sine(args.sine, x0, duration)
+        _check_within(ref, duration, "--sine (its START)")  # a sine starting after the end would be dropped
     elif args.open_loop_command:
-        cmd = _command_profile(args.open_loop_command)
+        cmd = _command_profile(args.open_loop_command, cfg.p("valve.command_limit"))
+        _check_within(cmd, duration, "--command")
+    if args.seed < 0:
+        raise InputError(f"--seed {args.seed}: expected a whole number >= 0")
     fc = None if args.flow_control is None else args.flow_control == "on"
     noise = SensorNoise(20e-6, 10e-6, 300.0, 1e6 / 65536) if args.noise else None
     return Scenario(duration=duration, initial_position=x0, reference=ref, command=cmd, load=load,
                     flow_control=fc, noise=noise, seed=args.seed)
 
 
-def write_frame(df, path: str) -> None:
-    """Write CSV or Parquet atomically (temp file + rename)."""
-    out = Path(path)
-    suffix = out.suffix.lower()
-    if suffix not in (".csv", ".parquet"):
-        raise InputError(f"{path}: output must end in .csv or .parquet")
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.", suffix=".tmp")
-    os.close(fd)
-    try:
-        if suffix == ".csv":
-            df.to_csv(tmp, index=False, float_format="%.9g")
-        else:
-            df.to_parquet(tmp, index=False)
-        os.replace(tmp, out)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+def _check_output(path: str) -> None:
+    from compliance.files.outputs import check_output
+
+    check_output(path, "-o/--output", (".csv", ".csv.gz", ".parquet"))
 
 
-def plot_run(df, path: str, title: str) -> None:
-    """PNG with position/reference, valve command and chamber pressures."""
+def sidecar_text(cfg, scenario, plant: str) -> str:
+    """The NAME.toml sidecar (docs/recording-format.md) of a simulated run: plant, conditions, controller."""
+    load = scenario.load
+    load_line = 'load_force = "curve"' if load == "curve" else f"load_force = {float(load or 0.0)!r}"
+    mode = "open loop (valve command given)" if scenario.command is not None else "closed loop (PID)"
+    return "\n".join([
+        SIDECAR_MARK,
+        f"plant = {json.dumps(plant)}",
+        f'description = "govcheck simulate: {mode}, {scenario.duration:g} s"',
+        "",
+        "[conditions]",
+        load_line,
+        f"initial_position = {float(scenario.initial_position)!r}",
+        f"supply_pressure = {float(cfg.p('air.supply_pressure'))!r}",
+        "",
+        "[controller]",
+        f"kp = {float(cfg.p('controller.kp'))!r}",
+        f"ki = {float(cfg.p('controller.ki'))!r}",
+        f"kd = {float(cfg.p('controller.kd'))!r}",
+        f"sample_time = {float(cfg.p('controller.sample_time'))!r}",
+        "",
+    ])
+
+
+def _sidecar_target(output: str) -> Path:
+    from compliance.files.outputs import check_output
+    from compliance.recordings.metadata import sidecar_path
+
+    side = sidecar_path(output)
+    check_output(side, "sidecar")
+    if side.exists():
+        head = side.read_text(encoding="utf-8", errors="replace").split("\n", 1)[0]
+        if head.strip() != SIDECAR_MARK:
+            raise InputError(f"-o {output}: its sidecar {side} exists and was not written by govcheck simulate; "
+                             "choose another output name (nothing is overwritten)")
+    return side
+
+
+def _plant_reference(source: str, side: Path) -> str:
+    """How the sidecar names the plant: a reference name as is, a file relative to the sidecar's folder."""
+    from compliance.model.config import reference_plants
+
+    if source in reference_plants() and not Path(source).exists():
+        return source
+    return os.path.relpath(Path(source).resolve(), side.resolve().parent)
+
+
+def frame_bytes(df, path: str) -> bytes:
+    """The CSV (.csv / .csv.gz) or Parquet bytes of a run, made in memory."""
+    name = path.lower()
+    buf = io.BytesIO()
+    if name.endswith(".parquet"):
+        df.to_parquet(buf, index=False)
+        return buf.getvalue()
+    text = df.to_csv(index=False, float_format="%.9g", lineterminator="\n").encode("utf-8")
+    if name.endswith(".gz"):
+        import gzip
+
+        return gzip.compress(text, mtime=0)
+    return text
+
+
+def plot_bytes(df, path: str, title: str) -> bytes:
+    """Plot with position/reference, valve command and chamber pressures, in the format of ``path``'s suffix."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -126,21 +216,34 @@ def plot_run(df, path: str, title: str) -> None:
         a.grid(alpha=0.3)
     fig.suptitle(title)
     fig.tight_layout()
-    out = Path(path)
-    tmp = out.with_name(f".{out.name}.tmp.png")
-    fig.savefig(tmp, dpi=110)
+    buf = io.BytesIO()
+    fmt = Path(path).suffix.lower().lstrip(".")
+    meta = {"Date": None} if fmt == "svg" else ({"CreationDate": None} if fmt == "pdf" else {})
+    fig.savefig(buf, format=fmt, dpi=110, metadata=meta)
     plt.close(fig)
-    os.replace(tmp, out)
+    return buf.getvalue()
 
 
 def run(args) -> int:
+    """Check every input and output, simulate, then write the run, its sidecar and the plot."""
+    from compliance.files.atomic import write_bytes_atomic, write_text_atomic
+    from compliance.files.outputs import check_outputs
+    from compliance.simulation import simulate
+
+    _check_output(args.output)
+    check_outputs((args.output, "-o/--output"), (args.plot, "--plot", PLOT_SUFFIXES))
+    side = _sidecar_target(args.output)
+    source = plant_source(args)
     cfg = plant_from_args(args)
     scenario = build_scenario(cfg, args)
     df = simulate(cfg, scenario)
-    write_frame(df, args.output)
-    if args.plot:
-        plot_run(df, args.plot, f"{cfg.name}: simulated")
+    data = frame_bytes(df, args.output)
+    plot = plot_bytes(df, args.plot, f"{cfg.name}: simulated") if args.plot else None
+    write_bytes_atomic(args.output, data)
+    write_text_atomic(side, sidecar_text(cfg, scenario, _plant_reference(source, side)))
+    if plot is not None:
+        write_bytes_atomic(args.plot, plot)
     err = (df.reference - df.position_true).abs().iloc[-1]
-    print(f"simulated {scenario.duration:g} s of {cfg.name} -> {args.output} ({len(df)} samples); "
+    print(f"simulated {scenario.duration:g} s of {cfg.name} -> {args.output} + {side} ({len(df)} samples); "
           f"final position {df.position_true.iloc[-1]*1e3:.2f} mm, final |error| {err*1e3:.3f} mm")
     return 0

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from compliance.cli.common import (add_outputs, add_quiet, add_reproducible, check_args_outputs, check_sidecar_conditions,
+                                   parse_param_overrides, sidecar_plant, split_config)
 from compliance.errors import InputError
 from compliance.files.atomic import write_json_atomic
 
@@ -29,15 +31,18 @@ def register(sub):
         ),
         epilog=(
             "examples:\n"
-            "  govcheck validate run.csv.gz --plant models/plant-a.toml\n"
-            "  govcheck validate log.txt --column-map bench.toml --plant plant-a --mode plant_only --json val.json\n"
-            "  govcheck validate run.csv --plant plant-a --setting limits.position.steady.max_error=0.005 --report val.html\n"
-            "  govcheck validate run.csv --plant plant-a --param friction.bristle_stiffness=1e6"
+            "  govcheck validate models/plant-a.toml run.csv.gz\n"
+            "  govcheck validate run.csv.gz                     (the plant named by the sidecar run.toml)\n"
+            "  govcheck validate plant-a log.txt --column-map bench.toml --mode plant_only --json val.json\n"
+            "  govcheck validate plant-a run.csv --setting limits.position.steady.max_error=0.005 --report val.html\n"
+            "  govcheck validate plant-a run.csv --param friction.bristle_stiffness=1e6"
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("recording", help="recording file (canonical CSV/CSV.GZ with NAME.toml sidecar, or any format a column map reads)")
-    p.add_argument("--plant", help="plant configuration file or reference name (default: the sidecar's 'plant')")
+    p.add_argument("inputs", nargs="+", metavar="[CONFIG] RECORDING",
+                   help="plant configuration (TOML file or reference name; default: the sidecar's 'plant') and the "
+                        "recording (canonical CSV/CSV.GZ with NAME.toml sidecar, or any format a column map reads)")
+    p.add_argument("--plant", help=argparse.SUPPRESS)
     p.add_argument("--column-map", help="column map (TOML path or shipped name) for a logger's own names and units")
     p.add_argument("--mode", default="both", help="closed_loop, plant_only or both (default both)")
     p.add_argument("--noise", default=None, help="closed-loop position-noise replay: auto (default), recorded, none")
@@ -46,24 +51,12 @@ def register(sub):
                    help="override one setting, e.g. limits.position.steady.max_error=0.02 or locate.k_on=4 (repeatable)")
     p.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
                    help="override one plant parameter in SI, e.g. friction.bristle_stiffness=1e6 (repeatable)")
-    p.add_argument("--json", dest="json_out", help="write the results (docs/validation-schema.md) to this JSON file")
-    p.add_argument("--report", help="write an HTML validation report (needs the report renderer)")
-    p.add_argument("--pdf", help="also write the report as PDF (with --report)")
+    add_outputs(p, "json", "report", "pdf", help={"json": "write the results (docs/validation-schema.md) to FILE.json",
+                                                  "pdf": "also write the report as PDF to FILE.pdf (with --report)"})
+    add_quiet(p, "print only the result line")
+    add_reproducible(p)
     p.add_argument("--max-windows", type=int, default=30, help="located windows printed per mode (default 30; all are in --json)")
     return p
-
-
-def _params(items) -> dict:
-    out = {}
-    for item in items:
-        if "=" not in item:
-            raise InputError(f"--param: '{item}' must look like KEY=VALUE (SI), e.g. friction.bristle_stiffness=1e6")
-        k, v = (s.strip() for s in item.split("=", 1))
-        try:
-            out[k] = float(v)
-        except ValueError:
-            raise InputError(f"--param {k}: '{v}' is not a number (give SI units)") from None
-    return out
 
 
 def _render(result: dict, html: str, pdf: str | None) -> None:
@@ -141,44 +134,56 @@ def format_summary(result: dict, max_windows: int = 30) -> str:
 
 
 def run(args) -> int:
+    """Check every input and output, replay the recording, print and write the result."""
     from compliance.model.config import load_plant
     from compliance.recordings.reader import read_recording
     from compliance.validation.validate import apply_overrides, read_settings_table, settings_from_dict, validate
 
+    plant_arg, recordings = split_config(args, args.inputs)
+    if len(recordings) > 1:
+        raise InputError(f"{recordings[1]}: one recording at a time (arguments: [CONFIG] RECORDING)")
+    recording = recordings[0]
     mode = args.mode.strip().replace("-", "_")
     if mode not in MODES + ("both",):
         raise InputError(f"--mode '{args.mode}' is not one of closed_loop, plant_only, both")
     modes = MODES if mode == "both" else (mode,)
+    if args.max_windows < 0:
+        raise InputError(f"--max-windows {args.max_windows}: expected a number of windows >= 0")
     if args.pdf and not args.report:
-        raise InputError("--pdf needs --report HTML_PATH")
-    for opt, target in (("--report", args.report), ("--pdf", args.pdf)):
-        if target and not Path(target).resolve().parent.is_dir():
-            raise InputError(f"{opt} {target}: folder '{Path(target).parent}' does not exist")  # fail before the work
+        raise InputError("--pdf needs --report FILE.html")
+    check_args_outputs(args)  # fail before the work, nothing written
+    params = parse_param_overrides(args.param)
     table = read_settings_table(args.settings) if args.settings else {}
-    overrides = list(args.setting)
     settings_where = args.settings or "--setting"
-    table = apply_overrides(table, overrides)
+    table = apply_overrides(table, list(args.setting))
     table.setdefault("replay", {})
     table["replay"] = dict(table["replay"], modes=list(modes))
     if args.noise is not None:
         table["replay"]["noise"] = args.noise
     settings = settings_from_dict(table, settings_where)
     required = ("time", "position") + (("reference",) if modes == ("closed_loop",) else ()) + (("valve_command",) if modes == ("plant_only",) else ())
-    df, meta = read_recording(args.recording, args.column_map, required=required)
-    plant_src = args.plant or meta.get("plant")
+    df, meta = read_recording(recording, args.column_map, required=required)
+    plant_src = plant_arg or sidecar_plant(meta, recording)
     if not plant_src:
-        raise InputError(f"{args.recording}: no plant given (--plant) and the sidecar names none")
+        raise InputError(f"{recording}: no plant given (CONFIG) and the sidecar names none")
     cfg = load_plant(plant_src)
-    params = _params(args.param)
     if params:
         cfg = cfg.replace(params=params)
+    check_sidecar_conditions(cfg, meta, recording)
     result = validate(cfg, df, meta, settings)
-    if args.json_out:
-        write_json_atomic(args.json_out, result)
-    print(format_summary(result, args.max_windows))
-    if args.json_out:
-        print(f"results: {args.json_out}")
+    summary = format_summary(result, args.max_windows)
+    print(summary.rstrip().splitlines()[-1] if args.quiet else summary)
+    written = _finish(result, args)
+    if args.json:
+        write_json_atomic(args.json, written)
+        print(f"results: {args.json}")
     if args.report:
-        _render(result, args.report, args.pdf)
+        _render(written, args.report, args.pdf)
         print(f"report: {args.report}" + (f", {args.pdf}" if args.pdf else ""))
     return 0 if result["summary"]["pass"] else 1
+
+
+def _finish(result: dict, args) -> dict:
+    from compliance.files.reproducible import is_reproducible, make_reproducible
+
+    return make_reproducible(result) if is_reproducible(args.reproducible) else result

@@ -1,34 +1,50 @@
 """The one atomic writer: a temporary file in the target folder, then ``os.replace``.
 
 A reader (a CI job, a browser, the next govcheck run) never sees half a file, and a failed
-write leaves the previous good file in place.
+write leaves the previous good file in place. Every file govcheck writes gets the same
+permissions (``0666`` minus the umask, as ``open()`` would give), whatever wrote its bytes.
 """
 
 from __future__ import annotations
 
-import json
 import os
 import tempfile
 from pathlib import Path
+from typing import Callable
 
 from compliance.errors import InputError
+from compliance.files.jsonable import json_text
 
-__all__ = ["write_json_atomic", "write_text_atomic"]
+__all__ = ["write_atomic_with", "write_bytes_atomic", "write_json_atomic", "write_text_atomic"]
 
 
-def write_text_atomic(path, text: str) -> None:
-    """Write ``text`` to ``path`` atomically (temp file in the same folder + os.replace)."""
+def _usual_mode() -> int:
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o666 & ~umask
+
+
+def write_atomic_with(path, write: Callable[[str], None]) -> None:
+    """Let ``write(tmp_path)`` produce the file, then move it onto ``path`` atomically.
+
+    For writers that want a file name (pandas, pyarrow, matplotlib). The temporary file keeps
+    the target's suffix so suffix-sniffing writers pick the right format.
+
+    Raises
+    ------
+    InputError
+        The folder does not exist or the target is read-only / a folder (nothing is written).
+    """
+    from compliance.files.outputs import check_output
+
     path = Path(path)
+    check_output(path, "output")
     folder = path.parent if str(path.parent) else Path(".")
-    if not folder.is_dir():
-        raise InputError(f"{path}: folder '{folder}' does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".tmp{path.suffix}", dir=folder)
+    os.close(fd)
     try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; give the file the usual permissions
+        write(tmp)
+        os.chmod(tmp, _usual_mode())  # mkstemp makes 0600; give the file the usual permissions
         os.replace(tmp, path)
     except BaseException:
         try:
@@ -38,7 +54,20 @@ def write_text_atomic(path, text: str) -> None:
         raise
 
 
-def write_json_atomic(path, data: dict) -> None:
-    """Write ``data`` as indented JSON (no NaN) to ``path`` atomically, creating its folder."""
-    Path(path).parent.mkdir(parents=True, exist_ok=True)
-    write_text_atomic(path, json.dumps(data, indent=1, allow_nan=False) + "\n")
+def write_bytes_atomic(path, data: bytes) -> None:
+    """Write ``data`` to ``path`` atomically."""
+    def _write(tmp: str) -> None:
+        with open(tmp, "wb") as fh:
+            fh.write(data)
+
+    write_atomic_with(path, _write)
+
+
+def write_text_atomic(path, text: str) -> None:
+    """Write ``text`` (UTF-8) to ``path`` atomically (temp file in the same folder + os.replace)."""
+    write_bytes_atomic(path, text.encode("utf-8"))
+
+
+def write_json_atomic(path, data, *, compact: bool = False) -> None:
+    """Write ``data`` as strict JSON (cleaned by the one JSON cleaner) to ``path`` atomically."""
+    write_text_atomic(path, json_text(data, compact=compact))

@@ -23,27 +23,13 @@ from compliance.model.config import PlantConfig
 from compliance.model.pid_controller import first_order_filter_gain
 from compliance.errors import InputError
 from compliance.model.vector_slots import P_BV, P_MASS, P_NFR, P_STROKE
+from compliance.files.jsonable import json_number, jsonable  # the one JSON cleaner (re-exported for linear/*)
 from compliance.linear.trim import TrimPoint, linearise_plant, minimal_realisation, pneumatic_stiffness, trim
 
 PADE_ORDER = 3  # delays as 3rd-order Pade: phase error < 1 deg up to omega*T = 2 (well beyond crossover)
 STEP_FRACTION = 0.05  # predicted step: 5 % of stroke (the linear shape does not depend on the size)
 METRIC_NAMES = ("time_constant", "gain_margin_db", "phase_margin_deg", "bandwidth_hz", "damping_ratio",
                 "pneumatic_damping_ratio", "natural_frequency_hz", "dominant_time_constant")
-
-
-def jsonable(obj):
-    """Plain Python copy of ``obj``: numpy scalars/arrays to float/list, non-finite floats to None."""
-    if isinstance(obj, dict):
-        return {str(k): jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple, np.ndarray)):
-        return [jsonable(v) for v in obj]
-    if isinstance(obj, (bool, np.bool_)):
-        return bool(obj)
-    if isinstance(obj, (int, np.integer)):
-        return int(obj)
-    if isinstance(obj, (float, np.floating)):
-        return float(obj) if math.isfinite(obj) else None
-    return obj
 
 
 def _pade_ss(delay, order=PADE_ORDER):
@@ -310,7 +296,7 @@ def _figures(cfg, op, plant, gmin, Lc, Ld, T, Td, n_freq, detail):
     if detail:
         mc = margins(Lc, floor)
         f.update(gain_margin_db_continuous=mc["gain_margin_db"], phase_margin_deg_continuous=mc["phase_margin_deg"])
-    f["bandwidth_hz"] = _finite(control.bandwidth(T) / (2 * math.pi)) if f["stable"] else None
+    f["bandwidth_hz"] = json_number(control.bandwidth(T) / (2 * math.pi)) if f["stable"] else None
     # predicted step (discrete closed loop: what the sampled controller does) and its time constant
     tau_guess = f["dominant_time_constant"] or f["first_order_time_constant"] or 0.2
     dur = float(np.clip(12.0 * tau_guess, 1.5, 30.0))
@@ -351,10 +337,6 @@ def _figures(cfg, op, plant, gmin, Lc, Ld, T, Td, n_freq, detail):
                  "time_continuous": tc[::4].tolist(), "position_continuous": (op.position + size * yc[::4]).tolist()},
     }
     return f, data
-
-
-def _finite(v):
-    return float(v) if v is not None and np.isfinite(v) else None
 
 
 _CACHE: dict = {}

@@ -23,7 +23,8 @@ import numpy as np
 from compliance import metrics as M
 from compliance.model.config import PlantConfig
 from compliance.errors import InputError
-from compliance.linear.analysis import analyse, jsonable
+from compliance.files.jsonable import jsonable
+from compliance.linear.analysis import analyse
 from compliance.linear.maps import nonlinear_step
 from compliance.simulation.profiles import Profile
 from compliance.simulation import Scenario, simulate

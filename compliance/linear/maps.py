@@ -18,7 +18,8 @@ from compliance.model.dead_zone_stall import stall_error
 from compliance import metrics as M
 from compliance.model.config import PlantConfig
 from compliance.errors import InputError
-from compliance.linear.analysis import analyse, jsonable
+from compliance.files.jsonable import jsonable
+from compliance.linear.analysis import analyse
 from compliance.simulation.profiles import steps
 from compliance.simulation import Scenario, simulate
 

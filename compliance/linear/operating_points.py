@@ -24,7 +24,8 @@ def linear_for_campaign(cfg: PlantConfig, reqset, *, with_map: bool = True) -> d
     dict
         ``{"schema", "analyses": [...], "map", "crosscheck", "governor", "notes"}``.
     """
-    from compliance.linear.analysis import analyse, jsonable
+    from compliance.files.jsonable import jsonable
+    from compliance.linear.analysis import analyse
     from compliance.linear.maps import crosscheck, operating_map
     from compliance.linear.governor_model import governor_parameters
     from compliance.simulation.scenario import scenario_load

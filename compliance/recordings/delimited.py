@@ -91,7 +91,7 @@ def read_text_table(path: Path, cmap: ColumnMap | None) -> RecordingSource:
     except pd.errors.ParserError as exc:
         m = re.search(r"line (\d+), saw (\d+)", str(exc))
         where = f"line {numbers[int(m.group(1)) - 1]}" if m else "a data line"
-        raise InputError(f"{path}: {where}: wrong number of fields ({exc})") from None
+        raise InputError(f"{path}: {where}: wrong number of fields ({' '.join(str(exc).split())})") from None
     width = len(names) if names is not None else table.shape[1]
     if table.shape[1] != width:
         counts = [len(_split(line, delim)) for line in lines]

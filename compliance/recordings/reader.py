@@ -2,7 +2,7 @@
 
 ``read_recording(path, column_map=None, required=...) -> (DataFrame, metadata)`` reads
 
-- the canonical CSV of ``/work/shared/recording-format.md`` (also ``.csv.gz``), with its
+- the canonical CSV of docs/recording-format.md (also ``.csv.gz``), with its
   optional ``NAME.toml`` sidecar (``X.csv.gz`` -> ``X.toml``);
 - any delimited text a column map describes (other names, units, gauge pressures, no header,
   settling rows to drop);
@@ -36,6 +36,7 @@ from compliance.recordings.delimited import TEXT_SUFFIXES, read_text_table
 from compliance.recordings.mat import read_mat
 from compliance.recordings.metadata import read_sidecar, si_metadata, sidecar_path
 from compliance.recordings.parquet import read_parquet
+from compliance.recordings.plausibility import check_ranges, check_time_base
 from compliance.metrics.trace_windows import true_runs
 
 __all__ = ["DEFAULT_REQUIRED", "read_recording", "si_metadata", "sidecar_path"]
@@ -90,12 +91,16 @@ def read_recording(path, column_map=None, *, required=DEFAULT_REQUIRED):
     row = (lambda i, _r=src.row, _d=drop: _r(i + _d))
     _check_finite(path, frame, row)
     _check_time(path, frame["time"].to_numpy(), row)
+    check_ranges(path, frame, row)  # every sample, not only the first
     meta = {}
     if cmap is not None and cmap.metadata:
         meta.update(si_metadata(cmap.metadata, f"{cmap.source}: metadata"))
     meta.update(read_sidecar(path))
     if src.extra:
         meta.update(src.extra)
+    time_spec = cmap.spec("time") if cmap is not None else None
+    check_time_base(path, frame["time"].to_numpy(), meta,
+                    unit_given=src.time is not None or (time_spec is not None and bool(time_spec.unit)))
     fmt_name = "csv.gz" if fmt == "csv" and path.name.lower().endswith(".gz") else fmt
     meta.update(
         source_path=str(path),

@@ -8,16 +8,14 @@ tightened freely; loosening it (or lowering the severity, or disabling a require
 say ``allow_loosen = true`` and is reported. The format is described in docs/requirements.md.
 
 This module finds, reads and merges the files; the rest lives beside it:
-``requirement_schema`` (file structure), ``requirement_entries`` (each entry's meaning),
-``requirement_set`` (the frozen objects), ``amounts`` (``"1 %stroke"``) and
-``limit_tightening`` (:func:`check_tightening`).
+``schema`` (file structure), ``entries`` (each entry's meaning), ``requirement_set`` (the
+frozen objects), ``compliance.units.amounts`` (``"1 %stroke"``) and ``tightening``
+(:func:`check_tightening`). The TOML itself is read by ``compliance.model.toml_file``.
 """
 
 from __future__ import annotations
 
-import hashlib
 import os
-import tomllib
 from importlib import resources
 from pathlib import Path
 
@@ -26,7 +24,9 @@ from pydantic import BaseModel
 from compliance.units.amounts import Amount, parse_amount
 from compliance.errors import did_you_mean
 from compliance.errors import InputError
+from compliance.model.toml_file import read_toml
 from compliance.requirements.tightening import check_tightening
+from compliance.requirements.limit_sign import check_limit_signs
 from compliance.requirements.entries import SEVERITIES, SOURCES, build_operating_point, build_procedure, build_requirement
 from compliance.requirements.schema import OPEN_LIMIT, SCHEMA, validate_file
 from compliance.requirements.requirement_set import LimitHistory, OperatingPoint, Procedure, Requirement, RequirementSet
@@ -80,26 +80,12 @@ def resolve_requirements_path(source: str | os.PathLike, relative_to: Path | Non
     return Path(str(ref))
 
 
-def _read_file(path: Path) -> tuple[dict, str]:
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise InputError(f"{path}: cannot read ({exc.strerror})") from None
-    try:
-        data = tomllib.loads(raw.decode("utf-8"))
-    except UnicodeDecodeError:
-        raise InputError(f"{path}: not a UTF-8 text file") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{path}: malformed TOML ({exc})") from None
-    return data, hashlib.sha256(raw).hexdigest()
-
-
 def _load_chain(path: Path, seen: tuple[str, ...]) -> list[tuple[Path, str, dict]]:
     """Files in merge order (bases first), each (path, digest, raw dict) validated structurally."""
     key = str(path.resolve())
     if key in seen:
         raise InputError(f"{path}: extends itself through {' -> '.join(seen)}")
-    data, digest = _read_file(path)
+    data, digest = read_toml(path)
     model = validate_file(data, path)
     chain: list[tuple[Path, str, dict]] = []
     bases = model.extends if isinstance(model.extends, list) else ([model.extends] if model.extends else [])
@@ -150,6 +136,7 @@ def load_requirements(source: str | os.PathLike) -> RequirementSet:
     )
     if not reqs:
         raise InputError(f"{path}: declares no requirements (a [requirements.ID] table)")
+    check_limit_signs(reqs, origin)
     return RequirementSet(
         name=top.get("name") or path.stem,
         title=top.get("title") or top.get("name") or path.stem,

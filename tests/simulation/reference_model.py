@@ -1,6 +1,6 @@
 """An independent plain-Python implementation of plant A's base equations for scipy ``solve_ivp``.
 
-Written from ../shared/reference-plant.md directly (not from compliance.model.assembly) so the
+Written from docs/reference-plant.md directly (not from compliance.model.assembly) so the
 cross-check compares two implementations: ISO 6358 flow (seed 000 eqs. 1-2), the tandem
 chambers (decoded eqs. 4-5, isentropic at T_s), motion (decoded eq. 6) with LuGre friction
 whose steady state is the sheet's map, PID + dead-zone compensation (eq. 3) at 1 ms ZOH.

@@ -1,0 +1,103 @@
+"""Physical plausibility of a whole recording: every sample in range, a time base that fits.
+
+The reader checks what a format can get wrong (NaN, time going backwards); this module
+checks what a logger or a person can get wrong with well-formed numbers: a 1e300 spike in
+one sample, a pressure logged as gauge in an absolute column, time logged in milliseconds
+(a 30 s test read as 30 000 s), a sample interval that disagrees with the sidecar's rate.
+Every sample is checked, not only the first; the message names the row.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from compliance.errors import InputError
+
+__all__ = ["RANGES", "check_ranges", "check_time_base"]
+
+# canonical column -> (low, high, unit, why); generous bounds of what any servo bench can log (SI)
+RANGES = {
+    "time": (-1e6, 1e6, "s", "a test lasts seconds to hours"),
+    "position": (-10.0, 10.0, "m", "strokes are at most a few metres"),
+    "reference": (-10.0, 10.0, "m", "strokes are at most a few metres"),
+    "valve_command": (-100.0, 100.0, "V", "valve commands are volts (+/-10 V, 0-10 V, 24 V)"),
+    "pressure_a": (0.0, 1e8, "Pa abs", "absolute pressure cannot be negative; a negative value is usually gauge logged as abs"),
+    "pressure_b": (0.0, 1e8, "Pa abs", "absolute pressure cannot be negative; a negative value is usually gauge logged as abs"),
+    "supply_pressure": (0.0, 1e8, "Pa abs", "absolute pressure cannot be negative; a negative value is usually gauge logged as abs"),
+    "force": (-1e8, 1e8, "N", "bench forces are far below 100 MN"),
+}
+RATE_MISMATCH = 100.0  # sample interval vs the sidecar's rate: beyond this factor the time unit is wrong
+SLOW_SAMPLE = 0.5  # [s] a servo test sampled this slowly cannot resolve a 0.1 s time constant
+
+
+def check_ranges(path, frame: pd.DataFrame, row) -> None:
+    """Every sample of every known column within its physical range.
+
+    Raises
+    ------
+    InputError
+        Naming the column, the first row outside and how many samples are outside.
+    """
+    for name, (low, high, unit, why) in RANGES.items():
+        if name not in frame.columns:
+            continue
+        v = frame[name].to_numpy()
+        bad = np.flatnonzero((v < low) | (v > high))
+        if bad.size:
+            i = int(bad[0])
+            raise InputError(
+                f"{path}: {row(i)}: column '{name}' = {float(v[i]):.6g} {unit} is outside {low:g}..{high:g} {unit} "
+                f"({bad.size} sample(s) outside; {why}); cut or repair the recording, or correct the column map's unit"
+            )
+
+
+def _sidecar_interval(meta: dict) -> tuple[float, str] | None:
+    ctrl = meta.get("controller")
+    for where, table, key in (("[controller] sample_time", ctrl, "sample_time"), ("sample_time", meta, "sample_time"),
+                              ("sample_rate", meta, "sample_rate")):
+        if isinstance(table, dict) and isinstance(table.get(key), (int, float)) and not isinstance(table.get(key), bool):
+            value = float(table[key])
+            if value > 0 and np.isfinite(value):
+                return (1.0 / value if key == "sample_rate" else value), where
+    return None
+
+
+def check_time_base(path, time: np.ndarray, meta: dict, unit_given: bool) -> None:
+    """The sample interval agrees with the sidecar's rate (within 100x) and does not look like milliseconds.
+
+    Parameters
+    ----------
+    path : path-like
+        The recording, for messages.
+    time : numpy.ndarray
+        The time column [s] (strictly increasing, checked before).
+    meta : dict
+        The sidecar / column-map metadata (SI).
+    unit_given : bool
+        A column map stated the time unit; the milliseconds guess is then not made.
+
+    Raises
+    ------
+    InputError
+        A median sample interval 100x or more away from the sidecar's, or integer time stamps one
+        second or more apart without a stated unit (time in ms, read as s).
+    """
+    dt = float(np.median(np.diff(time)))
+    duration = float(time[-1] - time[0])
+    side = _sidecar_interval(meta)
+    if side is not None:
+        ts, where = side
+        ratio = dt / ts
+        if not 1.0 / RATE_MISMATCH < ratio < RATE_MISMATCH:
+            hint = " - the time column looks like milliseconds; the canonical time is in seconds" if 500 < ratio < 2000 else ""
+            raise InputError(
+                f"{path}: column 'time': median sample interval {dt:.6g} s is {ratio:.4g} x the sidecar's {where} = "
+                f"{ts:.6g} s{hint}; convert the time to seconds (or give a column map with the time unit)"
+            )
+        return
+    if not unit_given and time.size >= 10 and dt >= SLOW_SAMPLE and np.all(time == np.round(time)):
+        raise InputError(
+            f"{path}: column 'time': integer time stamps {dt:g} s apart ({duration:g} s in all) look like milliseconds; "
+            "the canonical time is in seconds: convert it, or give a column map with unit = \"ms\" for time"
+        )
