@@ -264,7 +264,7 @@ def plant_to_toml(cfg: PlantConfig) -> str:
         else:
             unit = spec.unit
             val = f'"{_fmt(v)} {unit} abs"' if spec.pressure else (f'"{_fmt(v)} {unit}"' if unit else _fmt(v))
-        sections.setdefault(sec, []).append(f'{name} = {{ value = {val}, source = "{src}" }}')
+        sections.setdefault(sec, []).append(f'{name} = {{ value = {val}, source = {_toml_str(src)} }}')
     for sec, rows in sections.items():
         lines.append(f"[{sec}]")
         lines.extend(rows)
@@ -279,6 +279,8 @@ def plant_to_toml(cfg: PlantConfig) -> str:
     for ename, vals in cfg.effects.items():
         eff = EFFECTS[ename]
         lines.append(f"[effects.{ename}]")
+        if f"effect_{ename}" in cfg.provenance:  # where its values came from (a calibration, a diagnosis)
+            lines.append(f"source = {_toml_str(cfg.provenance[f'effect_{ename}'])}")
         for p in eff.params:
             v = vals[p.name]
             lines.append(f'{p.name} = "{_fmt(v)} {p.unit}"' if p.unit else f"{p.name} = {_fmt(v)}")
