@@ -9,6 +9,7 @@ combines its rows. Values are also formatted in each metric's display unit for t
 from __future__ import annotations
 
 from compliance.campaign.plan import Job
+from compliance.units.formatting import fmt_margin_pct, fmt_value
 from compliance.requirements.tightening import check_tightening
 from compliance.linear.requirement_values import linear_value
 from compliance.metrics.catalogue import METRICS
@@ -23,15 +24,14 @@ _WORST_KEYS = ("run", "procedure", "operating_point", "value", "margin", "margin
 
 
 def fmt(value, metric: str, digits: int = 3) -> str:
-    """Display a SI value of ``metric`` in its display unit (``0.0016`` m -> ``'1.60 mm'``)."""
+    """Display a SI value of ``metric`` in its display unit (``0.0016`` m -> ``'1.60 mm'``; the one formatter)."""
     if value is None:
         return "-"
     info = METRICS[metric]
     v = value * info.display_scale
     if abs(v) < 1e-9:  # numerical zero (a body at rest in stiction), not a measurement
         v = 0.0
-    text = f"{v:.0f}" if abs(v) >= 10 ** digits else f"{v:#.{digits}g}".rstrip(".")
-    return f"{text} {info.display_unit}"
+    return fmt_value(v, info.display_unit, digits)
 
 
 def sample_dict(s: Sample, metric: str) -> dict:
@@ -84,7 +84,7 @@ def _display_row(row: dict, metric: str) -> dict:
         "value": fmt(row.get("value"), metric),
         "limit": None if not row.get("limit") else " .. ".join(fmt(v, metric) for v in row["limit"]),
         "margin": fmt(row.get("margin"), metric),
-        "margin_pct": None if row.get("margin_pct") is None else f"{row['margin_pct']:+.1f} %",
+        "margin_pct": fmt_margin_pct(row.get("margin_pct"), unicode=False),
     }
 
 

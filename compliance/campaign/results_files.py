@@ -13,9 +13,9 @@ from xml.sax.saxutils import escape, quoteattr
 from compliance.errors import InputError
 from compliance.files.atomic import write_text_atomic
 from compliance.files.jsonable import json_text
+from compliance.units.formatting import STATUS_WORD as _STATUS_WORD  # the one status-word table
 
 RESULTS_SCHEMA = "govcheck-results/1"
-_STATUS_WORD = {"pass": "PASS", "fail": "FAIL", "not_evaluated": "NOT EVALUATED", "open": "OPEN", "disabled": "DISABLED"}
 
 
 def results_json(results: dict) -> str:

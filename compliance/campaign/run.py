@@ -18,6 +18,7 @@ import platform
 import time
 
 from compliance.files.display import display_path
+from compliance.model.identity import identity_dict
 from compliance import __version__
 from compliance.campaign.plan import Job, plan
 from compliance.campaign.executor import available_cores, execute
@@ -85,6 +86,7 @@ def plant_section(cfg) -> dict:
         "effects": effects,
         "load_curve": curve,
         "provenance": dict(cfg.provenance),
+        "identity": identity_dict(cfg.identity),
     }
 
 

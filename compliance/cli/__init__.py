@@ -21,6 +21,7 @@ _COMMANDS = (
     ("reproduce", "reproduce"),
     ("check", "check"),
     ("gate", "gate"),
+    ("sweep", "sweep"),
     ("report", "report"),
     ("linear", "linear"),
     ("validate", "validate"),

@@ -39,9 +39,14 @@ def register(subparsers):
     p.add_argument("--requirements", "-r", required=True, metavar="REQ",
                    help="requirement file: a TOML file or a shipped name (" + ", ".join(names) + ")")
     add_outputs(p, "json", "junit", "report", "pdf")
+    p.add_argument("--appendix", choices=("none", "summary", "full"), default="summary",
+                   help="report appendix: none, summary (configuration, requirement file, versions; default) or full (+ every run)")
     p.add_argument("--linear", action="store_true",
                    help="add the linear analysis to the results and report: every operating point, the stroke x load map, "
                         "the linear/nonlinear cross-check and the HYGOV parameters (adds ~20-40 s)")
+    p.add_argument("--remedies", nargs="?", const="default", metavar="SWEEP.toml",
+                   help="what would make it pass: sensitivities and the smallest verified change over the on-site settings "
+                        "(or the adjustable space of a sweep file); added to the results as 'remedies'")
     add_jobs(p)
     add_quiet(p, "no progress bar; print only the verdict line")
     add_reproducible(p)
@@ -92,6 +97,10 @@ def run(args) -> int:
     if is_reproducible(args.reproducible):
         fixed_created()  # a malformed SOURCE_DATE_EPOCH is refused before the work
     render = renderer(args)
+    if args.remedies and args.remedies != "default":  # a bad sweep file is exit 2 before any simulation
+        from compliance.sweep.spec import load_sweep
+
+        load_sweep(args.remedies)
     cfg = plant_from_args(args)
     reqset = load_requirements(args.requirements)
     stages = 1 + bool(args.linear) + (render is not None)
@@ -105,16 +114,24 @@ def run(args) -> int:
             bar.set_postfix_str("linear analysis", refresh=False)
             results["linear"] = linear_for_campaign(cfg, reqset)
             bar.update(1)
+        if args.remedies:
+            from compliance.sweep.check_remedies import remedies_for_check
+
+            results["remedies"] = remedies_for_check(cfg, reqset, args.remedies, workers=args.jobs, progress=not args.quiet)
         results = finish_results(results, args)
         table = summary_table(results)
         if render is not None:
             bar.set_postfix_str("report", refresh=False)
-            render(results, html_path=args.report, pdf_path=args.pdf)
+            render(results, html_path=args.report, pdf_path=args.pdf, appendix=args.appendix)
             bar.update(1)
     if args.quiet:
         print(table.rstrip().splitlines()[-1])
     else:
         sys.stdout.write(table)
+        if args.remedies:
+            from compliance.sweep.summary_text import remedies_markdown
+
+            sys.stdout.write("\n" + remedies_markdown(results["remedies"]))
     if args.json:
         write_json(results, args.json)
     if args.junit:

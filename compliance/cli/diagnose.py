@@ -190,7 +190,7 @@ def _run_friction(args, first, meta) -> int:
     if args.json:
         write_json_atomic(args.json, _finish(data, args))
     if args.report:
-        from compliance.diagnosis.friction_report import write_friction_report
+        from compliance.report.friction import write_friction_report
 
         write_friction_report(result, args.report)
     print(format_friction(data, args.quiet))

@@ -35,6 +35,9 @@ def register(subparsers):
     p.add_argument("--validation", metavar="VALIDATION.json",
                    help="add a model validation written by 'govcheck validate --json'")
     add_jobs(p, "processes drawing figures")
+    p.add_argument("--appendix", choices=("none", "summary", "full"), default="summary",
+                   help="compliance report appendix: none, summary (configuration, requirement file, versions; default) "
+                        "or full (+ every run with its figures)")
     return p
 
 
@@ -94,7 +97,7 @@ def run(args) -> int:
             val = read_json(args.validation, "validation")
             check_validation(val, str(args.validation))
             data["validation"] = val
-        render_report(data, html, args.pdf, workers=args.jobs)
+        render_report(data, html, args.pdf, workers=args.jobs, appendix=args.appendix)
     written = [p for p in (html, args.pdf) if p]
     print("report: " + ", ".join(written))
     return 0

@@ -22,6 +22,9 @@ def register(sub):
     add_plant_argument(p, help="reference plant name or configuration file (only the tandem plant A has a paper table)")
     p.add_argument("--no-explain", action="store_true", help="skip the sensitivity runs that name the driving parameter")
     add_outputs(p, "json", help={"json": "also write the comparison as JSON to FILE.json"})
+    p.add_argument("--calibrate", nargs="?", const="models/plant-a-calibrated.toml", metavar="OUT.toml",
+                   help="fit the parameters the paper leaves unstated to its figures, print before/after and save "
+                        "the calibrated configuration (default models/plant-a-calibrated.toml; docs/calibration.md)")
     return p
 
 
@@ -35,6 +38,10 @@ def run(args) -> int:
         from compliance.files.display import display_path
 
         raise InputError(f"{display_path(cfg.path) or cfg.name}: the paper comparison exists for the tandem gate servo (plant A) only")
+    if args.calibrate:
+        from compliance.papers.calibration_run import run_calibration
+
+        return run_calibration(cfg, args.calibrate, json_path=args.json)
     comp = compare(cfg, explain=not args.no_explain)
     print(format_table(comp))
     if args.json:

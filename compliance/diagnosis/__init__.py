@@ -13,8 +13,8 @@ Modules, one job each: ``replay_fit`` (fast re-synchronised replay with matched 
 ``noise_floor`` / ``residuals`` (normalised residuals), ``candidates`` (what may be fitted),
 ``fit`` (scan, simplex, least squares), ``select`` (information criteria, verdict),
 ``located`` (where the model misses), ``explain`` (the paragraph), ``engine`` (the chain),
-``concealed`` / ``benchmark`` (the proof), ``friction_models`` / ``friction_diagnosis`` /
-``friction_report`` (the friction bench).
+``concealed`` / ``benchmark`` (the proof), ``friction_models`` / ``friction_diagnosis`` (the friction
+bench; its report is compliance/report/friction.py).
 """
 
 from __future__ import annotations

@@ -195,6 +195,28 @@ LINKAGE_COMPLIANCE = Effect(
     draw={"stiffness": (2e4, 1e5, True), "damping": (100.0, 2000.0, True)},
 )
 
+VALVE_NULL_FLOW = Effect(
+    name="valve_null_flow",
+    meaning="the servo valve passes flow near its null: its lands leak, so pressure builds inside the nominal dead zone",
+    short="nf",
+    params=(
+        Param("null_opening", "", "relative opening through which each land leaks at null (leakage / underlap)", 0.003,
+              (0.0, 0.05), slot="a0"),
+        Param("null_width", "V", "command over which a covered land stops leaking (sets the pressure gain at null)", 0.3,
+              (0.05, 2.0), True, slot="w"),
+    ),
+    states=(),
+    signature="steady errors well inside the dead-zone stall band; chamber pressures follow the command at null",
+    signals=("position", "pressure_a", "pressure_b", "valve_command"),
+    # linear treatment: no state; at the trim (valve at null) the leaks' flow-pressure slope enters the state
+    # Jacobian through plant_rhs, and the input column is measured beyond the dead-zone edge (linear/trim.flow_columns)
+    plant_b=True,  # acts on the command about the valve centre: plant B's 0-10 V valve alike
+    explanation="the servo valve leaks across its lands near null, so the loop keeps a pressure gain inside the "
+                "nominal dead zone (leak opening {v} of full opening per land)",
+    fit_grid={"null_opening": (0.001, 0.003, 0.01), "null_width": (0.1, 0.3, 0.65)},
+    draw={"null_opening": (0.001, 0.01, True), "null_width": (0.1, 0.65, True)},
+)
+
 ALL_EFFECTS = (
     HEAT_TRANSFER,
     INTERNAL_LEAKAGE,
@@ -207,4 +229,5 @@ ALL_EFFECTS = (
     SENSOR_LAG,
     LINE_DYNAMICS,
     LINKAGE_COMPLIANCE,
+    VALVE_NULL_FLOW,
 )

@@ -7,7 +7,7 @@ from compliance.model.config import PlantConfig
 from compliance.errors import InputError
 
 
-def linear_for_campaign(cfg: PlantConfig, reqset, *, with_map: bool = True) -> dict:
+def linear_for_campaign(cfg: PlantConfig, reqset, *, with_map: bool = True, workers: int | None = None) -> dict:
     """Build the ``linear`` entry of a results dict (schema ``govcheck-linear/1``, as ``govcheck linear --json``).
 
     Parameters
@@ -17,7 +17,10 @@ def linear_for_campaign(cfg: PlantConfig, reqset, *, with_map: bool = True) -> d
     reqset : RequirementSet
         Its operating points with an initial position are analysed (critical points).
     with_map : bool
-        Include the stroke x load operating map (the slowest part, ~10-25 s).
+        Include the stroke x load operating map (the slowest part).
+    workers : int, optional
+        Processes (default: the available cores). The operating points, the map cells, the
+        cross-check points and the HYGOV fit are independent and run in parallel.
 
     Returns
     -------
@@ -25,9 +28,6 @@ def linear_for_campaign(cfg: PlantConfig, reqset, *, with_map: bool = True) -> d
         ``{"schema", "analyses": [...], "map", "crosscheck", "governor", "notes"}``.
     """
     from compliance.files.jsonable import jsonable
-    from compliance.linear.analysis import analyse
-    from compliance.linear.maps import crosscheck, operating_map
-    from compliance.linear.governor_model import governor_parameters
     from compliance.simulation.scenario import scenario_load
 
     out: dict = {"schema": "govcheck-linear/1", "analyses": [], "notes": []}
@@ -36,7 +36,7 @@ def linear_for_campaign(cfg: PlantConfig, reqset, *, with_map: bool = True) -> d
                             f"controller.type = '{cfg.options['controller.type']}' (see docs/plant-b.md for its design model)")
         return out
     stroke = cfg.p("cylinder.stroke")
-    seen = set()
+    seen, tasks = set(), []
     for op in reqset.operating_points.values():
         if op.initial_position is None:
             continue
@@ -46,16 +46,102 @@ def linear_for_campaign(cfg: PlantConfig, reqset, *, with_map: bool = True) -> d
         if key in seen or not 0.0 <= x <= stroke:
             continue
         seen.add(key)
-        try:
-            a = analyse(cfg, x, load, flow_control=op.flow_control)
-        except InputError as exc:
-            out["notes"].append(f"operating point '{op.name}': not linearised ({exc})")
-            continue
-        d = a.to_dict()
-        d["requirement_operating_point"] = op.name
-        out["analyses"].append(d)
+        tasks.append(("point", op.name, x, load, op.flow_control))
+    # independent pieces, slowest first (the cross-check simulates), spread over the cores
+    tasks = [("crosscheck", x, ld) for x, ld in _crosscheck_points(stroke)] + [("governor",)] + tasks
+    positions, loads = _map_grid(cfg) if with_map else ([], [])
+    tasks += [("cell", i, j, ld, x) for i, ld in enumerate(loads) for j, x in enumerate(positions)]
+    results = _run_tasks(cfg, tasks, workers)
+    cells = {}
+    out["crosscheck"] = []
+    for task, res in zip(tasks, results):
+        kind = task[0]
+        if kind == "point":
+            if isinstance(res, str):
+                out["notes"].append(f"operating point '{task[1]}': not linearised ({res})")
+            else:
+                res["requirement_operating_point"] = task[1]
+                out["analyses"].append(res)
+        elif kind == "crosscheck":
+            out["crosscheck"].extend(res)
+        elif kind == "governor":
+            out["governor"] = res
+        else:
+            cells[(task[1], task[2])] = res
     if with_map:
-        out["map"] = operating_map(cfg).to_dict()
-    out["crosscheck"] = jsonable(crosscheck(cfg))
-    out["governor"] = governor_parameters(cfg).to_dict()
-    return jsonable(out)
+        out["map"] = _assemble_map(positions, loads, cells)
+    # the order of the keys as before: analyses, notes, map, crosscheck, governor
+    return jsonable({k: out[k] for k in ("schema", "analyses", "notes", "map", "crosscheck", "governor") if k in out})
+
+
+def _crosscheck_points(stroke: float):
+    from compliance.linear.maps import PAPER_POINTS
+
+    return [(f * stroke, ld) for f, ld in PAPER_POINTS]
+
+
+def _map_grid(cfg: PlantConfig):
+    import numpy as np
+
+    from compliance.linear.maps import DEFAULT_LOADS
+
+    positions = [float(x) for x in np.linspace(0.0, cfg.p("cylinder.stroke"), 11)]
+    loads = [float(v) for v in DEFAULT_LOADS] + (["curve"] if cfg.load_curve is not None else [])
+    return positions, loads
+
+
+def _task(cfg: PlantConfig, task):
+    """One independent piece of the linear analysis (runs in a worker)."""
+    from compliance.linear.analysis import analyse
+    from compliance.linear.governor_model import governor_parameters
+    from compliance.linear.maps import crosscheck, operating_map
+
+    kind = task[0]
+    if kind == "point":
+        try:
+            return analyse(cfg, task[2], task[3], flow_control=task[4]).to_dict()
+        except InputError as exc:
+            return str(exc)
+    if kind == "crosscheck":
+        return crosscheck(cfg, points=[(task[1], task[2])])
+    if kind == "governor":
+        return governor_parameters(cfg).to_dict()
+    m = operating_map(cfg, positions=[task[4]], loads=[task[3]], curve=False)  # one cell of the map
+    return {"values": {n: v[0][0] for n, v in m.values.items()}, "notes": m.notes}
+
+
+def _assemble_map(positions, loads, cells) -> dict:
+    from compliance.linear.maps import MAP_FIGURES, OperatingMap
+
+    values = {n: [[cells[(i, j)]["values"][n] for j in range(len(positions))] for i in range(len(loads))]
+              for n in MAP_FIGURES + ("stable",)}
+    notes = [n for i in range(len(loads)) for j in range(len(positions)) for n in cells[(i, j)]["notes"]]
+    return OperatingMap(positions, loads, values, notes).to_dict()
+
+
+_CTX: dict = {}  # set before the pool forks: workers read the configuration and tasks without pickling them
+
+
+def _work(i: int):
+    return i, _task(_CTX["cfg"], _CTX["tasks"][i])
+
+
+def _run_tasks(cfg: PlantConfig, tasks: list, workers: int | None) -> list:
+    """Results of ``tasks`` in order; on ``workers`` forked processes (default: the available cores)."""
+    import multiprocessing as mp
+    import os
+
+    workers = len(os.sched_getaffinity(0)) if workers is None else workers
+    if workers <= 1 or len(tasks) < 4 or "fork" not in mp.get_all_start_methods():
+        return [_task(cfg, t) for t in tasks]
+    from concurrent.futures import ProcessPoolExecutor
+
+    out: list = [None] * len(tasks)
+    _CTX.update(cfg=cfg, tasks=tasks)
+    try:
+        with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("fork")) as pool:
+            for i, res in pool.map(_work, range(len(tasks))):
+                out[i] = res
+    finally:
+        _CTX.clear()
+    return out

@@ -259,18 +259,23 @@ def flow_columns(op: TrimPoint, cfg: PlantConfig, keep: list[int]) -> tuple[np.n
     """
     P, y0, null = op.params, op.state, op.valve_null
     spool = bool(P[P_VD_ON])
-    base = rhs(P, y0, null, cfg)
+
+    def at(u):
+        if not spool:
+            return rhs(P, y0, u, cfg)
+        y = y0.copy()
+        y[S_SP] = u  # the spool carries the command to the ports
+        d = rhs(P, y, null, cfg)
+        d[[S_SP, S_SV]] = 0.0  # the spool's own rows are not a flow effect
+        return d
+
     cols = []
     for sgn, dz in ((1.0, P[P_DZP]), (-1.0, P[P_DZN])):
-        u = null + sgn * (dz + OPENING_PROBE * (P[P_USAT] - dz))  # path_opening = (u - dz)/(u_sat - dz)
-        y = y0.copy()
-        if spool:
-            y[S_SP] = u  # the spool carries the command to the ports
-            d = rhs(P, y, null, cfg)
-            d[[S_SP, S_SV]] = base[[S_SP, S_SV]]  # the spool's own rows are not a flow effect
-        else:
-            d = rhs(P, y, u, cfg)
-        cols.append(sgn * (d - base)[keep] / OPENING_PROBE)
+        # from the dead-zone edge: a valve that leaks near null (valve_null_flow) already passes flow there,
+        # which is not the opening's slope; an ideal valve passes none at the edge nor at null
+        edge = null + sgn * dz
+        u = edge + sgn * OPENING_PROBE * (P[P_USAT] - dz)  # path_opening = (u - dz)/(u_sat - dz)
+        cols.append(sgn * (at(u) - at(edge))[keep] / OPENING_PROBE)
     return cols[0], cols[1]
 
 

@@ -38,7 +38,7 @@ from compliance.physics.valve_flow import (
     sanville_mass_flow,
     series_conductance,
 )
-from compliance.physics.valve_opening import openings_from_signed, signed_opening, valve_openings
+from compliance.physics.valve_opening import land_leak_openings, openings_from_signed, signed_opening, valve_openings
 
 STICK_TIME_CONSTANT = 1e-3  # s; variable-viscous model: how fast a stuck body's residual speed is removed
 
@@ -150,6 +150,14 @@ def plant_rhs(y, P, u_valve, load_xs, load_ys, dy, aux):
         if P[P_VO_ON] != 0.0:
             u = u + P[P_VO_OFF]  # valve null shift
         a_pa, a_at, a_pb, a_bt = valve_openings(u - P[P_UCEN], P[P_DZP], P[P_DZN], P[P_SLP], P[P_SLN], P[P_USAT])
+    if P[P_NF_ON] != 0.0:
+        # the lands leak near null (Merritt 1967 sec. 5.4), driven by the command the spool sees
+        u_null = (u if not lag_opening else u_valve + (P[P_VO_OFF] if P[P_VO_ON] != 0.0 else 0.0)) - P[P_UCEN]
+        l_pa, l_at, l_pb, l_bt = land_leak_openings(u_null, P[P_NF_A0], P[P_NF_W])
+        a_pa = min(a_pa + l_pa, 1.0)
+        a_at = min(a_at + l_at, 1.0)
+        a_pb = min(a_pb + l_pb, 1.0)
+        a_bt = min(a_bt + l_bt, 1.0)
     # --- supply, port and chamber temperatures
     ps = y[S_PSUP] if P[P_SD_ON] != 0.0 else P[P_PS]
     port_a = y[S_PLA] if P[P_LD_ON] != 0.0 else pa

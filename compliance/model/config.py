@@ -21,9 +21,10 @@ from compliance.errors import InputError, did_you_mean
 from compliance.files.atomic import write_text_atomic
 from compliance.model.config_fields import SECTIONS, effect_values, load_curve_field, section_values
 from compliance.model.parameters import BASE_BY_KEY, BASE_PARAMS, OPTIONS
+from compliance.model.identity import parse_identity
 from compliance.model.toml_file import read_toml
 
-_TOP_KEYS = {"name", "description", "provenance", "effects"}
+_TOP_KEYS = {"name", "description", "provenance", "effects", "identity"}
 
 
 _suggest = did_you_mean
@@ -64,6 +65,7 @@ class PlantConfig:
     load_curve: tuple[np.ndarray, np.ndarray] | None
     effects: Mapping[str, Mapping[str, float]]
     provenance: Mapping[str, str] = field(default_factory=dict)
+    identity: Mapping[str, Any] = field(default_factory=dict)  # optional [identity]: site, unit, equipment (model/identity.py)
 
     def p(self, key: str) -> float:
         """SI value of a base parameter."""
@@ -204,6 +206,7 @@ def plant_from_dict(data: dict[str, Any], where: str = "<configuration>", digest
         load_curve=load_curve,
         effects=MappingProxyType({k: MappingProxyType(v) for k, v in effects.items()}),
         provenance=MappingProxyType({str(k): str(v) for k, v in (data.get("provenance") or {}).items()}),
+        identity=parse_identity(data.get("identity"), where),
     )
     _check_physical(cfg, where)
     return cfg
@@ -261,7 +264,7 @@ def plant_to_toml(cfg: PlantConfig) -> str:
         else:
             unit = spec.unit
             val = f'"{_fmt(v)} {unit} abs"' if spec.pressure else (f'"{_fmt(v)} {unit}"' if unit else _fmt(v))
-        sections.setdefault(sec, []).append(f'{name} = {{ value = {val}, source = "{src}" }}')
+        sections.setdefault(sec, []).append(f'{name} = {{ value = {val}, source = {_toml_str(src)} }}')
     for sec, rows in sections.items():
         lines.append(f"[{sec}]")
         lines.extend(rows)
@@ -276,6 +279,8 @@ def plant_to_toml(cfg: PlantConfig) -> str:
     for ename, vals in cfg.effects.items():
         eff = EFFECTS[ename]
         lines.append(f"[effects.{ename}]")
+        if f"effect_{ename}" in cfg.provenance:  # where its values came from (a calibration, a diagnosis)
+            lines.append(f"source = {_toml_str(cfg.provenance[f'effect_{ename}'])}")
         for p in eff.params:
             v = vals[p.name]
             lines.append(f'{p.name} = "{_fmt(v)} {p.unit}"' if p.unit else f"{p.name} = {_fmt(v)}")

@@ -15,6 +15,8 @@ import numpy as np
 from compliance.effects import EFFECTS
 from compliance.errors import InputError, did_you_mean
 from compliance.model.parameters import BASE_BY_KEY, BASE_PARAMS, OPTION_DEFAULTS, OPTIONS, SOURCES
+
+CALIBRATED_PREFIX = "calibrated to "  # source of a value fitted by a calibration (papers/calibration_table.py)
 from compliance.model.toml_file import check_table
 from compliance.units import ATMOSPHERE_PA, convert_array, parse_quantity
 
@@ -47,8 +49,10 @@ def param_value(entry, key: str, where: str, atmosphere: float) -> tuple[float, 
         if "value" not in entry:
             raise InputError(f"{where}: missing 'value'")
         source = entry.get("source", "user")
-        if source not in SOURCES:
-            raise InputError(f"{where}.source: '{source}' is not one of {', '.join(SOURCES)}")
+        # a calibrated value names what it was calibrated to: "calibrated to <figures> ..."
+        if source not in SOURCES and not (isinstance(source, str) and source.startswith(CALIBRATED_PREFIX)):
+            raise InputError(f"{where}.source: '{source}' is not one of {', '.join(SOURCES)} "
+                             f"nor '{CALIBRATED_PREFIX}<what it was fitted to>'")
         entry = entry["value"]
     if spec.unit == "number":
         if isinstance(entry, bool) or not isinstance(entry, (int, float)):

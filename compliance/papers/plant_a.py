@@ -23,6 +23,7 @@ import numpy as np
 
 from compliance.model.config import PlantConfig
 from compliance.model.dead_zone_stall import stall_error
+from compliance.papers.plant_a_fig8 import fig8, format_fig8
 from compliance.metrics import find_steps, speed_extremes, step_response, stroke_time
 from compliance.simulation.profiles import Profile, steps
 from compliance.simulation import Scenario, simulate
@@ -30,6 +31,17 @@ from compliance.simulation import Scenario, simulate
 SETTLING_BAND = 0.05  # fraction of the actual change
 SETTLING_TOLERANCE = 0.35  # relative
 STEADY_TOLERANCE = 0.3e-3  # m
+# the paper's own scatter per metric (issue 17): (kind, width); a row outside it is flagged
+TOLERANCES = {
+    "settling time": ("rel", SETTLING_TOLERANCE),
+    "steady error": ("abs", STEADY_TOLERANCE),
+    "opening time t_a": ("rel", 0.05),
+    "closing time t_f": ("rel", 0.05),
+    "max speed": ("rel", 0.30),
+}
+# test conditions the lost figures leave open (choices; the calibration picks, docs/calibration.md)
+FIG9_SEQUENCES = {"alternating": "2%@4s,-2%@9s,2%@14s", "staircase": "2%@4s,2%@9s,2%@14s"}
+DEFAULT_CONDITIONS = {"fig9_sequence": "alternating", "full_stroke_start": "balanced"}
 SENSITIVITY_STEP = 0.2  # relative perturbation of assumed parameters
 SENSITIVITY_PARAMS = (
     "friction.static_force",
@@ -91,21 +103,29 @@ class Comparison:
     rows: list[Row] = field(default_factory=list)
     stall_error: float = 0.0
     notes: list[str] = field(default_factory=list)
+    fig8: list = field(default_factory=list)  # plant_a_fig8.Fig8Step, with and without compensation
 
 
-def _step_metrics(cfg: PlantConfig, case: StepCase):
-    c = cfg.replace(params={"controller.kd": case.kd})
+def _step_metrics(cfg: PlantConfig, case: StepCase, memo: dict | None = None):
+    """Step responses of one case; ``memo`` (a dict kept for one configuration) reuses a run."""
+    key = (case.x0, case.load, case.kd, case.spec, case.duration, case.flow_control)
+    if memo is not None and key in memo:
+        return memo[key]
+    c = cfg.replace(params={"controller.kd": case.kd}, sources={"controller.kd": cfg.sources.get("controller.kd", "user")})
     stroke = c.p("cylinder.stroke")
     ref = steps(case.spec, case.x0, stroke)
     df = simulate(c, Scenario(duration=case.duration, initial_position=case.x0, reference=ref,
                               load=case.load, flow_control=case.flow_control))
     t = df.time.to_numpy()
     events = find_steps(t, df.reference.to_numpy())
-    return [step_response(t, df.position_true.to_numpy(), ev, settling_band=SETTLING_BAND) for ev in events]
+    out = [step_response(t, df.position_true.to_numpy(), ev, settling_band=SETTLING_BAND) for ev in events]
+    if memo is not None:
+        memo[key] = out
+    return out
 
 
-def _case_rows(cfg: PlantConfig, case: StepCase) -> list[Row]:
-    metrics = _step_metrics(cfg, case)
+def _case_rows(cfg: PlantConfig, case: StepCase, memo: dict | None = None) -> list[Row]:
+    metrics = _step_metrics(cfg, case, memo)
     rows = []
     for idx, (p_settle, p_err) in case.paper.items():
         m = metrics[idx]
@@ -115,14 +135,42 @@ def _case_rows(cfg: PlantConfig, case: StepCase) -> list[Row]:
     return rows
 
 
+def scaled_miss(row: Row) -> float | None:
+    """(simulated - paper) in units of the paper's scatter for this metric (None: not compared)."""
+    if row.paper is None or row.metric not in TOLERANCES:
+        return None
+    if row.simulated is None:
+        return float("inf")
+    kind, width = TOLERANCES[row.metric]
+    return (row.simulated - row.paper) / (width * abs(row.paper) if kind == "rel" else width)
+
+
 def _flag(row: Row) -> bool:
-    if row.simulated is None or row.paper is None:
-        return row.paper is not None and row.simulated is None
-    if row.unit == "s":
-        return abs(row.simulated - row.paper) > SETTLING_TOLERANCE * row.paper
-    if row.unit == "mm":
-        return abs(row.simulated - row.paper) > STEADY_TOLERANCE
-    return False
+    r = scaled_miss(row)
+    return r is not None and abs(r) > 1.0
+
+
+def conditions_of(cfg: PlantConfig) -> dict:
+    """Test conditions recorded in a calibrated configuration's provenance (defaults otherwise)."""
+    out = dict(DEFAULT_CONDITIONS)
+    for k in out:
+        v = cfg.provenance.get(f"condition_{k}")
+        if v:
+            out[k] = v.split()[0]
+    return out
+
+
+def cases(conditions: dict | None = None) -> tuple[StepCase, ...]:
+    """The paper's step tests under the given test conditions (fig. 9's sequence shape)."""
+    cond = dict(DEFAULT_CONDITIONS, **(conditions or {}))
+    spec = FIG9_SEQUENCES[cond["fig9_sequence"]]
+    out = []
+    for c in CASES:
+        if c.test.startswith("fig. 9"):
+            note = f"sequence {cond['fig9_sequence']} (fig. 9 is lost)" if c.note else ""
+            c = StepCase(c.test, c.x0, c.load, c.kd, spec, c.duration, c.flow_control, c.paper, note)
+        out.append(c)
+    return tuple(out)
 
 
 def _metric_of(cfg: PlantConfig, case: StepCase, idx: int, metric: str):
@@ -158,15 +206,25 @@ def _driver(cfg: PlantConfig, case: StepCase, idx: int, row: Row) -> str:
             f"{best[3] * scale:.3g} {row.unit}")
 
 
-def full_stroke(cfg: PlantConfig, load: float = 5700.0) -> dict:
-    """Opening/closing times and peak speed at full command through the flow-control valves."""
+def full_stroke(cfg: PlantConfig, load: float = 5700.0, start: str = "balanced") -> dict:
+    """Opening/closing times and peak speed at full command through the flow-control valves.
+
+    ``start``: "balanced" starts at rest with the pressures balancing the load about their mean;
+    "end_stop" starts where the previous stroke left the servo, the side that drove it there at
+    supply pressure and the other exhausted to atmosphere (the paper does not say which).
+    """
     stroke = cfg.p("cylinder.stroke")
+    ps, patm = cfg.p("air.supply_pressure"), cfg.p("air.atmospheric_pressure")
     out = {}
     for name, direction in (("opening", +1), ("closing", -1)):
         x0 = 0.0 if direction > 0 else stroke
         u = cfg.p("valve.centre_voltage") + direction * cfg.p("valve.command_limit")
         cmd = Profile(np.array([0.0, 0.2, 0.2]), np.array([cfg.p("valve.centre_voltage")] * 2 + [u]))
-        df = simulate(cfg, Scenario(duration=20.0, initial_position=x0, command=cmd, load=load, flow_control=True))
+        pressures = None
+        if start == "end_stop":  # closing ended at x = 0 with B at supply; opening ended at L with A at supply
+            pressures = (1.001 * patm, ps) if direction > 0 else (ps, 1.001 * patm)
+        df = simulate(cfg, Scenario(duration=12.0, initial_position=x0, command=cmd, load=load, flow_control=True,
+                                    initial_pressures=pressures))
         t = df.time.to_numpy()
         x = df.position_true.to_numpy()
         out[name] = stroke_time(t, x, stroke, name)[0]
@@ -174,34 +232,52 @@ def full_stroke(cfg: PlantConfig, load: float = 5700.0) -> dict:
     return out
 
 
-def compare(cfg: PlantConfig, explain: bool = True) -> Comparison:
+def figure_rows(cfg: PlantConfig, conditions: dict | None = None,
+                memo: dict | None = None) -> list[tuple[StepCase | None, int, Row]]:
+    """The paper's figures (figs. 9-12, section 5.2) simulated: (case, step index, row), flags set.
+
+    ``memo``: a dict kept for one configuration, so that several condition sets share the runs.
+    """
+    cond = dict(DEFAULT_CONDITIONS, **(conditions or {}))
+    memo = {} if memo is None else memo
+    out = []
+    for case in cases(cond):
+        rows = _case_rows(cfg, case, memo)
+        idxs = [i for i in case.paper for _ in (0, 1)]
+        out.extend((case, idx, row) for idx, row in zip(idxs, rows))
+    key = ("full_stroke", cond["full_stroke_start"])
+    if key not in memo:
+        memo[key] = full_stroke(cfg, start=cond["full_stroke_start"])
+    fs = memo[key]
+    for name, key in (("opening time t_a", "opening"), ("closing time t_f", "closing")):
+        out.append((None, 0, Row("speed-governor set-up (5.7 kN)", name, fs[key], 5.0, "s")))
+    vmax = max(fs["opening_speed"], fs["closing_speed"])
+    out.append((None, 0, Row("speed-governor set-up (5.7 kN)", "max speed", vmax, 0.09, "m/s",
+                             note=f"full strokes start {cond['full_stroke_start']}")))
+    for _, _, row in out:
+        row.flagged = _flag(row)
+    return out
+
+
+def compare(cfg: PlantConfig, explain: bool = True, conditions: dict | None = None) -> Comparison:
     """Run every test of the paper table and build the comparison (see module docstring)."""
     comp = Comparison(stall_error=stall_error(cfg))
-    for case in CASES:
-        rows = _case_rows(cfg, case)
-        idxs = [i for i in case.paper for _ in (0, 1)]
-        for idx, row in zip(idxs, rows):
-            row.flagged = _flag(row)
-            if row.flagged and explain:
-                row.driver = _driver(cfg, case, idx, row)
-            comp.rows.append(row)
-    fs = full_stroke(cfg)
-    for name, key in (("opening time t_a", "opening"), ("closing time t_f", "closing")):
-        comp.rows.append(Row("speed-governor set-up (5.7 kN)", name, fs[key], 5.0, "s"))
-    vmax = max(fs["opening_speed"], fs["closing_speed"])
-    r = Row("speed-governor set-up (5.7 kN)", "max speed", vmax, 0.09, "m/s")
-    r.flagged = abs(vmax - 0.09) > 0.35 * 0.09
-    if r.flagged:
-        r.driver = ("peak speed comes from the first instants, when the exhaust side still holds its "
-                    "initial pressure; the meter-out throttle model (series ISO 6358 conductance, no "
-                    "throttle check valve dynamics) and the assumed load set it")
-    comp.rows.append(r)
+    cond = conditions_of(cfg) if conditions is None else conditions
+    for case, idx, row in figure_rows(cfg, cond):
+        if row.flagged and explain and case is not None:
+            row.driver = _driver(cfg, case, idx, row)
+        elif row.flagged and row.metric == "max speed":
+            row.driver = ("peak speed comes from the first instants, when the exhaust side still holds its "
+                          "initial pressure; the meter-out throttle model (series ISO 6358 conductance, no "
+                          "throttle check valve dynamics) and the test's starting pressures set it")
+        comp.rows.append(row)
     comp.rows.extend(_overall_rows(cfg))
+    comp.fig8 = fig8(cfg)
     comp.notes.append(
         f"With lc = {cfg.p('controller.compensation_width'):.2f} V and K_P = {cfg.p('controller.kp'):.0f} V/m the "
         f"compensated valve stays shut once |e| < {comp.stall_error * 1e3:.2f} mm: an ideal dead zone leaves steady "
         f"errors up to that value, and stick-slip can end anywhere inside it. The paper measured 0.24-0.32 mm (up to "
-        f"0.8 mm): flow through the real valve near its null, or a narrower lc, closes that gap (reference-plant.md)."
+        f"0.8 mm): flow through the real valve near its null, or a narrower lc, closes that gap (effect valve_null_flow; docs/calibration.md)."
     )
     return comp
 
@@ -234,7 +310,8 @@ def format_table(comp: Comparison) -> str:
         f"  settling time: from the step to the last exit from +/-{SETTLING_BAND:.0%} of the actual change around the settled position",
         "  steady error: |set-point - mean position over the last 0.5 s before the next step|",
         "  t_a / t_f: 25 % -> 75 % of stroke at full command with 2V2/2V3 installed, extrapolated to 100 %",
-        f"  flagged (!): settling off by > {SETTLING_TOLERANCE:.0%}, steady error off by > {STEADY_TOLERANCE * 1e3:.1f} mm",
+        f"  flagged (!): settling off by > {SETTLING_TOLERANCE:.0%}, steady error off by > {STEADY_TOLERANCE * 1e3:.1f} mm,",
+        "  stroke times within 5 %, peak speed within 30 %",
         "",
         f"{'test':42s} {'metric':18s} {'simulated':>10s} {'paper':>8s}  ",
     ]
@@ -247,5 +324,7 @@ def format_table(comp: Comparison) -> str:
         if r.flagged and r.driver:
             lines.append(f"{'':42s}   -> {r.driver}")
     lines.append("")
+    if comp.fig8:
+        lines += [format_fig8(comp.fig8), ""]
     lines.extend("Note: " + n for n in comp.notes)
     return "\n".join(lines)

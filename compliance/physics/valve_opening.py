@@ -72,3 +72,34 @@ def openings_from_signed(o):
         return a, 0.0, 0.0, a
     a = -o if -o < 1.0 else 1.0
     return 0.0, a, a, 0.0
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def land_leak_openings(u, null_opening, null_width):
+    """Relative openings through which the four lands leak near null (a_pa, a_at, a_pb, a_bt) [-].
+
+    A real spool passes flow inside its nominal dead zone: air leaks through the radial
+    clearance of every land, more the less of the land is covered (Merritt 1967, sec. 5.4: null
+    leakage and the pressure sensitivity of a practical critical-centre valve). Taken linear in
+    the command: each land leaks ``null_opening`` at null; the lands a command of |u| =
+    ``null_width`` uncovers leak twice that, the ones it covers no longer leak. With both lands
+    of a port leaking, the port pressure follows the command inside the dead zone (a finite
+    pressure gain at null) instead of staying where the valve shut.
+
+    Parameters
+    ----------
+    u : float
+        Command about the valve's null [V]; > 0 uncovers P->A and B->T.
+    null_opening : float
+        Relative opening of each land at null [-] (>= 0).
+    null_width : float
+        Command over which a land goes from half to fully covered [V] (> 0).
+    """
+    s = u / null_width
+    if s > 1.0:
+        s = 1.0
+    elif s < -1.0:
+        s = -1.0
+    uncovering = null_opening * (1.0 + s)  # P->A and B->T for u > 0
+    covering = null_opening * (1.0 - s)  # P->B and A->T for u > 0
+    return uncovering, covering, covering, uncovering

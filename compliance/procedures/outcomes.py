@@ -7,11 +7,17 @@ plots so the results stay small.
 
 from __future__ import annotations
 
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["MAX_TRACE_POINTS", "TRACE_COLUMNS", "RunOutcome", "Sample", "downsample", "request_key"]
+__all__ = ["MAX_TRACE_POINTS", "TRACE_COLUMNS", "RunOutcome", "Sample", "downsample", "request_key", "traces_off"]
+
+# False inside ``traces_off()``: sweeps judge thousands of candidates and plot none of them, and
+# formatting the plot traces costs about a quarter of a campaign's CPU (measured, docs/performance.md)
+_KEEP_TRACES: ContextVar[bool] = ContextVar("keep_traces", default=True)
 
 # signals kept for plots, and the most points per signal (report figures need no more)
 TRACE_COLUMNS = ("time", "reference", "position", "valve_command", "pressure_a", "pressure_b")
@@ -57,8 +63,13 @@ def request_key(metric: str, options: dict | None = None) -> str:
 
 
 def downsample(frame, label: str, columns=TRACE_COLUMNS, max_points=MAX_TRACE_POINTS) -> dict:
-    """Trace for plots: at most ``max_points`` evenly chosen samples per signal (lists of floats)."""
+    """Trace for plots: at most ``max_points`` evenly chosen samples per signal (lists of floats).
+
+    Inside :func:`traces_off` the trace keeps its label and length but no signals.
+    """
     n = len(frame)
+    if not _KEEP_TRACES.get():
+        return {"label": label, "points": 0, "samples": int(n)}
     idx = np.unique(np.linspace(0, n - 1, min(n, max_points)).round().astype(int)) if n else np.array([], int)
     out = {"label": label, "points": int(idx.size), "samples": int(n)}
     for c in columns:
@@ -66,3 +77,13 @@ def downsample(frame, label: str, columns=TRACE_COLUMNS, max_points=MAX_TRACE_PO
             # 7 significant digits: 0.1 um on a metre, 0.1 Pa on 1 MPa - far below plot resolution
             out[c] = [float(f"{v:.7g}") for v in frame[c].to_numpy()[idx]]
     return out
+
+
+@contextmanager
+def traces_off():
+    """Within this block, :func:`downsample` keeps no signals (sweeps: verdicts only, no plots)."""
+    token = _KEEP_TRACES.set(False)
+    try:
+        yield
+    finally:
+        _KEEP_TRACES.reset(token)

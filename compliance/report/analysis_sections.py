@@ -9,7 +9,7 @@ physics added with its fitted parameters). Missing parts are reported as "not ru
 
 from __future__ import annotations
 
-from compliance.report.content import fmt_num, pretty_unit
+from compliance.units.formatting import fmt_num, fmt_value, unit_text as pretty_unit
 from compliance.report.figures_linear import MAP_QUANTITIES
 
 SIGNAL_DISPLAY = {  # signal -> (label, unit shown, scale from SI)
@@ -81,22 +81,33 @@ def linear_section(linear: dict | None, start: int) -> tuple[dict | None, list[d
         rows = [{"name": k, "value": fmt_num(v, 4), "unit": units.get(k, "")} for k, v in params.items()]
         if g.get("Tg_linear") is not None:
             rows.append({"name": "Tg (linear)", "value": fmt_num(g["Tg_linear"], 4), "unit": "s"})
-        gov = {"model": g.get("model", "HYGOV"), "rows": rows,
-               "basis": [{"key": k, "value": _basis_text(v)} for k, v in (g.get("basis") or {}).items()]}
+        gov = {"model": g.get("model", "HYGOV"), "rows": rows, "basis": governor_basis(g.get("basis") or {})}
     notes = list((omap or {}).get("notes") or [])
     ctx = {"maps": maps, "points": points, "bode": bode, "poles": poles, "crosscheck": cross, "governor": gov,
            "notes": notes, "window": (omap or {}).get("window")}
     return ctx, specs
 
 
-def _basis_text(v) -> str:
-    if isinstance(v, float):
-        return fmt_num(v)
-    if isinstance(v, dict):
-        return ", ".join(f"{k} = {_basis_text(x)}" for k, x in v.items())
-    if isinstance(v, list):
-        return ", ".join(_basis_text(x) for x in v)
-    return str(v)
+def governor_basis(b: dict) -> list[str]:
+    """Where the HYGOV figures come from, in sentences (never a raw dict)."""
+    out = []
+    pt = b.get("Tg_point") or {}
+    samples = [v for v in b.get("Tg_nonlinear_samples") or [] if isinstance(v, (int, float))]
+    if samples:
+        where = _mm(pt.get("position")) + (", " + _load(pt.get("load")) + " load" if pt.get("load") is not None else "")
+        out.append(f"Tg is the mean time constant of {len(samples)} nonlinear steps of "
+                   + " and ".join(f"{100 * s:+.0f} %" for s in b.get("Tg_steps") or []) + f" of stroke at {where}: "
+                   + ", ".join(fmt_value(v, "s", 3) for v in samples) + ".")
+    runs = b.get("stroke_runs") or {}
+    if runs:
+        o, c = runs.get("opening") or {}, runs.get("closing") or {}
+        load = runs.get("load")
+        out.append("UO and UC come from closed-loop strokes end to end (reference step, 25\u201375 % of stroke extrapolated)"
+                   + (f" at a {fmt_value(load / 1e3, 'kN', 3)} closing load" if isinstance(load, (int, float)) else "")
+                   + f": opening {fmt_value(o.get('stroke_time'), 's', 3)}, closing {fmt_value(c.get('stroke_time'), 's', 3)}. "
+                   "They differ slightly from the opening and closing times of section 2, which are judged on open-loop "
+                   "full strokes at the governor set-up load.")
+    return out
 
 
 def _ms(v, none="\u2013"):
@@ -137,7 +148,7 @@ def validation_section(val: dict | None, start: int) -> tuple[dict | None, list[
                 series.append(("simulated (after)", aov.get("time"), aov.get("simulated"), "after"))
             fid = f"fig-{start + len(specs)}"
             specs.append({"id": fid, "kind": "waveform", "series": series, "scale": scale, "ylabel": f"{label} [{unit}]",
-                          "windows": [(w["start"], w["end"]) for w in windows if w.get("signal") == sig]})
+                          "windows": _shaded(windows, sig, ov.get("time")), "smooth": sig == "valve_command"})
             figs.append({"id": fid, "signal": label, "role": ov.get("role")})
         fits = [{"signal": SIGNAL_DISPLAY.get(s, (s,))[0], "fit": fmt_num(f.get("fit_percent"), 3),
                  "nrmse": fmt_num(f.get("nrmse"), 3), "rms": _sig(f.get("rms_error"), s), "max": _sig(f.get("max_abs_error"), s),
@@ -146,7 +157,7 @@ def validation_section(val: dict | None, start: int) -> tuple[dict | None, list[
         rows = _window_table(m.get("window_metrics") or [])
         located = [{"signal": SIGNAL_DISPLAY.get(w.get("signal"), (w.get("signal"),))[0], "start": fmt_num(w.get("start"), 4),
                     "end": fmt_num(w.get("end"), 4), "peak_ratio": fmt_num(w.get("peak_ratio"), 3),
-                    "regimes": ", ".join(w.get("dominant") or [])} for w in windows]
+                    "regimes": ", ".join(regime_text(r) for r in w.get("dominant") or [])} for w in windows]
         modes.append({"name": mode, "pass": m.get("pass"), "figures": figs, "fits": fits, "rows": rows, "located": located,
                       "has_after": bool(after)})
     added = []
@@ -156,10 +167,73 @@ def validation_section(val: dict | None, start: int) -> tuple[dict | None, list[
                                   "bounds": " .. ".join(fmt_num(b, 3) for b in (p.get("bounds") or []))}
                                  for p in eff.get("params") or []]})
     rec = val.get("recording") or {}
-    ctx = {"recording": rec, "plant": val.get("plant") or {}, "conditions": val.get("conditions") or {},
+    ctx = {"finding": diagnosis_finding(diag) if diag else None, "recording": rec, "plant": val.get("plant") or {}, "conditions": val.get("conditions") or {},
            "modes": modes, "added": added, "diagnosis": bool(diag), "explanation": diag.get("explanation"),
            "warnings": val.get("warnings") or [], "pass": (val.get("summary") or {}).get("pass")}
     return ctx, specs
+
+
+_REGIME_TEXT = {"a_choked": "choked flow into chamber A", "a_subsonic": "subsonic flow into chamber A",
+                "b_choked": "choked flow into chamber B", "b_subsonic": "subsonic flow into chamber B",
+                "valve_dead_band": "valve in its dead band", "valve_saturated": "valve fully open",
+                "command_at_limit": "command at its limit", "region_closed": "near the closed end",
+                "region_low": "low stroke", "region_mid": "mid stroke", "region_high": "high stroke"}
+
+
+def regime_text(name) -> str:
+    """A regime of compliance.validation.regimes in words (``b_choked`` -> ``choked flow into chamber B``)."""
+    return _REGIME_TEXT.get(str(name), str(name).replace("_", " "))
+
+
+VERDICT_TEXT = {"missing_physics": "MISSING PHYSICS FOUND", "parameters_only": "PARAMETERS ONLY",
+                "no_mismatch": "NO MISMATCH", "unexplained": "UNEXPLAINED"}
+NEXT_STEP = {
+    "missing_physics": "Add the effect with the fitted parameters to the configuration (govcheck diagnose --save-model), "
+                       "then re-run govcheck check on the fitted model.",
+    "parameters_only": "Recalibrate the named parameters (govcheck diagnose --save-model) and re-run govcheck check.",
+    "no_mismatch": "None: the model reproduces the recording within its noise floor.",
+    "unexplained": "No declared effect explains the mismatch: record a test that separates the candidates "
+                   "(e.g. slow ramps at several supply pressures for friction and leakage, steps of several sizes for "
+                   "valve dynamics) and diagnose again.",
+}
+
+
+def diagnosis_finding(diag: dict) -> dict:
+    """The finding of a diagnosis for the top of its report: verdict, effect, parameters with uncertainty, next step."""
+    verdict = diag.get("verdict")
+    ranked = diag.get("effects_ranked") or []
+    winner = ranked[0] if ranked else None
+    for e in ranked:
+        if e.get("name") == diag.get("winner"):
+            winner = e
+    params = []
+    for p in (winner or {}).get("parameters") or []:
+        u = p.get("unit") or ""
+        se = p.get("stderr")
+        val = fmt_num(p.get("value"), 3)
+        params.append({"name": p.get("name"), "text": f"{val} \u00b1 {fmt_num(se, 2)} {pretty_unit(u)}".strip()
+                       if se is not None else f"{val} {pretty_unit(u)}".strip(), "meaning": p.get("meaning") or ""})
+    runner = ranked[1] if len(ranked) > 1 else None
+    step = NEXT_STEP.get(verdict, "")
+    if runner is not None and runner.get("delta_bic") is not None and winner is not None and verdict in NEXT_STEP:
+        gap = (runner.get("delta_bic") or 0.0) - (winner.get("delta_bic") or 0.0)
+        if 0 <= gap < 10:  # BIC difference under 10: the data do not decide between the two
+            step = (f"Ambiguous between {winner.get('name')} and {runner.get('name')} (BIC differs by {gap:.1f}, under 10): "
+                    "run a test that separates them before changing the model. " + step)
+    return {"verdict": verdict, "word": VERDICT_TEXT.get(verdict, str(verdict or "\u2013").upper()),
+            "effect": (winner or {}).get("name") if verdict in ("missing_physics", "parameters_only") else None,
+            "params": params if verdict in ("missing_physics", "parameters_only") else [],
+            "explanation": diag.get("explanation"), "next": step}
+
+
+def _shaded(windows: list, sig: str, time) -> list:
+    """The located mismatch windows worth shading on a plot: the three strongest, none longer than 40 % of the record."""
+    span = (max(time) - min(time)) if time else None
+    ws = [w for w in windows if w.get("signal") == sig and w.get("start") is not None and w.get("end") is not None]
+    if span:
+        ws = [w for w in ws if (w["end"] - w["start"]) <= 0.4 * span]
+    ws.sort(key=lambda w: -(w.get("peak_ratio") or 0.0))
+    return [(w["start"], w["end"]) for w in ws[:3]]
 
 
 def _window_table(metrics: list) -> dict:

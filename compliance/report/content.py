@@ -8,19 +8,14 @@ text by the jinja2 templates.
 
 from __future__ import annotations
 
-import datetime as _dt
 import hashlib
-import math
 import shlex
 
 from compliance.errors import InputError
-from compliance.metrics import METRICS
+from compliance.report.requirement_pages import TOLERANCE_METRICS, limit_text, metric_text, reader_text
+from compliance.units.formatting import fmt_margin_pct, fmt_num, unit_text
 
 RESULTS_SCHEMA = "govcheck-results/1"
-STATUS_WORD = {"pass": "PASS", "fail": "FAIL", "not_evaluated": "NOT EVALUATED", "open": "OPEN",
-               "disabled": "DISABLED", "incomplete": "INCOMPLETE"}
-# metrics whose limit is a position tolerance drawn as the error band on the run's plot
-TOLERANCE_METRICS = ("max_positioning_error", "tracking_max_error", "steady_state_error")
 SOURCES = ("paper", "assumed", "derived", "user")
 
 _REQUIRED = {
@@ -73,70 +68,24 @@ def check_results(results, where: str = "results") -> None:
 
 
 # --------------------------------------------------------------------------- formatting
-_SUPERSCRIPT = str.maketrans("-0123456789", "\u207b\u2070\u00b9\u00b2\u00b3\u2074\u2075\u2076\u2077\u2078\u2079")
-
-
-def fmt_num(v, digits: int = 4) -> str:
-    """A float for a table: 4 significant digits, plain notation where reasonable."""
-    if v is None:
-        return "\u2013"
-    if isinstance(v, bool):
-        return "yes" if v else "no"
-    if not isinstance(v, (int, float)):
-        return str(v)
-    if not math.isfinite(v):
-        return "\u2013"
-    if v == 0:
-        return "0"
-    a = abs(v)
-    if 1e-3 <= a < 10**digits:
-        s = f"{v:.{digits}g}"
-    elif 10**digits <= a < 1e7:
-        s = f"{v:.0f}"  # 800000 Pa, 12000 N: whole numbers read better than mantissas
-    else:
-        m, e = f"{v:.{digits - 1}e}".split("e")
-        mant = m.rstrip("0").rstrip(".") if "." in m else m
-        s = f"{mant}\u00d710{str(int(e)).translate(_SUPERSCRIPT)}"
-    return s.replace("-", "\u2212")
-
+# the one formatter and status-word table live in compliance/units/formatting.py
 
 def fmt_metric(value, metric: str) -> str:
-    """A SI value of ``metric`` in its display unit (``0.0016`` m -> ``1.6 mm``)."""
-    if value is None:
-        return "\u2013"
-    info = METRICS.get(metric)
-    if info is None:
-        return fmt_num(value)
-    unit = info.display_unit
-    return f"{fmt_num(value * info.display_scale, 3)} {unit}".strip()
+    """A SI value of ``metric`` in its display unit (``0.0016`` m -> ``1.60 mm``)."""
+    return metric_text(value, metric)
 
 
-_UNIT_PRETTY = (("Pa^0.5", "\u221aPa"), ("^3", "\u00b3"), ("^2", "\u00b2"), ("*", "\u00b7"))
-
-
-def pretty_unit(unit: str) -> str:
-    """``m^3/(s*Pa)`` -> ``m³/(s·Pa)``; ``""`` -> ``–`` (dimensionless)."""
-    if not unit:
-        return "\u2013"
-    if unit == "number":
-        return "(see meaning)"
-    for a, b in _UNIT_PRETTY:
-        unit = unit.replace(a, b)
-    return unit
-
-
-def fmt_date(iso: str | None) -> str:
-    """ISO time stamp -> ``2026-05-10 12:00 UTC``."""
-    if not iso:
-        return "\u2013"
-    try:
-        d = _dt.datetime.fromisoformat(str(iso))
-    except ValueError:
-        return str(iso)
-    if d.tzinfo is not None:
-        d = d.astimezone(_dt.timezone.utc)
-        return d.strftime("%Y-%m-%d %H:%M UTC")
-    return d.strftime("%Y-%m-%d %H:%M")
+def setting_text(v) -> str:
+    """A procedure setting as a reader reads it: units typeset, yes/no, lists joined."""
+    if isinstance(v, bool):
+        return "yes" if v else "no"
+    if isinstance(v, str):
+        return unit_text(v)
+    if isinstance(v, (list, tuple)):
+        return ", ".join(setting_text(x) for x in v)
+    if isinstance(v, (int, float)):
+        return fmt_num(v)
+    return str(v)
 
 
 def status_class(status: str | None) -> str:
@@ -144,20 +93,14 @@ def status_class(status: str | None) -> str:
     return {"pass": "pass", "fail": "fail", "incomplete": "warn", "not_evaluated": "warn"}.get(status or "", "neutral")
 
 
-def status_word(status: str | None) -> str:
-    """Upper-case word of a status."""
-    return STATUS_WORD.get(status or "", str(status or "\u2013").upper())
-
-
 # --------------------------------------------------------------------------- sections
 def _display(row: dict, metric: str) -> dict:
-    d = dict(row.get("display") or {})
-    d.setdefault("value", fmt_metric(row.get("value"), metric))
-    if not d.get("limit") and row.get("limit"):
+    """Value, limit and margin of a verdict row, formatted from the SI numbers (one source per figure)."""
+    d = {"value": fmt_metric(row.get("value"), metric)}
+    if row.get("limit"):
         d["limit"] = " .. ".join(fmt_metric(v, metric) for v in row["limit"])
-    d.setdefault("margin", fmt_metric(row.get("margin"), metric))
-    if d.get("margin_pct") is None and row.get("margin_pct") is not None:
-        d["margin_pct"] = f"{row['margin_pct']:+.1f} %"
+    d["margin"] = fmt_metric(row.get("margin"), metric)
+    d["margin_pct"] = fmt_margin_pct(row.get("margin_pct"))
     return d
 
 
@@ -178,7 +121,7 @@ def summary_rows(results: dict) -> list[dict]:
             "id": e["id"], "title": e["title"], "metric": e["metric"], "severity": e["severity"],
             "source": e.get("source", "simulation"), "standard": e.get("standard"), "clause": e.get("clause"),
             "limit_text": e["limit_text"],
-            "limit": d.get("limit") or ("open" if e.get("limit") is None else (e.get("limit_display") or e["limit_text"])),
+            "limit": limit_text(e),
             "value": d.get("value", "\u2013"), "margin": d.get("margin", "\u2013") if w.get("margin") is not None else "\u2013",
             "margin_pct": d.get("margin_pct"), "status": e["status"], "where": where, "which": w.get("which"),
             "procedure": w.get("procedure"), "operating_point": w.get("operating_point"), "reason": reason,
@@ -232,12 +175,14 @@ def valve_marks(results: dict) -> dict:
         out["saturation_voltage"] = p["valve.saturation_voltage"]
     if p.get("valve.dead_zone_positive") or p.get("valve.dead_zone_negative"):
         out["dead_zone"] = [p.get("valve.dead_zone_positive") or 0.0, p.get("valve.dead_zone_negative") or 0.0]
+    if p.get("valve.centre_voltage"):
+        out["centre_voltage"] = p["valve.centre_voltage"]
     if p.get("valve.command_limit"):
         out["command_limit"] = p["valve.command_limit"]
     return out
 
 
-def procedure_sections(results: dict) -> tuple[list[dict], list[dict]]:
+def procedure_sections(results: dict, start: int = 1) -> tuple[list[dict], list[dict]]:
     """Runs grouped by procedure (in the requirement set's order) and the figure specs.
 
     Returns
@@ -264,7 +209,7 @@ def procedure_sections(results: dict) -> tuple[list[dict], list[dict]]:
             figs = []
             tol = _tolerance(results, run["id"])
             for j, tr in enumerate(run.get("traces") or []):
-                fid = f"fig-{len(specs) + 1}"
+                fid = f"fig-{start + len(specs)}"
                 specs.append({"id": fid, "kind": "trace", "trace": tr, "marks": run.get("marks") or [],
                               "run_kind": run["kind"], "tolerance": tol})
                 figs.append({"id": fid, "label": tr.get("label") or run["id"], "points": tr.get("points"),
@@ -297,8 +242,8 @@ def parameter_rows(results: dict) -> list[dict]:
     rows = []
     for p in sorted(results["plant"]["parameters"], key=lambda q: str(q.get("key"))):
         src = p.get("source") or "\u2013"
-        rows.append({"key": p.get("key"), "value": fmt_num(p.get("value"), 6), "unit": pretty_unit(p.get("unit", "")),
-                     "meaning": p.get("meaning") or "", "source": src, "source_class": src if src in SOURCES else "other"})
+        rows.append({"key": p.get("key"), "value": fmt_num(p.get("value"), 6), "unit": unit_text(p.get("unit", "")) or "\u2013",
+                     "meaning": reader_text(p.get("meaning")), "source": src, "source_class": src if src in SOURCES else "other"})
     return rows
 
 

@@ -73,7 +73,8 @@ def _shade(ax, t0, t1, color, alpha=0.12, label=None):
 
 
 @styled
-def trace_figure(trace: dict, marks: list, kind: str, prefix: str, *, tolerance=None, valve=None) -> str:
+def trace_figure(trace: dict, marks: list, kind: str, prefix: str, *, tolerance=None, valve=None, speed_limit=None,
+                 compact: bool = False) -> str:
     """Four stacked panels of one run, with the metrics measured on it marked.
 
     Parameters
@@ -94,19 +95,30 @@ def trace_figure(trace: dict, marks: list, kind: str, prefix: str, *, tolerance=
     tolerance : float, optional
         Position tolerance to draw as the error band [m] (the positioning requirement).
     valve : dict, optional
-        ``saturation_voltage`` and ``dead_zone`` (pair, [V]) to draw on the command panel.
+        ``saturation_voltage``, ``centre_voltage`` (the valve null) and ``dead_zone`` (pair, [V])
+        to draw on the command panel, around the null.
+    speed_limit : float, optional
+        Speed limit [m/s] of a speed requirement: the second panel then shows the speed with
+        the limit drawn (whatever the procedure).
+    compact : bool or "short"
+        Three panels (no chamber pressures) in a shorter figure: the worst case on a requirement
+        page ("short": shorter still, for a page shared by several requirements).
     """
     label = trace.get("label")
     mk = _marks_of(marks, label) if label is not None else []
     t = _arr(trace, "time")
-    fig, axes = new_figure("trace", 4, 1, sharex=True, gridspec_kw={"height_ratios": [1.5, 1.0, 1.0, 1.0], "hspace": 0.12})
-    ax_x, ax_e, ax_u, ax_p = axes
+    if compact:
+        fig, axes = new_figure("trace_short" if compact == "short" else "trace_compact", 3, 1, sharex=True, gridspec_kw={"height_ratios": [1.5, 1.0, 1.0], "hspace": 0.12})
+        (ax_x, ax_e, ax_u), ax_p = axes, None
+    else:
+        fig, axes = new_figure("trace", 4, 1, sharex=True, gridspec_kw={"height_ratios": [1.5, 1.0, 1.0, 1.0], "hspace": 0.12})
+        ax_x, ax_e, ax_u, ax_p = axes
     if t is None:
         for ax in axes:
             message_axes(ax, "no samples")
         return to_svg(fig, prefix)
     x, r = _arr(trace, "position"), _arr(trace, "reference")
-    closed_loop = kind not in OPEN_LOOP_KINDS and r is not None
+    closed_loop = kind not in OPEN_LOOP_KINDS and r is not None and speed_limit is None
     t_span = (float(t[0]), float(t[-1]))
 
     # ---- panel 1: reference and position [mm]
@@ -139,6 +151,10 @@ def trace_figure(trace: dict, marks: list, kind: str, prefix: str, *, tolerance=
     elif x is not None:
         v = np.gradient(x, t) * MM if t.size > 2 else np.zeros_like(x)
         _plot(ax_e, t, v, color=COLORS["error"], lw=0.9, label="speed")
+        if speed_limit is not None and math.isfinite(speed_limit):
+            for sgn in (-1, 1):
+                ax_e.axhline(sgn * speed_limit * MM, color=COLORS["limit"], lw=0.9, ls=(0, (4, 2)))
+            ax_e.plot([], [], color=COLORS["limit"], lw=0.9, ls=(0, (4, 2)), label=f"limit \u00b1{speed_limit * MM:.3g} mm/s")
         ax_e.set_ylabel("speed [mm/s]")
         _legend(ax_e)
     else:
@@ -149,14 +165,18 @@ def trace_figure(trace: dict, marks: list, kind: str, prefix: str, *, tolerance=
     if u is not None:
         _plot(ax_u, t, u, color=COLORS["command"], lw=0.9, label="valve command")
         if valve:
+            c0 = valve.get("centre_voltage") or 0.0  # the valve null: 0 V for a +/-10 V valve, 5 V for a 0-10 V one
             sat = valve.get("saturation_voltage")
             if sat:
                 for s in (-1, 1):
-                    ax_u.axhline(s * sat, color=COLORS["limit"], lw=0.6, ls=(0, (3, 2)))
-                ax_u.plot([], [], color=COLORS["limit"], lw=0.6, ls=(0, (3, 2)), label=f"full opening \u00b1{sat:.3g} V")
+                    ax_u.axhline(c0 + s * sat, color=COLORS["limit"], lw=0.6, ls=(0, (3, 2)))
+                where = f"{c0:.3g} \u00b1 {sat:.3g} V" if c0 else f"\u00b1{sat:.3g} V"
+                ax_u.plot([], [], color=COLORS["limit"], lw=0.6, ls=(0, (3, 2)), label=f"full opening {where}")
+            if c0:
+                ax_u.axhline(c0, color="#999999", lw=0.6, ls=(0, (1, 1)), zorder=0.5, label=f"valve null {c0:.3g} V")
             dz = valve.get("dead_zone")
             if dz:
-                ax_u.axhspan(-dz[1], dz[0], color="#999999", alpha=0.15, lw=0, label="valve dead zone")
+                ax_u.axhspan(c0 - dz[1], c0 + dz[0], color="#999999", alpha=0.15, lw=0, label="valve dead zone")
         ax_u.set_ylabel("command [V]")
         _legend(ax_u)
     else:
@@ -164,7 +184,10 @@ def trace_figure(trace: dict, marks: list, kind: str, prefix: str, *, tolerance=
 
     # ---- panel 4: chamber pressures [bar abs]
     pa, pb, ps = _arr(trace, "pressure_a"), _arr(trace, "pressure_b"), _arr(trace, "supply_pressure")
-    if pa is not None or pb is not None:
+    last = ax_p if ax_p is not None else ax_u
+    if ax_p is None:
+        pass
+    elif pa is not None or pb is not None:
         if pa is not None:
             _plot(ax_p, t, pa * BAR, color=COLORS["pressure_a"], lw=0.9, label="chamber A")
         if pb is not None:
@@ -175,11 +198,11 @@ def trace_figure(trace: dict, marks: list, kind: str, prefix: str, *, tolerance=
         _legend(ax_p)
     else:
         message_axes(ax_p, "chamber pressures not recorded")
-    ax_p.set_xlabel("time [s]")
-    ax_p.set_xlim(*t_span)
+    last.set_xlabel("time [s]")
+    last.set_xlim(*t_span)
     for ax in axes:
         ax.yaxis.set_label_coords(-0.075, 0.5)  # aligned labels whatever the tick widths
-    fig.subplots_adjust(left=0.1, right=0.985, top=0.955, bottom=0.075)
+    fig.subplots_adjust(left=0.1, right=0.985, top=0.94 if compact else 0.955, bottom=0.1 if compact else 0.075)
     return to_svg(fig, prefix)
 
 
@@ -227,22 +250,37 @@ def _position_marks(ax, mk) -> None:
 
 
 @styled
-def waveform_figure(series: list, prefix: str, *, ylabel: str, windows=(), xlabel="time [s]") -> str:
+def waveform_figure(series: list, prefix: str, *, ylabel: str, windows=(), xlabel="time [s]", smooth: bool = False) -> str:
     """One panel of overlaid signals with shaded windows (model validation).
 
     Parameters
     ----------
     series : list of (label, time [s], values, role)
-        ``role`` in ``recorded``/``before``/``after`` picks the colour.
+        ``role`` in ``recorded``/``before``/``after`` picks the colour. The recording is drawn
+        last and on top (a fitted "after" line that matches it must not hide it).
     windows : iterable of (t0, t1)
         Time windows to shade (located mismatches) [s].
+    smooth : bool
+        Noisy signal (valve command): each series is drawn as a 50 ms moving mean over a faint raw
+        trace, so the command stays readable instead of a band of noise.
     """
     fig, ax = new_figure("validation")
     for i, (t0, t1) in enumerate(windows):
-        _shade(ax, t0, t1, COLORS["limit"], 0.12, "mismatch window" if i == 0 else None)
-    for label, t, y, role in series:
-        ax.plot(t, y, color=COLORS.get(role, None), lw=1.2 if role == "recorded" else 1.0,
-                ls="-" if role != "before" else (0, (4, 2)), label=label)
+        _shade(ax, t0, t1, COLORS["limit"], 0.10, "mismatch window" if i == 0 else None)
+    order = sorted(series, key=lambda s: s[3] == "recorded")  # the recording last: on top
+    for label, t, y, role in order:
+        t, y = np.asarray(t, float), np.asarray(y, float)
+        style = {"recorded": dict(color="#111111", lw=1.3, zorder=4),
+                 "before": dict(color=COLORS.get("before"), lw=1.0, ls=(0, (4, 2)), zorder=2),
+                 "after": dict(color=COLORS.get("after"), lw=1.1, alpha=0.8, zorder=3)}.get(role, dict(lw=1.0))
+        if smooth and t.size > 10:
+            dt = np.median(np.diff(t)) if t.size > 1 else 0.0
+            k = max(1, int(round(0.05 / dt))) if dt > 0 else 1
+            if k > 1:
+                ax.plot(*decimate(t, y), color=style.get("color"), lw=0.4, alpha=0.25, zorder=1)
+                y = np.convolve(np.where(np.isfinite(y), y, 0.0), np.ones(k) / k, mode="same")
+                label = f"{label} (50 ms mean)"
+        ax.plot(*decimate(t, y), label=label, **style)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.legend(loc="best", ncol=2)

@@ -26,8 +26,12 @@ import jinja2
 
 from compliance import __version__
 from compliance.errors import InputError
+from compliance.files.display import display_path
 from compliance.report import content as C
+from compliance.report import signoff as S
 from compliance.report.analysis_sections import linear_section, validation_section
+from compliance.report.requirement_pages import requirement_pages
+from compliance.units.formatting import fmt_date, fmt_num, status_word, unit_text
 
 TEMPLATES = resources.files("compliance.report") / "templates"
 VALIDATION_SCHEMA = "govcheck.validation/1"
@@ -45,7 +49,8 @@ def _draw(spec: dict, valve: dict | None = None) -> str:
         return path_figure(spec["trace"], spec["id"])
     if k == "trace":
         return figures.trace_figure(spec["trace"], spec["marks"], spec["run_kind"], spec["id"],
-                                    tolerance=spec.get("tolerance"), valve=valve)
+                                    tolerance=spec.get("tolerance"), valve=valve, speed_limit=spec.get("speed_limit"),
+                                    compact=spec.get("compact", False))
     if k == "map":
         return figures_linear.map_figure(spec["omap"], spec["name"], spec["id"])
     if k == "bode":
@@ -56,7 +61,8 @@ def _draw(spec: dict, valve: dict | None = None) -> str:
         sc = spec.get("scale", 1.0)
         series = [(lab, t, [float("nan") if v is None else v * sc for v in y], role)
                   for lab, t, y, role in spec["series"] if t is not None and y is not None]
-        return figures.waveform_figure(series, spec["id"], ylabel=spec["ylabel"], windows=spec.get("windows") or ())
+        return figures.waveform_figure(series, spec["id"], ylabel=spec["ylabel"], windows=spec.get("windows") or (),
+                                       smooth=spec.get("smooth", False))
     raise ValueError(f"unknown figure kind {k!r}")
 
 
@@ -111,7 +117,8 @@ def _environment() -> jinja2.Environment:
         trim_blocks=True,
         lstrip_blocks=True,
     )
-    env.filters.update(status_class=C.status_class, status_word=C.status_word, num=C.fmt_num)
+    env.filters.update(status_class=C.status_class, status_word=status_word, num=fmt_num, unit=unit_text,
+                       setting=C.setting_text, words=C.reader_text)
     return env
 
 
@@ -205,14 +212,26 @@ def _common(results: dict) -> dict:
     v.setdefault("matplotlib (report)", matplotlib.__version__)
     v.setdefault("weasyprint (report)", weasyprint.__version__)
     v.setdefault("jinja2 (report)", jinja2.__version__)
-    return {"versions": v, "rendered": C.fmt_date(_now()), "govcheck_version": __version__}
+    return {"versions": v, "rendered": fmt_date(_now()), "govcheck_version": __version__}
 
 
 # --------------------------------------------------------------------------- API
-def build_report(results: dict, workers: int | None = None) -> tuple[dict, dict]:
-    """Check the results and build the template context and the figures (no file written)."""
+APPENDIX_LEVELS = ("none", "summary", "full")
+
+
+def build_report(results: dict, workers: int | None = None, appendix: str = "summary") -> tuple[dict, dict]:
+    """Check the results and build the template context and the figures (no file written).
+
+    ``appendix``: ``none`` (sign-off page, requirement pages, linear and validation sections),
+    ``summary`` (+ configuration, requirement file, command, versions) or ``full`` (+ every run
+    with its figures).
+    """
+    if appendix not in APPENDIX_LEVELS:
+        raise InputError(f"--appendix {appendix}: expected one of {', '.join(APPENDIX_LEVELS)}")
     C.check_results(results)
-    sections, specs = C.procedure_sections(results)
+    pages, specs = requirement_pages(results, 1)
+    sections, run_specs = C.procedure_sections(results, len(specs) + 1) if appendix == "full" else ([], [])
+    specs += run_specs
     lin_ctx, lin_specs = linear_section(results.get("linear"), len(specs) + 1)
     val_ctx, val_specs = validation_section(results.get("validation"), len(specs) + len(lin_specs) + 1)
     svgs = draw_figures(specs + lin_specs + val_specs, C.valve_marks(results), workers)
@@ -220,11 +239,20 @@ def build_report(results: dict, workers: int | None = None) -> tuple[dict, dict]
     ctx = {
         **_common(results),
         "plant": plant,
+        "identity": plant.get("identity") or {},
         "rs": rs,
         "summary": summary,
         "verdict": summary["status"],
-        "created": C.fmt_date(results.get("created")),
+        "created": fmt_date(results.get("created")),
         "rows": C.summary_rows(results),
+        "basis": S.basis(results),
+        "failures": S.failures(results),
+        "not_evaluated": S.not_evaluated(results),
+        "deviations": S.deviations(results),
+        "assumptions": S.assumptions(results),
+        "remedies": results.get("remedies"),
+        "pages": pages,
+        "appendix": appendix,
         "sections": sections,
         "linear": lin_ctx,
         "validation": val_ctx,
@@ -239,7 +267,8 @@ def build_report(results: dict, workers: int | None = None) -> tuple[dict, dict]
     return ctx, svgs
 
 
-def render_report(results: dict, html_path=None, pdf_path=None, *, workers: int | None = None) -> None:
+def render_report(results: dict, html_path=None, pdf_path=None, *, workers: int | None = None,
+                  appendix: str = "summary") -> None:
     """Render the compliance report of a ``govcheck check`` results dict.
 
     Parameters
@@ -252,6 +281,9 @@ def render_report(results: dict, html_path=None, pdf_path=None, *, workers: int 
         Where to write the HTML and the PDF; at least one.
     workers : int, optional
         Processes drawing figures (default: the available cores).
+    appendix : {"none", "summary", "full"}
+        What follows the body: nothing; the configuration, requirement file, command and
+        versions; or also every run with its figures.
 
     Raises
     ------
@@ -264,7 +296,7 @@ def render_report(results: dict, html_path=None, pdf_path=None, *, workers: int 
         _check_target(html_path, "--report")
     if pdf_path:
         _check_target(pdf_path, "--pdf")
-    ctx, svgs = build_report(results, workers)
+    ctx, svgs = build_report(results, workers, appendix)
     _emit("report.html.j2", ctx, svgs, html_path, pdf_path)
 
 
@@ -303,7 +335,9 @@ def render_validation_report(result: dict, html_path, pdf_path=None, *, workers:
     ctx, specs = validation_section(result, 1)
     svgs = draw_figures(specs, None, workers)
     plant = dict(result.get("plant") or {})
+    plant["path"] = display_path(plant.get("path"))  # never an installation's absolute path
+    ctx["recording"] = dict(ctx["recording"], path=display_path(ctx["recording"].get("path")))
     ctx = {**_common({"versions": {"govcheck": (result.get("tool") or {}).get("version", __version__)}}),
            "v": ctx, "plant": plant, "settings": result.get("settings") or {}, "windows": result.get("windows") or [],
-           "created": C.fmt_date(result.get("created"))}
+           "created": fmt_date(result.get("created"))}
     _emit("validation.html.j2", ctx, svgs, html_path, pdf_path)

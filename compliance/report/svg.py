@@ -87,7 +87,7 @@ COLORS = {
 
 # one width for every figure (A4 text width 170 mm); heights from a small fixed set
 WIDTH_IN = 6.7
-HEIGHTS_IN = {"trace": 5.4, "map": 2.9, "bode": 3.6, "validation": 4.2}
+HEIGHTS_IN = {"trace": 5.4, "trace_compact": 3.2, "trace_short": 2.6, "map": 2.9, "bode": 3.6, "validation": 4.2}
 
 # matplotlib names the one font it measured with; viewers without it fall back to a generic sans
 FONT_STACK = "'DejaVu Sans', 'Liberation Sans', Arial, Helvetica, sans-serif"

@@ -25,6 +25,7 @@ from compliance.errors import InputError
 from compliance.report import render as R
 from compliance.report.figures import decimate
 from compliance.report.render import render_report, render_validation_report
+from compliance.report.requirement_pages import requirement_pages
 
 FIXTURE = Path(__file__).resolve().parents[1] / "data" / "results_fixture.json"
 EVIL = "<script>alert(1)</script>"
@@ -67,7 +68,7 @@ def rendered(tmp_path_factory):
     res["requirements"][0]["title"] = 'dead time <img src="x" onerror="alert(2)"> & "quotes"'
     out = tmp_path_factory.mktemp("report")
     html_path, pdf_path = out / "r.html", out / "r.pdf"
-    render_report(res, html_path, pdf_path)
+    render_report(res, html_path, pdf_path, appendix="full")
     return res, html_path, pdf_path
 
 
@@ -80,7 +81,9 @@ def test_html_is_self_contained_with_every_figure_inline(rendered):
     n_traces = sum(len(r["traces"]) for r in res["runs"])
     n_val = sum(len(m["overlays"]) for m in res["validation"]["modes"].values())
     n_lin = 3 + 2  # three maps (time constant, gain and phase margins) + Bode + poles
-    assert doc.tags.count("figure") == n_traces + n_val + n_lin
+    n_pages = len(requirement_pages(res)[1])  # the worst case of each requirement page whose run is in the fixture
+    assert n_pages >= 3
+    assert doc.tags.count("figure") == n_pages + n_traces + n_val + n_lin
     assert doc.tags.count("svg") == doc.tags.count("figure")
     # nothing outside the file: no scheme, no import, no src/href to anything but an in-page anchor
     assert "http:" not in text and "https:" not in text
@@ -160,7 +163,7 @@ def test_pdf_has_pages_verdict_and_every_requirement(rendered):
     # running footer with page numbers and a table of contents with page numbers
     assert f"Page 2 of {len(reader.pages)}" in text
     toc = reader.pages[1].extract_text()
-    assert re.search(r"1\. Summary of requirements[ .]*\d+", toc)
+    assert re.search(r"1\. Summary, deviations and assumptions[ .]*\d+", toc)
 
 
 def _png_stats(path):
@@ -199,6 +202,84 @@ def test_html_renders_in_headless_chromium(rendered, tmp_path):
     shape, std = _png_stats(png)
     assert shape == (2000, 1280)
     assert std > 10.0  # the cover: title, verdict box, tables - not a blank page
+
+
+# --------------------------------------------------------------------------- what a signer reads
+# patterns a careful reader found in earlier reports (issue 15): split words, units set wrong,
+# Python literals, exponents on millimetres, uncapped margins, internal ids in captions
+_BAD_PDF_TEXT = [
+    (r"\bpositionin g\b|\badjustmen t\b|\bperfor mance\b", "a word split across lines"),
+    (r"%stroke", "'%stroke' without a space"),
+    (r"\bDB\b|\bHZ\b", "dB / Hz upper-cased"),
+    (r"\bTrue\b|\bFalse\b|\bNone\b|\{'|'\}|\[\]", "a Python literal"),
+    (r"\de-?\d+ ?(mm|s|N|%)", "an exponent on a value with a unit (1e-06 mm)"),
+    (r"[+\-\u2212](?:[2-9]\d\d|1\d[1-9]|1[1-9]\d|\d{4,})\.\d %", "an uncapped margin (+920.7 %)"),
+    (r"samples plotted", "plotting internals in a caption"),
+    (r"a_subsonic|b_choked|seed 00\d", "internal names"),
+]
+
+
+@pytest.fixture(scope="module")
+def pdf_text(tmp_path_factory):
+    """Pages of the default (appendix summary) PDF of the fixture as text (poppler's pdftotext)."""
+    if shutil.which("pdftotext") is None:
+        pytest.skip("pdftotext not installed (Debian package poppler-utils)")
+    out = tmp_path_factory.mktemp("signoff")
+    res = _results()
+    render_report(res, pdf_path=out / "r.pdf")
+    text = subprocess.run(["pdftotext", "-layout", str(out / "r.pdf"), "-"], capture_output=True, text=True,
+                          check=True, timeout=60).stdout
+    return res, text.split("\f")
+
+
+@pytest.mark.parametrize("pattern, what", _BAD_PDF_TEXT)
+def test_pdf_text_has_no_known_failure_pattern(pdf_text, pattern, what):
+    _, pages = pdf_text
+    for i, page in enumerate(pages, 1):
+        m = re.search(pattern, page)
+        assert m is None, f"page {i}: {what}: ...{page[max(0, m.start() - 60):m.end() + 60]}..."
+
+
+def test_page_one_states_basis_failures_and_not_evaluated(pdf_text):
+    res, pages = pdf_text
+    p1 = " ".join(pages[0].split())
+    assert "simulation, not measurement" in p1 and "Model validation" in p1
+    n_ne = sum(1 for e in res["requirements"] for r in e["rows"] if r["status"] == "not_evaluated")
+    n_cases = sum(len(e["rows"]) for e in res["requirements"])
+    assert f"{n_ne} of {n_cases} test cases" in p1 and "NOT EVALUATED" in p1
+    for rid in res["summary"]["failed"]:
+        assert rid in p1, rid
+    assert "govcheck check --remedies" in p1  # no remedies in the results: says how to get them
+    assert res["plant"]["digest"][:16] in p1.replace(" ", "")
+    assert "Accepted for the plant owner" in p1
+
+
+def test_body_is_at_most_25_pages_and_appendix_levels(pdf_text, tmp_path):
+    _, pages = pdf_text
+    body = next(i for i, p in enumerate(pages) if re.search(r"^\s*Appendix\s*$", p, re.M))
+    validation = body - next(i for i, p in enumerate(pages) if re.search(r"^\s*4\. Model validation\s*$", p, re.M))
+    # plant A's report carries no validation (the fixture adds one to test that section)
+    assert body - validation <= 25, f"body without the validation section has {body - validation} pages"
+    res = _results()
+    render_report(res, pdf_path=tmp_path / "none.pdf", appendix="none")
+    none = subprocess.run(["pdftotext", str(tmp_path / "none.pdf"), "-"], capture_output=True, text=True).stdout
+    assert "Configuration parameters of" not in none and none.count("\f") <= body
+    with pytest.raises(InputError, match="--appendix"):
+        render_report(res, pdf_path=tmp_path / "x.pdf", appendix="all")
+
+
+def test_steps_that_cannot_fail_are_marked_with_coverage():
+    res = _results()
+    pos = next(e for e in res["requirements"] if e["id"] == "IEC61362-POS")
+    row = copy.deepcopy(pos["rows"][0])
+    row["samples"] = [{"label": "step 1 up 1.60 mm", "value": 0.00086, "eligible": True, "reason": None,
+                       "detail": {"size": 0.0016, "x_start": 0.08, "x_final": 0.08074}}]
+    row["limit"] = [0.0016]
+    pos["rows"] = [row]
+    page = next(p for p in requirement_pages(res)[0] if "IEC61362-POS" in p["ids"])
+    case = page["cases"][0]
+    assert case["cannot_fail"]  # tolerance 1.6 mm >= step 1.6 mm: the error cannot exceed it
+    assert "moved 46 % of the step" in case["steps"][0]["text"]  # 0.74 of 1.6 mm
 
 
 # --------------------------------------------------------------------------- validation report
@@ -362,3 +443,18 @@ def regenerate(path: Path = FIXTURE) -> None:  # pragma: no cover - run by hand
 if __name__ == "__main__":  # pragma: no cover
     if "--regenerate" in sys.argv:
         regenerate()
+
+
+def test_diagnosis_finding_states_verdict_parameters_with_errors_and_next_step():
+    from compliance.report.analysis_sections import diagnosis_finding
+
+    diag = {"verdict": "missing_physics", "winner": "valve_dynamics", "explanation": "the valve lags",
+            "effects_ranked": [
+                {"name": "valve_dynamics", "delta_bic": 0.0,
+                 "parameters": [{"name": "valve_dynamics.natural_frequency", "value": 37.8, "stderr": 1.2, "unit": "rad/s"}]},
+                {"name": "internal_leakage", "delta_bic": 4.0, "parameters": []}]}
+    f = diagnosis_finding(diag)
+    assert f["word"] == "MISSING PHYSICS FOUND" and f["effect"] == "valve_dynamics"
+    assert f["params"][0]["text"] == "37.8 ± 1.2 rad/s"
+    # BIC 4 apart: the data do not decide between the two; the report says so and asks for a separating test
+    assert f["next"].startswith("Ambiguous between valve_dynamics and internal_leakage")

@@ -1,0 +1,232 @@
+"""What would make it pass: local sensitivities, the smallest combined change, verified by a campaign.
+
+1. Judge the configuration as it is and, for each adjustable parameter, once more with that
+   parameter moved by ``STEP`` (10 %) of its declared range: finite-difference sensitivities
+   of every mandatory requirement's margin (in % of its limit) to every parameter, from the
+   same simulations the campaign runs.
+2. Linearise the margins and solve for the smallest change from the base (Euclidean, in
+   normalised units u = (value - low) / (high - low)) that lifts every mandatory margin above
+   ``TARGET`` inside the declared box and a trust region (scipy SLSQP).
+3. Judge that candidate; if every mandatory requirement passes, verify it with a full
+   campaign (``run_campaign``, traces and all); else re-linearise there (up to ``iterations``)
+   with a smaller trust region when it did not improve.
+   A requirement the linearised margins cannot bring to the target anywhere in the box (it
+   hardly moves with any parameter) is set aside for the step, so the search still fixes
+   the others; it is named in the result as out of reach.
+4. If nothing passes, the closest candidate judged and the requirement that binds it are
+   reported: evidence, not a proof, that the declared space holds no pass. Closest = the
+   smallest worst shortfall (to 10 % of its limit), then the smallest sum of shortfalls,
+   then the smallest change.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from compliance.sweep.results import change
+from compliance.sweep.runner import run_candidates, shortfall, total_shortfall
+from compliance.sweep.sampling import from_normalised, to_normalised
+
+__all__ = ["STEP", "TARGET", "binding", "closeness", "find_remedy", "mandatory_margins", "unreachable"]
+
+STEP = 0.1  # finite-difference step, fraction of each declared range
+TARGET = 0.02  # margin (fraction of the limit) the linear step aims for, against the model's curvature
+
+
+def mandatory_margins(row: dict) -> dict:
+    """Mandatory requirement id -> margin as a fraction of its limit (judged ones only)."""
+    return {rid: r["margin_pct"] / 100.0 for rid, r in row["requirements"].items()
+            if r["severity"] == "mandatory" and r["status"] in ("pass", "fail") and r["margin_pct"] is not None}
+
+
+def binding(row: dict) -> tuple[str | None, float | None]:
+    """The mandatory requirement with the smallest margin % and that margin."""
+    m = mandatory_margins(row)
+    if not m:
+        return None, None
+    rid = min(m, key=m.get)
+    return rid, 100.0 * m[rid]
+
+
+def _sensitivities(adjust, u0, row0, probe_rows, steps):
+    m0 = mandatory_margins(row0)
+    ids = sorted(m0)
+    J = np.zeros((len(ids), len(adjust)))
+    for k, (row, du) in enumerate(zip(probe_rows, steps)):
+        mk = mandatory_margins(row) if row["status"] not in ("invalid", "failed") else {}
+        for r, rid in enumerate(ids):
+            if rid in mk and du != 0.0:
+                J[r, k] = (mk[rid] - m0[rid]) / du
+    return ids, np.array([m0[i] for i in ids]), J
+
+
+def _probes(adjust, u0):
+    us, steps = [], []
+    for k in range(len(adjust)):
+        du = STEP if u0[k] + STEP <= 1.0 else -STEP
+        u = u0.copy()
+        u[k] = u0[k] + du
+        us.append(u)
+        steps.append(du)
+    return us, steps
+
+
+def unreachable(u0, m0, J) -> np.ndarray:
+    """Rows whose linearised margin stays below TARGET everywhere in the box [0, 1]."""
+    best = m0 + np.sum(np.maximum(J * (0.0 - u0), J * (1.0 - u0)), axis=1)
+    return best < TARGET
+
+
+def _least_change(ubase, u0, m0, J, radius):
+    """min ||u - ubase||^2 s.t. m0 + J (u - u0) >= TARGET (reachable rows), 0 <= u <= 1, |u - u0| <= radius."""
+    from scipy.optimize import minimize
+
+    keep = ~unreachable(u0, m0, J)
+    m0, J = m0[keep], J[keep]
+    lo = np.maximum(0.0, u0 - radius)
+    hi = np.minimum(1.0, u0 + radius)
+    cons = [{"type": "ineq", "fun": lambda u: m0 + J @ (u - u0) - TARGET, "jac": lambda u: J}] if len(m0) else []
+    res = minimize(lambda u: float(np.sum((u - ubase) ** 2)), np.clip(u0, lo, hi), jac=lambda u: 2 * (u - ubase),
+                   bounds=list(zip(lo, hi)), constraints=cons, method="SLSQP", options={"maxiter": 200})
+    if res.success or not len(m0):
+        return res.x
+    # not reachable inside the trust region: go as far as it allows toward the worst reachable margin
+    g = J[int(np.argmin(m0))]
+    return np.clip(u0 + radius * np.sign(g), lo, hi)
+
+
+def closeness(row: dict, values: dict, adjust, start: dict) -> tuple:
+    """Ranking key of a failing candidate (smaller is closer to passing)."""
+    worst = shortfall(row)
+    if not math.isfinite(worst):
+        return (math.inf, math.inf, math.inf)
+    return (round(worst, 1), total_shortfall(row), change(adjust, start, values))
+
+
+def _sensitivity_table(adjust, ids, m0, J, failed):
+    out = []
+    for r, rid in enumerate(ids):
+        if rid not in failed:
+            continue
+        by = [{"path": a.param.path, "unit": a.param.unit, "step": STEP * a.span,
+               "delta_margin_pct": float(100.0 * J[r, k] * STEP)} for k, a in enumerate(adjust)]
+        by.sort(key=lambda d: -abs(d["delta_margin_pct"]))
+        out.append({"requirement": rid, "margin_pct": float(100.0 * m0[r]), "by_parameter": by})
+    return out
+
+
+def _describe(adjust, base, values, row, index=None) -> dict:
+    rid, marg = binding(row)
+    return {
+        "values": {k: float(v) for k, v in values.items()},
+        "changes": [{"path": a.param.path, "unit": a.param.unit, "from": float(base[a.param.path]),
+                     "to": float(values[a.param.path])} for a in adjust
+                    if abs(values[a.param.path] - base[a.param.path]) > 1e-6 * a.span],  # unchanged to round-off
+        "change": change(adjust, base, values),
+        "status": row["status"],
+        "shortfall_pct": 100.0 * shortfall(row) if math.isfinite(shortfall(row)) else None,
+        "binding": rid,
+        "binding_margin_pct": marg,
+        "failed_mandatory": sorted(k for k, r in row["requirements"].items()
+                                   if r["severity"] == "mandatory" and r["status"] == "fail"),
+    }
+
+
+def _clamped_base(adjust, base):
+    return {a.param.path: float(min(max(base[a.param.path], a.low), a.high)) for a in adjust}
+
+
+def find_remedy(ctx, adjust, base: dict, *, verify, iterations: int = 4, seeds=(), run_kw=None) -> dict:
+    """Sensitivities and the smallest verified change that passes every mandatory requirement.
+
+    Parameters
+    ----------
+    ctx : compliance.sweep.evaluate.Context
+    adjust : tuple of Adjustable
+    base : dict
+        path -> SI value of the configuration as it is (clamped into the declared box).
+    verify : callable
+        settings dict -> results dict of a full campaign of the changed configuration.
+    iterations : int
+        Re-linearisations after the first step.
+    seeds : list of (settings, row)
+        Candidates already judged (a sweep's samples): the search may start from the closest.
+    run_kw : dict
+        Passed to :func:`~compliance.sweep.runner.run_candidates` (scheduler, workers, progress, client).
+
+    Returns
+    -------
+    dict
+        The ``remedies`` section of the results (docs/results-schema.md).
+    """
+    run_kw = dict(run_kw or {})
+    run_kw.setdefault("label", "remedies")
+    start = _clamped_base(adjust, base)
+    ubase = to_normalised(adjust, start)
+    (row0,), _ = run_candidates(ctx, [start], **run_kw)
+    judged = [(start, row0)] + list(seeds)
+    space = [{"path": a.param.path, "unit": a.param.unit, "low": a.low, "high": a.high, "base": float(base[a.param.path])}
+             for a in adjust]
+    out = {"status": "already_passes", "space": space, "failed": [], "sensitivities": [], "out_of_reach": [],
+           "remedy": None, "closest": None, "evaluated": 1 + len(seeds), "note": ""}
+    if row0["status"] == "pass":
+        out["note"] = "every mandatory requirement passes as configured: nothing to change"
+        return out
+    out["failed"] = sorted(k for k, r in row0["requirements"].items() if r["severity"] == "mandatory" and r["status"] != "pass"
+                           and r["status"] not in ("open", "disabled"))
+
+    def key(t):
+        return closeness(t[1], t[0], adjust, start)
+
+    u0 = ubase
+    ids, m0, J = _linearise(ctx, adjust, u0, row0, run_kw, judged, out)
+    out["sensitivities"] = _sensitivity_table(adjust, ids, m0, J, set(out["failed"]))
+    out["out_of_reach"] = [rid for rid, bad in zip(ids, unreachable(u0, m0, J)) if bad]
+    cur, cur_row = min([(start, row0)] + list(seeds), key=key)
+    radius = 0.5
+    for it in range(iterations + 1):
+        if it or cur is not start:  # at the base the probes are the sensitivities above
+            u0 = to_normalised(adjust, cur)
+            ids, m0, J = _linearise(ctx, adjust, u0, cur_row, run_kw, judged, out)
+        u_new = _least_change(ubase, u0, m0, J, radius) if ids else u0
+        cand = from_normalised(adjust, u_new)
+        (row,), _ = run_candidates(ctx, [cand], **run_kw)
+        out["evaluated"] += 1
+        judged.append((cand, row))
+        if row["status"] == "pass":
+            results = verify(cand)
+            remedy = _describe(adjust, start, cand, row)
+            remedy["verified"] = {"status": results["summary"]["status"],
+                                  "failed_mandatory": results["summary"]["failed_mandatory"]}
+            if results["summary"]["status"] == "pass":
+                out.update(status="found", remedy=remedy,
+                           note=f"verified by a full campaign of the changed configuration ({len(results['runs'])} runs)")
+                return out
+        if key((cand, row)) < key((cur, cur_row)):
+            cur, cur_row = cand, row
+        else:
+            radius *= 0.5
+    return _none_found(out, adjust, start, min(judged, key=key))
+
+
+def _linearise(ctx, adjust, u0, row, run_kw, judged, out):
+    """Judge the probes around ``u0``; finite-difference margins (ids, m0, J). Appends to ``judged``."""
+    us, steps = _probes(adjust, u0)
+    settings = [from_normalised(adjust, u) for u in us]
+    probe_rows, _ = run_candidates(ctx, settings, **run_kw)
+    out["evaluated"] += len(us)
+    judged += list(zip(settings, probe_rows))
+    return _sensitivities(adjust, u0, row, probe_rows, steps)
+
+
+def _none_found(out, adjust, start, closest):
+    out.update(status="none_found", closest=_describe(adjust, start, *closest))
+    rid = out["closest"]["binding"]
+    reach = (f" Out of reach of every declared parameter by the local sensitivities: {', '.join(out['out_of_reach'])}."
+             if out["out_of_reach"] else "")
+    out["note"] = (f"no candidate of the {out['evaluated']} judged in the declared space passes every mandatory requirement; "
+                   f"the closest is stopped by {rid} ({out['closest']['binding_margin_pct']:+.1f} % of its limit).{reach} "
+                   "This is the evidence of a search, not a proof that no pass exists.")
+    return out

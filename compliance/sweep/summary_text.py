@@ -1,0 +1,82 @@
+"""Plain-text (Markdown) summaries of a sweep, a remedies search and a yield run, for people and CI logs."""
+
+from __future__ import annotations
+
+__all__ = ["remedies_markdown", "summary_markdown", "yield_markdown"]
+
+
+def _g(v) -> str:
+    return "-" if v is None else f"{v:.4g}"
+
+
+def _pct(v) -> str:
+    return "-" if v is None else f"{v:+.1f} %"
+
+
+def remedies_markdown(rem: dict) -> str:
+    """The remedies section: status, sensitivities of each failed requirement, the change or the closest candidate."""
+    lines = ["## What would make it pass", "", rem.get("note", ""), ""]
+    for s in rem.get("sensitivities", []):
+        lines.append(f"- **{s['requirement']}** (margin {_pct(s['margin_pct'])}) moves with, per 10 % of each range:")
+        for b in s["by_parameter"][:4]:
+            lines.append(f"  - {b['path']} +{_g(b['step'])} {b['unit']}: {_pct(b['delta_margin_pct'])} points")
+    pick = rem.get("remedy") or rem.get("closest")
+    if pick:
+        title = "Smallest verified change" if rem.get("remedy") else "Closest candidate (does not pass)"
+        lines += ["", f"**{title}** (normalised change {pick['change']:.3f}; binding {pick['binding']} "
+                      f"{_pct(pick['binding_margin_pct'])}):", ""]
+        lines += ["| parameter | from | to | unit |", "|---|---|---|---|"]
+        lines += [f"| {c['path']} | {_g(c['from'])} | {_g(c['to'])} | {c['unit']} |" for c in pick["changes"]]
+        if pick.get("failed_mandatory"):
+            lines.append(f"\nStill failing: {', '.join(pick['failed_mandatory'])}")
+    return "\n".join(lines) + "\n"
+
+
+def summary_markdown(s: dict) -> str:
+    """The sweep summary as Markdown."""
+    ex = s.get("executor") or {}
+    lines = [f"# Sweep {s['name']}: {s['title']}", "",
+             f"- file: `{s['sweep_file']}`; method {s['method']} (seed {s['seed']}); {s['candidates']} candidates",
+             f"- **{s['passing']} of {s['candidates']} pass** every mandatory requirement; by status: "
+             + ", ".join(f"{k} {v}" for k, v in sorted(s["counts"].items())),
+             f"- executor: {ex.get('backend')} x {ex.get('workers')}; done {ex.get('done')}, failed {ex.get('failed')}, "
+             f"retried {ex.get('retried')} (tasks); wall {s['wall']:.0f} s", ""]
+    par = s["pareto"]
+    if len(par["requirements"]) == 2:
+        a, b = par["requirements"]
+        lines += [f"## Pareto front of the two tightest requirements: {a} x {b}", "",
+                  f"| candidate | status | {a} margin | {b} margin | change |", "|---|---|---|---|---|"]
+        lines += [f"| {c['candidate']} | {c['status']} | {_pct(c[a + '.margin_pct'])} | {_pct(c[b + '.margin_pct'])} | "
+                  f"{c['change']:.3f} |" for c in par["candidates"]]
+        lines.append("")
+    b = s.get("best")
+    if b:
+        lines += [f"## Best candidate: #{b['candidate']} ({b['status']}; full campaign: {b['verified_status']})", "",
+                  "| parameter | value | unit | base |", "|---|---|---|---|"]
+        for p in s["parameters"]:
+            lines.append(f"| {p['path']} | {_g(b['values'][p['path']])} | {p['unit']} | {_g(p['base'])} |")
+        if b["failed_mandatory"]:
+            lines.append(f"\nStill failing: {', '.join(b['failed_mandatory'])}")
+        lines.append(f"\nFull results: `{b['results_file']}` (`govcheck report` renders it)\n")
+    if s.get("remedies"):
+        lines.append(remedies_markdown(s["remedies"]))
+    return "\n".join(lines) + "\n"
+
+
+def yield_markdown(y: dict) -> str:
+    """The yield summary as Markdown."""
+    a = y["all_mandatory"]
+    conf = int(round(100 * y["confidence"]))
+    lines = [f"# Tolerance yield of {y['name']} candidate '{y['label']}'", "",
+             f"- {y['units']} units (seed {y['seed']}); {y['valid']} valid, {y['invalid']} invalid draws, "
+             f"{y['failed_tasks']} lost",
+             f"- **all mandatory requirements: {a['pass']} / {y['valid']} = {100 * (a['fraction'] or 0):.1f} %** "
+             f"({conf} % CI {100 * a['ci'][0]:.1f} - {100 * a['ci'][1]:.1f} %)", "",
+             "| requirement | severity | pass | yield | CI | median margin |", "|---|---|---|---|---|---|"]
+    for r in y["requirements"]:
+        f = "-" if r["fraction"] is None else f"{100 * r['fraction']:.1f} %"
+        lines.append(f"| {r['requirement']} | {r['severity']} | {r['pass']}/{r['units']} | {f} | "
+                     f"{100 * r['ci'][0]:.1f} - {100 * r['ci'][1]:.1f} % | {_pct(r['margin_pct_median'])} |")
+    lines += ["", "Drivers (Spearman rank correlation with the worst mandatory margin):", ""]
+    lines += [f"- {d['path']}: {_g(d['worst_margin'])}" for d in y["drivers"]]
+    return "\n".join(lines) + "\n"

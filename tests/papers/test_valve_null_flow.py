@@ -1,0 +1,74 @@
+"""The valve's null flow (effect valve_null_flow) moves the steady error the way its physics says."""
+
+from __future__ import annotations
+
+import pytest
+from scipy.optimize import brentq
+
+from compliance.metrics import find_steps, step_response
+from compliance.model.config import load_plant
+from compliance.model.dead_zone_stall import stall_error
+from compliance.physics.valve_flow import iso6358_mass_flow
+from compliance.physics.valve_opening import land_leak_openings, valve_openings
+from compliance.simulation import Scenario, simulate
+from compliance.simulation.profiles import steps
+
+
+def _steady_errors(cfg):
+    """Steady errors of a 5 % step up then down at mid-stroke, no load, K_D = 20 [m]."""
+    df = simulate(cfg, Scenario(duration=6.5, initial_position=0.08, reference=steps("5%@0.5s,-5%@3.5s", 0.08, 0.16)))
+    t = df.time.to_numpy()
+    return [step_response(t, df.position_true.to_numpy(), ev).steady_state_error
+            for ev in find_steps(t, df.reference.to_numpy())]
+
+
+def _with_null_flow(opening, width=0.3):
+    return load_plant("plant-a").replace(effects={"valve_null_flow": {"null_opening": opening, "null_width": width}})
+
+
+def test_zero_flow_at_null_leaves_the_stall_band():
+    """Ideal dead zone: the compensated valve shuts once |e| < zmd*lc/((zmd + lc)*K_P) (0.86 mm up, 0.90 mm down)
+    and nothing moves the servo after that; 0.1 mm allows the coast after the valve shuts."""
+    cfg = load_plant("plant-a")
+    up, down = _steady_errors(cfg)
+    assert up == pytest.approx(stall_error(cfg, "opening"), abs=0.1e-3)
+    assert down == pytest.approx(stall_error(cfg, "closing"), abs=0.1e-3)
+
+
+def test_finite_null_flow_shrinks_the_steady_error_monotonically():
+    """Leaking lands keep a pressure gain inside the dead zone: the loop stays stiff and pushes on. More leak,
+    smaller error; 0.5 % leak with 0.3 V width brings both errors below a quarter of the stall band."""
+    band = stall_error(load_plant("plant-a"), "opening")
+    errs = [max(_steady_errors(_with_null_flow(a))) for a in (0.002, 0.005, 0.01)]
+    assert errs[0] > errs[1] > errs[2]
+    assert errs[1] < 0.25 * band
+
+
+def _port_pressure(u, opening, width, ps=8.0e5, patm=1.013e5, c=2.33e-8):
+    """Steady pressure of a blocked port A: inflow P->A equals outflow A->T (ISO 6358, seed 000 eq. 1)."""
+    dz_pa, dz_at, _, _ = valve_openings(u, 0.61, 0.69, 1.0, 1.0, 4.0)
+    l_pa, l_at, _, _ = land_leak_openings(u, opening, width)
+
+    def net(p):
+        q_in = iso6358_mass_flow(1.0, c * (dz_pa + l_pa), ps, p, 293.15, 0.528, 1.204, 293.15)
+        q_out = iso6358_mass_flow(1.0, c * (dz_at + l_at), p, patm, 293.15, 0.528, 1.204, 293.15)
+        return q_in - q_out
+
+    lo, hi = patm * 1.0001, ps * 0.9999
+    if net(hi) >= 0.0:  # the exhaust land is covered: the port fills to supply
+        return ps
+    if net(lo) <= 0.0:
+        return patm
+    return brentq(net, lo, hi)
+
+
+def test_null_flow_gives_a_pressure_gain_at_null():
+    """With leaking lands a blocked port settles between exhaust and supply and follows the command inside the
+    dead zone (finite pressure gain); with the ideal valve every path is shut there (no flow, no gain)."""
+    assert valve_openings(0.3, 0.61, 0.69, 1.0, 1.0, 4.0) == (0.0, 0.0, 0.0, 0.0)
+    p0 = _port_pressure(0.0, 0.005, 0.3)
+    assert 1.013e5 < p0 < 8.0e5
+    gain = (_port_pressure(0.05, 0.005, 0.3) - _port_pressure(-0.05, 0.005, 0.3)) / 0.1
+    assert gain > 1e5  # Pa/V: over 1 bar per volt near null
+    # the swing is set by the width: a covered land stops leaking at |u| = width
+    assert _port_pressure(0.3, 0.005, 0.3) == 8.0e5 and _port_pressure(-0.3, 0.005, 0.3) < 1.1e5

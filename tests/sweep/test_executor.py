@@ -1,0 +1,120 @@
+"""The one executor: local pool and a real Dask LocalCluster give identical sweeps; lost tasks are retried and counted."""
+
+import os
+
+import pandas as pd
+import pytest
+
+from compliance.campaign.executor import map_tasks, parse_scheduler
+from compliance.sweep.run import load_inputs
+from compliance.sweep.evaluate import make_context
+from compliance.sweep.results import table
+from compliance.sweep.runner import run_candidates
+from compliance.sweep.sampling import grid
+from compliance.sweep.spec import load_sweep
+
+from tests.sweep.conftest import sweep_text
+
+
+def _fail_first(marker_dir, item):
+    """Raises on the first attempt of item 3 (a marker file remembers across processes)."""
+    marker = os.path.join(marker_dir, f"seen-{item}")
+    if item == 3 and not os.path.exists(marker):
+        open(marker, "w").close()
+        raise RuntimeError("simulated lost task")
+    return item * item
+
+
+def _die_first(marker_dir, item):
+    """Kills its worker process on the first attempt of item 2 (BrokenProcessPool in the parent)."""
+    marker = os.path.join(marker_dir, f"died-{item}")
+    if item == 2 and not os.path.exists(marker):
+        open(marker, "w").close()
+        os._exit(1)
+    return item + 100
+
+
+@pytest.fixture(scope="module")
+def dask_client():
+    from distributed import Client, LocalCluster
+
+    # in-process workers on the inproc:// transport: nothing leaves this process (loopback only)
+    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address="127.0.0.1:0")
+    client = Client(cluster)
+    yield client
+    client.close()
+    cluster.close()
+
+
+def test_scheduler_addresses():
+    assert parse_scheduler(None) == ("local", None)
+    assert parse_scheduler("local:3") == ("dask-local", 3)
+    assert parse_scheduler("tcp://10.0.0.5:8786") == ("dask", "tcp://10.0.0.5:8786")
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_failed_task_is_retried_and_counted_locally(tmp_path, workers):
+    out, stats = map_tasks(_fail_first, str(tmp_path), list(range(6)), workers=workers, progress=False)
+    assert out == [i * i for i in range(6)]
+    assert (stats.done, stats.failed, stats.retried) == (6, 0, 1)
+
+
+def test_killed_worker_is_retried_and_counted(tmp_path):
+    out, stats = map_tasks(_die_first, str(tmp_path), list(range(5)), workers=2, progress=False)
+    assert out == [i + 100 for i in range(5)]
+    assert stats.failed == 0 and stats.retried >= 1  # the dead worker's task, and any sharing its pool
+
+
+def test_task_failing_every_attempt_is_counted_not_dropped(tmp_path):
+    def always(ctx, item):
+        raise ValueError("broken")
+    out, stats = map_tasks(always, None, [1, 2], workers=1, progress=False, retries=1)
+    assert out == [None, None] and (stats.done, stats.failed, stats.retried) == (0, 2, 2)
+
+
+def test_failed_task_is_retried_on_dask(tmp_path, dask_client):
+    out, stats = map_tasks(_fail_first, str(tmp_path), list(range(6)), client=dask_client, progress=False)
+    assert out == [i * i for i in range(6)]
+    assert (stats.backend, stats.done, stats.retried) == ("dask", 6, 1)
+
+
+def test_small_sweep_local_equals_dask(write_sweep, dask_client):
+    spec = load_sweep(write_sweep(sweep_text()))
+    cfg, reqset = load_inputs(spec)
+    ctx = make_context(cfg, reqset, spec.paths)
+    cands = grid(spec.adjust)
+    assert len(cands) == 8
+    local, st_l = run_candidates(ctx, cands, workers=2, progress=False)
+    remote, st_d = run_candidates(ctx, cands, client=dask_client, progress=False)
+    ids = [r.id for r in ctx.reqset.requirements]
+    a, b = table(cands, local, ids), table(cands, remote, ids)
+    pd.testing.assert_frame_equal(a, b)
+    assert st_l.failed == st_d.failed == 0 and st_l.done == st_d.done >= 2  # every batch done, none lost
+    # physics, not plumbing: a stiffer proportional gain shortens the time constant (static friction
+    # is overcome sooner), so along kp at kd = 10 V*s/m the time constant falls
+    tc = a[a["controller.kd"] == 10.0].sort_values("controller.kp")["TC.value"].dropna().to_numpy()
+    assert len(tc) >= 2 and all(tc[1:] < tc[:-1])
+
+
+@pytest.mark.slow
+def test_killed_dask_worker_process_is_retried_and_counted(tmp_path):
+    # a real LocalCluster of 2 worker processes on 127.0.0.1, started and stopped here (local:2)
+    out, stats = map_tasks(_die_first, str(tmp_path), list(range(5)), scheduler="local:2", progress=False)
+    assert out == [i + 100 for i in range(5)]
+    assert stats.backend == "dask" and stats.failed == 0 and stats.retried >= 1
+
+
+def _square(ctx, item):
+    return item * item
+
+
+def test_progress_is_plain_lines_when_not_a_terminal(monkeypatch, capsys):
+    import compliance.campaign.executor as ex
+
+    monkeypatch.setattr(ex, "_PLAIN_EVERY", 0.0)  # every completion prints (CI logs get one per interval)
+    out, _ = map_tasks(_square, None, [1, 2, 3], workers=1, progress=True, label="candidates")
+    err = capsys.readouterr().err
+    assert out == [1, 4, 9]
+    assert "candidates: 3/3 done" in err and "\r" not in err
+    map_tasks(_square, None, [1, 2, 3], workers=1, progress=False)
+    assert capsys.readouterr().err == ""
