@@ -42,6 +42,16 @@ def register(subparsers):
     return p
 
 
+DASK_SCHEMES = ("tcp", "tls", "inproc", "ucx", "ws", "wss")  # what distributed.comm knows
+
+
+def _check_scheme(kind: str, address) -> None:
+    """A Dask address must name a scheme Dask can connect with (checked before any work or folder)."""
+    if kind == "dask" and str(address).split("://", 1)[0] not in DASK_SCHEMES:
+        raise InputError(f"--scheduler {address}: unknown address scheme; expected one of "
+                         f"{', '.join(s + '://' for s in DASK_SCHEMES)} (e.g. tcp://host:8786) or local:N")
+
+
 def _out_dir(args, spec) -> Path:
     out = Path(args.out) if args.out else Path("reports") / "sweeps" / spec.name
     try:
@@ -101,7 +111,8 @@ def run(args) -> int:
         v = getattr(args, flag)
         if v is not None and v < 1:
             raise InputError(f"--{flag} {v}: expected a positive number")
-    parse_scheduler(args.scheduler)  # a bad address is exit 2 before any work
+    kind, address = parse_scheduler(args.scheduler)  # a bad address is exit 2 before any work
+    _check_scheme(kind, address)
     spec = load_sweep(args.sweep)
     if args.samples:
         spec = replace(spec, samples=args.samples)

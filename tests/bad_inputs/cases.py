@@ -318,3 +318,41 @@ for cid, argv, frag in [
     ("out-reproduce-json-nodir", "reproduce plant-a --json nodir/p.json", "does not exist"),
 ]:
     case(cid, argv, frag)
+# ------------------------------------------------------------------------------------- sweep files
+SWEEP = '''schema = "govcheck-sweep/1"
+name = "tiny"
+title = "catalogue sweep"
+base = "plant.toml"
+requirements = "req.toml"
+
+[search]
+method = "grid"
+
+[adjust."controller.kp"]
+values = ["280 V/m", "300 V/m"]
+'''
+
+
+def sweep(old, new):
+    assert old in SWEEP, old
+    return SWEEP.replace(old, new, 1)
+
+
+SW = "sweep bad-sweep.toml --out out"
+for cid, text, frag in [
+    ("sweep-malformed-toml", "schema = \n", "bad-sweep.toml"),
+    ("sweep-wrong-schema", sweep('"govcheck-sweep/1"', '"govcheck-sweep/7"'), "schema"),
+    ("sweep-unknown-parameter", sweep('"controller.kp"', '"controller.kq"'), "controller.kq"),
+    ("sweep-wrong-unit", sweep('"280 V/m", "300 V/m"', '"280 kg", "300 kg"'), "kg"),
+    ("sweep-empty-values", sweep('values = ["280 V/m", "300 V/m"]', 'values = []'), "empty"),
+    ("sweep-empty-range", sweep('values = ["280 V/m", "300 V/m"]', 'range = ["300 V/m", "280 V/m"]'), "range"),
+    ("sweep-negative-gain", sweep('"280 V/m", "300 V/m"', '"-280 V/m", "300 V/m"'), "admissible"),
+    ("sweep-base-missing", sweep('base = "plant.toml"', 'base = "nothere.toml"'), "nothere.toml"),
+    ("sweep-requirements-missing", sweep('requirements = "req.toml"', 'requirements = "noreq.toml"'), "noreq.toml"),
+    ("sweep-no-adjust", SWEEP.split("[adjust")[0], "adjust"),
+]:
+    case(cid, SW, frag, {"bad-sweep.toml": text})
+case("sweep-missing-file", "sweep nothere-sweep.toml --out out", "nothere-sweep.toml")
+case("sweep-jobs-zero", ["sweep", "bad-sweep.toml", "-j", "0", "--out", "out"], "--jobs", {"bad-sweep.toml": SWEEP})
+case("sweep-bad-scheduler", ["sweep", "bad-sweep.toml", "--scheduler", "ftp://x", "--out", "out"], "scheduler", {"bad-sweep.toml": SWEEP})
+case("sweep-samples-zero", ["sweep", "bad-sweep.toml", "--samples", "0", "--out", "out"], "--samples", {"bad-sweep.toml": SWEEP})
