@@ -33,6 +33,12 @@ def case(id, argv, fragment, files=None, code=2, env=None):
     CASES.append(Case(id, files or {}, argv.split() if isinstance(argv, str) else argv, fragment, code, env or {}))
 
 
+def file_cases(argv, name, rows):
+    """One case per ``(id, text of the file NAME, fragment)`` row, all run with ``argv``."""
+    for cid, text, frag in rows:
+        case(cid, argv, frag, {name: text})
+
+
 def plant(old, new):
     """Plant A with one line changed (the old text must be there)."""
     assert old in W.PLANT_A, old
@@ -76,7 +82,7 @@ def drop(name):
 
 # ------------------------------------------------------------------------------------- configs
 CHECK = "check bad.toml -r req.toml --json out/r.json -q"
-for cid, text, frag in [
+file_cases(CHECK, "bad.toml", [
     ("config-malformed-toml", "name = 'x\n[cylinder\n", "bad.toml"),
     ("config-empty", "", "bad.toml"),
     ("config-not-utf8", b"\xff\xfe\x00bad", "bad.toml"),
@@ -101,8 +107,7 @@ for cid, text, frag in [
     ("config-step-too-large", plant('step = { value = "1 ms"', 'step = { value = "1 s"'), "step"),
     ("config-conductance-unit", plant('"0.440 dm^3/(s*bar)"', '"0.440 bar"'), "opening_conductance"),
     ("config-critical-ratio-above-1", plant("critical_pressure_ratio = { value = 0.528", "critical_pressure_ratio = { value = 1.5"), "critical_pressure_ratio"),
-]:
-    case(cid, CHECK, frag, {"bad.toml": text})
+])
 case("config-missing-file", "check nothere.toml -r req.toml -q", "nothere.toml")
 case("config-is-folder", "check out -r req.toml -q", "out")
 case("config-unknown-reference", "check plant-z -r req.toml -q", "plant-z")
@@ -110,7 +115,7 @@ case("config-none-given", "check -r req.toml -q", "no plant configuration given"
 
 # ------------------------------------------------------------------------------------- requirements
 CHECKR = "check plant.toml -r bad-req.toml --json out/r.json -q"
-for cid, text, frag in [
+file_cases(CHECKR, "bad-req.toml", [
     ("req-malformed-toml", "schema = \n", "bad-req.toml"),
     ("req-wrong-schema", req('schema = "govcheck-requirements/1"', 'schema = "govcheck-requirements/9"'), "schema"),
     ("req-unknown-metric", req('metric = "time_constant"', 'metric = "time_konstant"'), "time_konstant"),
@@ -133,8 +138,7 @@ for cid, text, frag in [
     ("req-step-size-unit", req('size = "5 %stroke"', 'size = "5 kg"'), "size"),
     ("req-position-outside", req('initial_position = "50 %stroke"', 'initial_position = "150 %stroke"'), "stroke"),
     ("req-load-unit", req('load = "none"', 'load = "12 m"'), "load"),
-]:
-    case(cid, CHECKR, frag, {"bad-req.toml": text})
+])
 case("req-missing-file", "check plant.toml -r nothere.toml -q", "nothere.toml")
 case("req-unknown-reference", "check plant.toml -r iec99999 -q", "iec99999")
 
@@ -339,7 +343,7 @@ def sweep(old, new):
 
 
 SW = "sweep bad-sweep.toml --out out"
-for cid, text, frag in [
+file_cases(SW, "bad-sweep.toml", [
     ("sweep-malformed-toml", "schema = \n", "bad-sweep.toml"),
     ("sweep-wrong-schema", sweep('"govcheck-sweep/1"', '"govcheck-sweep/7"'), "schema"),
     ("sweep-unknown-parameter", sweep('"controller.kp"', '"controller.kq"'), "controller.kq"),
@@ -350,8 +354,7 @@ for cid, text, frag in [
     ("sweep-base-missing", sweep('base = "plant.toml"', 'base = "nothere.toml"'), "nothere.toml"),
     ("sweep-requirements-missing", sweep('requirements = "req.toml"', 'requirements = "noreq.toml"'), "noreq.toml"),
     ("sweep-no-adjust", SWEEP.split("[adjust")[0], "adjust"),
-]:
-    case(cid, SW, frag, {"bad-sweep.toml": text})
+])
 case("sweep-missing-file", "sweep nothere-sweep.toml --out out", "nothere-sweep.toml")
 case("sweep-jobs-zero", ["sweep", "bad-sweep.toml", "-j", "0", "--out", "out"], "--jobs", {"bad-sweep.toml": SWEEP})
 case("sweep-bad-scheduler", ["sweep", "bad-sweep.toml", "--scheduler", "ftp://x", "--out", "out"], "scheduler", {"bad-sweep.toml": SWEEP})
