@@ -17,7 +17,6 @@ import base64
 import datetime as _dt
 import os
 import platform
-import tempfile
 import time
 from importlib import resources
 from pathlib import Path
@@ -26,7 +25,9 @@ import jinja2
 
 from compliance import __version__
 from compliance.errors import InputError
+from compliance.files.atomic import write_bytes_atomic
 from compliance.files.display import display_path
+from compliance.files.reproducible import fixed_created, is_reproducible
 from compliance.report import content as C
 from compliance.report import signoff as S
 from compliance.report.analysis_sections import linear_section, validation_section
@@ -165,25 +166,6 @@ def _check_target(path, flag: str) -> Path:
     return p
 
 
-def write_atomic(path, data: bytes) -> None:
-    """Write ``data`` to ``path`` via a temporary file in the same folder and ``os.replace``."""
-    p = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent if str(p.parent) else ".")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # a report is for reading: ordinary file permissions
-        os.replace(tmp, p)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
-
-
 def _emit(template: str, ctx: dict, svgs: dict, html_path, pdf_path) -> dict:
     """Render HTML and PDF fully in memory, then write both atomically; returns timings [s]."""
     t0 = time.perf_counter()
@@ -192,13 +174,16 @@ def _emit(template: str, ctx: dict, svgs: dict, html_path, pdf_path) -> dict:
     pdf = _pdf_bytes(_render(template, ctx, svgs, for_pdf=True)) if pdf_path else None
     t2 = time.perf_counter()
     if html is not None:
-        write_atomic(html_path, html.encode("utf-8"))
+        write_bytes_atomic(html_path, html.encode("utf-8"))
     if pdf is not None:
-        write_atomic(pdf_path, pdf)
+        write_bytes_atomic(pdf_path, pdf)
     return {"html": t1 - t0, "pdf": t2 - t1}
 
 
-def _now() -> str:
+def _now(results: dict) -> str:
+    """When the report was rendered; the results' fixed ``created`` for a reproducible run."""
+    if results.get("reproducible") or is_reproducible():
+        return results.get("created") or fixed_created()
     return _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
 
 
@@ -212,7 +197,7 @@ def _common(results: dict) -> dict:
     v.setdefault("matplotlib (report)", matplotlib.__version__)
     v.setdefault("weasyprint (report)", weasyprint.__version__)
     v.setdefault("jinja2 (report)", jinja2.__version__)
-    return {"versions": v, "rendered": fmt_date(_now()), "govcheck_version": __version__}
+    return {"versions": v, "rendered": fmt_date(_now(results)), "govcheck_version": __version__}
 
 
 # --------------------------------------------------------------------------- API

@@ -458,3 +458,14 @@ def test_diagnosis_finding_states_verdict_parameters_with_errors_and_next_step()
     assert f["params"][0]["text"] == "37.8 ± 1.2 rad/s"
     # BIC 4 apart: the data do not decide between the two; the report says so and asks for a separating test
     assert f["next"].startswith("Ambiguous between valve_dynamics and internal_leakage")
+
+
+def test_reproducible_html_is_byte_identical_and_dated_by_the_results(tmp_path, monkeypatch):
+    res = _results()
+    res["runs"] = res["runs"][:2]
+    res["reproducible"], res["created"] = True, "2023-11-14T22:13:20+00:00"
+    a, b = tmp_path / "a.html", tmp_path / "b.html"
+    render_report(copy.deepcopy(res), a, workers=1, appendix="none")
+    render_report(copy.deepcopy(res), b, workers=1, appendix="none")
+    assert a.read_bytes() == b.read_bytes()
+    assert "2023-11-14" in a.read_text()  # the rendering date is the results' fixed date, not today
