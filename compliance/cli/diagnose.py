@@ -54,6 +54,8 @@ def register(sub):
     p.add_argument("--report", help="write an HTML report with the before/after figures")
     p.add_argument("--save-model", help="write the fitted plant configuration here (never overwrites)")
     p.add_argument("--quiet", action="store_true", help="print only the verdict line")
+    p.add_argument("--suggest-test", action="store_true",
+                   help="design and print the test that best tells the two leading explanations apart")
     return p
 
 
@@ -87,7 +89,8 @@ def run(args) -> int:
     if not plant:
         raise InputError(f"{args.recordings[0]}: no --plant given and the sidecar names no 'plant'")
     cfg = load_plant(plant)
-    diag = diagnose(cfg, frame, meta, effects=effects, jobs=args.jobs, recalibrate=not args.no_recalibration)
+    diag = diagnose(cfg, frame, meta, effects=effects, jobs=args.jobs, recalibrate=not args.no_recalibration,
+                    suggest_test=args.suggest_test)
     if args.save_model:
         save_fitted(diag, args.save_model)
     data = diag.to_dict()
@@ -96,6 +99,10 @@ def run(args) -> int:
     if args.report:
         _render_servo_report(cfg, frame, meta, diag, data, args.report)
     _print_servo(data, args.quiet)
+    if args.suggest_test:
+        from compliance.diagnosis.discriminate import suggestion_lines
+
+        print("\n".join(suggestion_lines(diag.suggested_test)))
     return 0
 
 
