@@ -207,9 +207,9 @@ def _decide(st: _Stage) -> dict:
     search = []
     if winner is not None and winner != "base" and verdict_name != "no_mismatch":
         search = _search_sets(st, winner)
+        scores = score_all(st.fits, n)  # the sets tried are candidates too
         kept = [r for r in search if r["kept"]]
         if kept:
-            scores = score_all(st.fits, n)
             winner = kept[-1]["best"]
             reason = f"{' and '.join(set_effects(winner))} together explain {100*scores[winner].explained:.0f} % of the excess residual"
             verdict_name = "missing_physics" if scores[winner].explained >= EXPLAINED_ENOUGH else "unexplained"

@@ -150,10 +150,18 @@ def same_physics(a: str, b: str) -> bool:
     return ea == eb
 
 
+def nested(a: str, b: str) -> bool:
+    """True when one candidate's effects contain the other's (a set and its subset are not rivals:
+    the multi-effect search and parsimony decide between them; ``base``, the recalibration, counts
+    as one more term)."""
+    ea, eb = set(a.split("+")), set(b.split("+"))
+    return ea <= eb or eb <= ea
+
+
 def ambiguity_set(scores: dict[str, Score], winner: str | None, objectives: dict | None = None) -> list[str]:
     """Candidates (other physics than the winner) the recording cannot tell from it.
 
-    A candidate is indistinguishable when it explains as much of the excess as the verdict asks
+    A candidate with other, not nested, physics is indistinguishable when it explains as much of the excess as the verdict asks
     of a winner (``EXPLAINED_ENOUGH``) and either its BIC is within ``AMBIGUOUS_BIC`` of the
     winner's, or both it and the winner are complete (``objectives``: candidate -> signal ->
     normalised RMS, every signal within ``RESIDUAL_LIMIT``) with chi-squares within
@@ -168,7 +176,7 @@ def ambiguity_set(scores: dict[str, Score], winner: str | None, objectives: dict
         return k in objectives and not signals_left(objectives[k])
 
     def rival(k, s):
-        if k in ("nominal", winner) or same_physics(k, winner) or s.explained < EXPLAINED_ENOUGH:
+        if k in ("nominal", winner) or nested(k, winner) or s.explained < EXPLAINED_ENOUGH:
             return False
         if s.bic - w.bic < AMBIGUOUS_BIC:
             return True
