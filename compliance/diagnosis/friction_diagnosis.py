@@ -36,11 +36,15 @@ from compliance.diagnosis.friction_runs import Run
 from compliance.diagnosis.noise_floor import sensor_noise_std
 from compliance.diagnosis.report_data import SCHEMA
 from compliance.diagnosis.friction_structure import friction_structure
-from compliance.diagnosis.select import EXPLAINED_ENOUGH, NOISE_TOLERANCE, RESIDUAL_LIMIT, score_all
+from compliance.diagnosis.select import EXPLAINED_ENOUGH, NOISE_TOLERANCE, score_all
 
 REVERSAL_TRAVEL = 2e-3  # m of travel after a change of direction counted as "after reversal"
 VELOCITY_WINDOW = 0.05  # s; Savitzky-Golay (quadratic) derivative window of the position
 MIN_SLIDING_SPEED = 1e-3  # m/s; slower samples are not "steady sliding"
+# a friction law is complete when its residual is within 3 x the force noise (issue 13's target for the
+# real seals): the floor here is the force sensor alone, while the law is evaluated on a velocity
+# differentiated from a noisy position, whose error adds ~1-2 x the force noise near the Stribeck hump
+FRICTION_RESIDUAL_LIMIT = 3.0
 UNITS = {"bias": "N", "bias_per_pressure": "N/Pa", "coulomb": "N", "static": "N", "stribeck_velocity": "m/s",
          "viscous": "N*s/m", "pressure_coefficient": "N/Pa", "bristle_stiffness": "N/m"}
 MEANING = {
@@ -264,14 +268,15 @@ def diagnose_seal(runs: list[Run]) -> SealDiagnosis:
     runner = next((k for k in ranked if k != winner), None)
     located_after = locate_friction(runs, fits[winner]) if winner else None
     after = math.sqrt(fits[winner].chi2 / n) if winner else rms_norm
-    if verdict == "missing_physics" and after > RESIDUAL_LIMIT:
-        verdict = "partially_explained"  # select.honest: complete only within the stated multiple of the noise
+    if verdict == "missing_physics" and after > FRICTION_RESIDUAL_LIMIT:
+        verdict = "partially_explained"  # as select.honest: complete only within the stated multiple of the noise
     diag = SealDiagnosis(runs[0].seal, runs, fits, scores, verdict, winner, runner, located, located_after, "", floor)
     if verdict != "no_mismatch":
         diag.structure = friction_structure(runs, fits[winner or "baseline"])
     diag.explanation = explain_friction(diag)
     if diag.structure:
-        diag.explanation += (f" The law leaves {after:.1f} times the force noise (complete only within {RESIDUAL_LIMIT:g});"
+        diag.explanation += (f" The law leaves {after:.1f} times the force noise (complete only within "
+                             f"{FRICTION_RESIDUAL_LIMIT:g});"
                              f" empirical suggestion, not a declared effect: {diag.structure['words']}")
     return diag
 

@@ -7,8 +7,9 @@ declared default when that starts better). An added effect is kept only when
 
 - it pays for itself by the information criterion (``select.SIGNIFICANCE``),
 - it removes at least ``ADD_GAIN`` of the current set's excess chi-square (chi2 - N), and
-- it makes no signal worse: no signal's chi-square rises by more than ``NO_WORSE`` (a third
-  effect that lowers the pooled chi-square by trading one signal for another is not physics).
+- it makes no signal worse: no signal's chi-square rises by more than ``NO_WORSE`` to end above
+  ``select.RESIDUAL_LIMIT`` times its floor (a third effect that lowers the pooled chi-square by
+  trading one signal for another is not physics; a signal that stays at its floor may wobble).
 
 Each effect's own contribution in the final set is the chi-square the set loses when that
 effect alone is switched off (the others at their fitted values): one replay per effect.
@@ -18,7 +19,7 @@ from __future__ import annotations
 
 from compliance.effects import EFFECTS
 from compliance.diagnosis.fit import FitContext, FitResult, least_squares_fit, scan_points
-from compliance.diagnosis.select import SIGNIFICANCE
+from compliance.diagnosis.select import RESIDUAL_LIMIT, SIGNIFICANCE
 
 ADD_GAIN = 0.3  # share of the current set's excess chi-square an added effect must remove
 NO_WORSE = 1.25  # no signal's chi-square may rise by more than this factor when an effect is added
@@ -64,9 +65,11 @@ def adds_enough(new: FitResult, current: FitResult, n: int, penalty_per_param: f
     if excess <= 0.0 or current.chi2 - new.chi2 < ADD_GAIN * excess:
         share = 0.0 if excess <= 0 else (current.chi2 - new.chi2) / excess
         return False, f"removes {100*share:.0f} % of the remaining excess (needs {100*ADD_GAIN:.0f} %)"
+    m = n / max(len(current.chi2_signal), 1)  # residuals per signal
     for s, c in current.chi2_signal.items():
-        if new.chi2_signal.get(s, 0.0) > NO_WORSE * c and new.chi2_signal.get(s, 0.0) - c > 0.01 * n:
-            return False, f"makes the {s} residual worse ({new.chi2_signal[s] / max(c, 1e-12):.1f} times its chi-square)"
+        after = new.chi2_signal.get(s, 0.0)
+        if after > NO_WORSE * c and after > RESIDUAL_LIMIT ** 2 * m:
+            return False, f"makes the {s} residual worse ({after / max(c, 1e-12):.1f} times its chi-square)"
     return True, f"removes {100*(current.chi2 - new.chi2)/excess:.0f} % of the remaining excess"
 
 
