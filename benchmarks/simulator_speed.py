@@ -16,7 +16,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from compliance.model.config import load_plant  # noqa: E402
 from compliance.simulation.profiles import Profile, steps  # noqa: E402
 from compliance.simulation import Scenario, simulate  # noqa: E402
-from tests import reference_model as ref  # noqa: E402
+from tests.simulation import reference_model as ref  # noqa: E402
 
 
 def practice_profile(x0: float) -> Profile:

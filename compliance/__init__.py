@@ -16,12 +16,9 @@ def _numba_cache_dir() -> str:
     """
     here = _Path(__file__).resolve().parent
     digest = _hashlib.sha256()
-    for sub in ("physics",):
-        for f in sorted((here / sub).glob("*.py")) if (here / sub).is_dir() else ():
-            digest.update(f.read_bytes())
-    for name in ("model/assembly.py", "model/pid_controller.py", "model/vector_slots.py", "simulation/closed_loop.py", "simulation/state_feedback_loop.py"):
-        f = here / name
-        if f.is_file():
+    # every package that holds compiled code or the slot layout it freezes (effects generate the slots)
+    for sub in ("physics", "effects", "model", "simulation", "diagnosis"):
+        for f in sorted((here / sub).glob("*.py")):
             digest.update(f.read_bytes())
     return str(here / "__pycache__" / f"numba-{digest.hexdigest()[:16]}")
 

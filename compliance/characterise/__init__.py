@@ -2,7 +2,8 @@
 
 - ``charging``: mass flow from the pressure of a fixed volume, flow-law ranking, synthetic data.
 - ``flow_law``: vectorised ISO 6358 / Sanville / Bobrow / power laws and their fits.
-- ``friction_map``: friction from force and pressure, speed bins, Stribeck map fits.
+- ``friction_runs``: friction from force and pressure per run (recorded or synthetic).
+- ``friction_map``: speed bins and Stribeck map fits over the runs.
 - ``derivative``: Savitzky-Golay value and derivative on the actual sample times.
 
 See docs/characterisation.md.

@@ -165,6 +165,36 @@ def characterise_valve(
             raise InputError(f"{source}: needs a '{col}' column; has {', '.join(frame.columns)}")
     t = frame["time"].to_numpy(dtype=float)
     p_raw = frame[pressure_column].to_numpy(dtype=float)
+    mode, window = _mode_and_window(t, p_raw, mode, window, pressure_column, source)
+    idx, w_value, w_deriv = savgol_weights(t, window, DERIVATIVE_ORDER)
+    p = np.sum(w_value * p_raw[idx], axis=1)
+    factor, t_gas = _flow_factor(p, volume, temperature, mode)
+    q = factor * np.sum(w_deriv * p_raw[idx], axis=1)
+    sigma_p = noise_std(t, p_raw, window, DERIVATIVE_ORDER, weights=(idx, w_value, w_deriv))
+    if mode == "charge":
+        if "supply_pressure" in frame.columns:
+            p_up = frame["supply_pressure"].to_numpy(dtype=float)
+        elif supply_pressure is not None:
+            p_up = np.full_like(p, float(supply_pressure))
+        else:
+            raise InputError(f"{source}: charging needs the supply pressure: a 'supply_pressure' column or --supply-pressure")
+        p_down, t_up = p, t_gas
+    else:
+        p_up, p_down, t_up = p, np.full_like(p, float(exhaust_pressure)), t_gas
+    used = _fitted_span(q, p_down / p_up, window, max_ratio, source)
+    flow_noise = (idx[used], factor[used, None] * w_deriv[used], sigma_p)
+    fits = rank_flow_laws(
+        p_up[used], p_down[used], t_up[used], q[used], laws, correlation_length=float(window), flow_noise=flow_noise
+    )
+    return ValveCharacterisation(
+        source=source, mode=mode, volume=float(volume), temperature=float(temperature), window=int(window),
+        derivative=f"Savitzky-Golay, cubic, {window} samples, on the sample times",
+        fits=tuple(fits), pressure_noise=sigma_p, time=t[used], p_up=p_up[used], p_down=p_down[used], t_up=t_up[used], mass_flow=q[used],
+    )
+
+
+def _mode_and_window(t, p_raw, mode: str, window: int | None, pressure_column: str, source: str) -> tuple[str, int]:
+    """Charge or discharge (``auto``: whether the pressure rises) and the derivative window [samples]."""
     if mode == "auto":
         k = max(3, t.size // 50)
         mode = "charge" if np.median(p_raw[-k:]) > np.median(p_raw[:k]) else "discharge"
@@ -182,41 +212,23 @@ def characterise_valve(
             f"{source}: derivative window {window} samples must be odd, > {DERIVATIVE_ORDER + 1} and at most half "
             f"the recording ({t.size} samples)"
         )
-    idx, w_value, w_deriv = savgol_weights(t, window, DERIVATIVE_ORDER)
-    p = np.sum(w_value * p_raw[idx], axis=1)
-    factor, t_gas = _flow_factor(p, volume, temperature, mode)
-    q = factor * np.sum(w_deriv * p_raw[idx], axis=1)
-    sigma_p = noise_std(t, p_raw, window, DERIVATIVE_ORDER, weights=(idx, w_value, w_deriv))
-    if mode == "charge":
-        if "supply_pressure" in frame.columns:
-            p_up = frame["supply_pressure"].to_numpy(dtype=float)
-        elif supply_pressure is not None:
-            p_up = np.full_like(p, float(supply_pressure))
-        else:
-            raise InputError(f"{source}: charging needs the supply pressure: a 'supply_pressure' column or --supply-pressure")
-        p_down, t_up = p, t_gas
-    else:
-        p_up, p_down, t_up = p, np.full_like(p, float(exhaust_pressure)), t_gas
-    ratio = p_down / p_up
+    return mode, window
+
+
+def _fitted_span(q, ratio, window: int, max_ratio: float, source: str) -> slice:
+    """Samples to fit: from the valve opening (past the smeared edge) to the pressure ratio ``max_ratio``."""
+    n = q.size
     half = window // 2
     start = int(np.argmax(q >= 0.5 * np.max(q))) + half  # valve open, past the smeared opening edge
     beyond = np.flatnonzero(ratio[start:] > max_ratio)
-    stop = start + int(beyond[0]) if beyond.size else t.size - half
-    used = slice(start, min(stop, t.size - half))
+    stop = start + int(beyond[0]) if beyond.size else n - half
+    used = slice(start, min(stop, n - half))
     if used.stop - used.start < 10:
         raise InputError(
             f"{source}: only {max(used.stop - used.start, 0)} samples between the valve opening and the pressure ratio "
             f"{max_ratio}; record faster or a larger volume"
         )
-    flow_noise = (idx[used], factor[used, None] * w_deriv[used], sigma_p)
-    fits = rank_flow_laws(
-        p_up[used], p_down[used], t_up[used], q[used], laws, correlation_length=float(window), flow_noise=flow_noise
-    )
-    return ValveCharacterisation(
-        source=source, mode=mode, volume=float(volume), temperature=float(temperature), window=int(window),
-        derivative=f"Savitzky-Golay, cubic, {window} samples, on the sample times",
-        fits=tuple(fits), pressure_noise=sigma_p, time=t[used], p_up=p_up[used], p_down=p_down[used], t_up=t_up[used], mass_flow=q[used],
-    )
+    return used
 
 
 def synthetic_charging(

@@ -25,38 +25,20 @@ import numpy as np
 import pandas as pd
 from scipy.optimize import least_squares
 
+from compliance.characterise.friction_runs import FrictionRun, friction_from_force, piston_area, prepare_run
+from compliance.characterise.friction_runs import stribeck_friction, synthetic_friction_run
 from compliance.errors import InputError
-from compliance.units import ATMOSPHERE_PA
-from compliance.characterise.derivative import odd_window, smoothed_derivative
+from compliance.physics.friction import stribeck_magnitude_array
+
+__all__ = [  # the runs are prepared beside this module and stay importable from it
+    "FrictionCharacterisation", "FrictionFit", "FrictionRun", "bin_friction", "characterise_friction", "fit_friction_map",
+    "friction_from_force", "piston_area", "prepare_run", "stribeck_friction", "synthetic_friction_run",
+]
 
 VISCOUS_SPAN = 3.0  # populated speed range (max/min) needed to fit b
 STRIBECK_SPAN = 10.0  # ... and to fit the Stribeck decay
 STRIBECK_BINS = 5
 PRESSURE_SPREAD = 0.5e5  # [Pa] needed between the lowest and highest run pressure to fit k_p
-
-
-def piston_area(bore: float) -> float:
-    """Piston area pi*d^2/4 [m^2] of a bore ``bore`` [m]."""
-    return math.pi * bore**2 / 4.0
-
-
-def friction_from_force(force, pressure_abs, area, atmosphere=ATMOSPHERE_PA):
-    """Seal friction of a single-acting cylinder stroked by an external drive [N].
-
-    Zillen et al. eq. (3): F_f = F - p_gauge * A, with F the force the drive applies [N],
-    ``pressure_abs`` the chamber pressure [Pa abs] and ``area`` the piston area [m^2].
-    """
-    return np.asarray(force, dtype=float) - (np.asarray(pressure_abs, dtype=float) - atmosphere) * area
-
-
-def stribeck_friction(velocity, coulomb, static, stribeck_velocity, viscous):
-    """Friction-velocity map F(v) = sign(v)[F_C + (F_S - F_C) exp(-|v|/v_s)] + b v [N], vectorised.
-
-    reference-plant.md friction map (same as ``compliance.physics.friction.stribeck_map``).
-    ``velocity`` [m/s], ``coulomb`` / ``static`` [N], ``stribeck_velocity`` [m/s], ``viscous`` [N*s/m].
-    """
-    v = np.asarray(velocity, dtype=float)
-    return np.sign(v) * (coulomb + (static - coulomb) * np.exp(-np.abs(v) / stribeck_velocity)) + viscous * v
 
 
 def _directions(asymmetric: bool):
@@ -88,12 +70,12 @@ class FrictionFit:
         d = direction if self.asymmetric else ""
         g = self.params
         s = np.asarray(speed, dtype=float)
-        out = g[_pname("coulomb", d)] + g.get("pressure_coefficient", 0.0) * np.asarray(pressure_gauge, dtype=float)
-        out = out + g[_pname("viscous", d)] * s
+        coulomb = g[_pname("coulomb", d)] + g.get("pressure_coefficient", 0.0) * np.asarray(pressure_gauge, dtype=float)
+        viscous = g[_pname("viscous", d)] * s
         drop = g[_pname("stribeck_drop", d)]
-        if drop != 0.0:  # a Stribeck term that was not fitted has drop 0 and velocity NaN
-            out = out + drop * np.exp(-s / g[_pname("stribeck_velocity", d)])
-        return out
+        if drop == 0.0:  # a Stribeck term that was not fitted has drop 0 and velocity NaN
+            return coulomb + viscous
+        return stribeck_magnitude_array(s, coulomb + drop, coulomb, g[_pname("stribeck_velocity", d)]) + viscous
 
     def predict(self, velocity, pressure_gauge=0.0):
         """Friction force at ``velocity`` [m/s] and gauge pressure [Pa] [N] (0 at v = 0)."""
@@ -186,37 +168,7 @@ def fit_friction_map(bins: pd.DataFrame, *, asymmetric=True, pressure_dependent=
     used = bins[bins["populated"]]
     if used.empty:
         raise InputError("no populated speed bins: the runs have no constant-speed part above the minimum speed")
-    names, x0, lo, hi, units = [], [], [], [], {}
-    fixed, ranges = {}, {}
-    for d, sgn in _directions(asymmetric):
-        part = used if not d else used[used["direction"] == sgn]
-        if part.empty:
-            raise InputError(f"no populated speed bins in the {'positive' if sgn > 0 else 'negative'} direction")
-        smin, smax = float(part["speed"].min()), float(part["speed"].max())
-        ranges[d or "both"] = (smin, smax)
-        mag = float(np.median(np.abs(part["friction"])))
-        names.append(_pname("coulomb", d)); x0.append(mag); lo.append(-np.inf); hi.append(np.inf)
-        span = smax / smin
-        distinct = part["bin"].nunique()
-        if span >= STRIBECK_SPAN and distinct >= STRIBECK_BINS:
-            names += [_pname("stribeck_drop", d), _pname("stribeck_velocity", d)]
-            x0 += [0.1 * abs(mag) + 1e-3, 2.0 * smin]; lo += [0.0, 0.1 * smin]; hi += [np.inf, smax]
-        else:
-            why = f"populated speeds {smin:.3g}-{smax:.3g} m/s span x{span:.2g} (< {STRIBECK_SPAN:g} or < {STRIBECK_BINS} bins)"
-            fixed[_pname("stribeck_drop", d)] = why
-        if span >= VISCOUS_SPAN:
-            names.append(_pname("viscous", d)); x0.append(0.0); lo.append(0.0); hi.append(np.inf)
-        else:
-            fixed[_pname("viscous", d)] = f"populated speeds {smin:.3g}-{smax:.3g} m/s span x{span:.2g} (< {VISCOUS_SPAN:g})"
-        units.update({_pname("coulomb", d): "N", _pname("static", d): "N", _pname("stribeck_drop", d): "N",
-                      _pname("stribeck_velocity", d): "m/s", _pname("viscous", d): "N*s/m"})
-    if pressure_dependent:
-        spread = float(used["pressure_gauge"].max() - used["pressure_gauge"].min())
-        if spread >= PRESSURE_SPREAD:
-            names.append("pressure_coefficient"); x0.append(0.0); lo.append(-np.inf); hi.append(np.inf)
-            units["pressure_coefficient"] = "N/Pa"
-        else:
-            fixed["pressure_coefficient"] = f"run pressures span {spread / 1e5:.2g} bar (< {PRESSURE_SPREAD / 1e5:g} bar)"
+    names, x0, lo, hi, units, fixed, ranges = _free_terms(used, asymmetric, pressure_dependent)
     speed = used["speed"].to_numpy()
     direction = used["direction"].to_numpy()
     pg = used["pressure_gauge"].to_numpy()
@@ -252,22 +204,10 @@ def fit_friction_map(bins: pd.DataFrame, *, asymmetric=True, pressure_dependent=
         if _pname("stribeck_drop", d) in fixed:
             params[_pname("stribeck_velocity", d)] = float("nan")
     if asymmetric:
-        # the two directions' mean is the seal's Coulomb level; half their difference is a
-        # direction-independent force (sensor zero, p*A area error) seen as asymmetry
-        ip, ineg = names.index("coulomb_pos"), names.index("coulomb_neg")
-        for key, sign in (("coulomb_mean", 1.0), ("direction_offset", -1.0)):
-            params[key] = 0.5 * (params["coulomb_pos"] + sign * params["coulomb_neg"])
-            block = cov[np.ix_([ip, ineg], [ip, ineg])]
-            var = 0.25 * (block[0, 0] + block[1, 1] + 2.0 * sign * block[0, 1]) if np.all(np.isfinite(block)) else np.inf
-            stderr[key] = float(np.sqrt(max(var, 0.0)))
-            units[key] = "N"
+        _direction_split(params, stderr, units, cov, names)
     rms_samples, n_samples = float("nan"), int(used["count"].sum())
     if samples is not None:
-        sv, sf, sp = (np.asarray(a, dtype=float) for a in samples)
-        sample_bin = bins.attrs.get("sample_bin")
-        mask = np.isin(sample_bin, np.flatnonzero(bins["populated"].to_numpy())) if sample_bin is not None else np.ones(sv.size, bool)
-        r = build(res.x).predict(sv[mask], sp[mask]) - sf[mask]
-        rms_samples, n_samples = float(np.sqrt(np.mean(r**2))), int(mask.sum())
+        rms_samples, n_samples = _sample_rms(build(res.x), bins, samples)
     return FrictionFit(
         model="pressure-dependent" if pressure_dependent else "pressure-independent", asymmetric=asymmetric,
         params=params, stderr=stderr, units={k: units[k] for k in params if k in units}, fixed=fixed,
@@ -275,47 +215,70 @@ def fit_friction_map(bins: pd.DataFrame, *, asymmetric=True, pressure_dependent=
     )
 
 
-@dataclass(frozen=True)
-class FrictionRun:
-    """One recording prepared for the map: velocity, friction and pressure per sample."""
+def _free_terms(used: pd.DataFrame, asymmetric: bool, pressure_dependent: bool):
+    """The map's terms the populated bins can show: names, start values, bounds, units; the rest fixed (why).
 
-    name: str
-    time: np.ndarray
-    velocity: np.ndarray  # [m/s]
-    friction: np.ndarray  # [N]
-    pressure_gauge: np.ndarray  # [Pa]
-    area: float  # piston area used for the pressure force [m^2]
-    steady: np.ndarray  # speed constant within the tolerance over the derivative window
-
-    @property
-    def mean_pressure_gauge(self) -> float:
-        """Mean gauge pressure of the run [Pa]."""
-        return float(np.mean(self.pressure_gauge))
-
-
-def prepare_run(name: str, frame: pd.DataFrame, area: float, *, window_s: float = 0.2,
-                steady_tolerance: float = 0.1) -> FrictionRun:
-    """Velocity (Savitzky-Golay, quadratic, ``window_s`` wide) and friction of one recording.
-
-    ``frame`` needs ``time`` [s], ``position`` [m], ``force`` [N] and ``pressure_a`` [Pa abs].
-    A sample is ``steady`` (a constant-speed point of the map) when the speed changes by less
-    than ``steady_tolerance`` of itself over the derivative window: |a| * T_w <= tol * |v|.
-    Reversals and ramps fail this; the map is a steady-state relation and they are not in it.
+    Returns
+    -------
+    tuple
+        (names, x0, lower, upper, units, fixed {name: reason}, populated speed range per direction).
     """
-    for col in ("time", "position", "force", "pressure_a"):
-        if col not in frame.columns:
-            raise InputError(f"{name}: friction needs a '{col}' column; has {', '.join(frame.columns)}")
-    t = frame["time"].to_numpy(dtype=float)
-    dt = float(np.median(np.diff(t)))
-    window = odd_window(window_s / dt, 2)
-    if t.size < 2 * window:
-        raise InputError(f"{name}: {t.size} samples; the {window_s:g} s velocity window needs at least {2 * window}")
-    _, v = smoothed_derivative(t, frame["position"].to_numpy(dtype=float), window, 2)
-    _, a = smoothed_derivative(t, v, window, 2)
-    steady = np.abs(a) * (window * dt) <= steady_tolerance * np.abs(v)
-    p_abs = frame["pressure_a"].to_numpy(dtype=float)
-    friction = friction_from_force(frame["force"].to_numpy(dtype=float), p_abs, area)
-    return FrictionRun(name, t, v, friction, p_abs - ATMOSPHERE_PA, float(area), steady)
+    names, x0, lo, hi, units = [], [], [], [], {}
+    fixed, ranges = {}, {}
+    for d, sgn in _directions(asymmetric):
+        part = used if not d else used[used["direction"] == sgn]
+        if part.empty:
+            raise InputError(f"no populated speed bins in the {'positive' if sgn > 0 else 'negative'} direction")
+        smin, smax = float(part["speed"].min()), float(part["speed"].max())
+        ranges[d or "both"] = (smin, smax)
+        mag = float(np.median(np.abs(part["friction"])))
+        names.append(_pname("coulomb", d)); x0.append(mag); lo.append(-np.inf); hi.append(np.inf)
+        span = smax / smin
+        distinct = part["bin"].nunique()
+        if span >= STRIBECK_SPAN and distinct >= STRIBECK_BINS:
+            names += [_pname("stribeck_drop", d), _pname("stribeck_velocity", d)]
+            x0 += [0.1 * abs(mag) + 1e-3, 2.0 * smin]; lo += [0.0, 0.1 * smin]; hi += [np.inf, smax]
+        else:
+            why = f"populated speeds {smin:.3g}-{smax:.3g} m/s span x{span:.2g} (< {STRIBECK_SPAN:g} or < {STRIBECK_BINS} bins)"
+            fixed[_pname("stribeck_drop", d)] = why
+        if span >= VISCOUS_SPAN:
+            names.append(_pname("viscous", d)); x0.append(0.0); lo.append(0.0); hi.append(np.inf)
+        else:
+            fixed[_pname("viscous", d)] = f"populated speeds {smin:.3g}-{smax:.3g} m/s span x{span:.2g} (< {VISCOUS_SPAN:g})"
+        units.update({_pname("coulomb", d): "N", _pname("static", d): "N", _pname("stribeck_drop", d): "N",
+                      _pname("stribeck_velocity", d): "m/s", _pname("viscous", d): "N*s/m"})
+    if pressure_dependent:
+        spread = float(used["pressure_gauge"].max() - used["pressure_gauge"].min())
+        if spread >= PRESSURE_SPREAD:
+            names.append("pressure_coefficient"); x0.append(0.0); lo.append(-np.inf); hi.append(np.inf)
+            units["pressure_coefficient"] = "N/Pa"
+        else:
+            fixed["pressure_coefficient"] = f"run pressures span {spread / 1e5:.2g} bar (< {PRESSURE_SPREAD / 1e5:g} bar)"
+    return names, x0, lo, hi, units, fixed, ranges
+
+
+def _direction_split(params: dict, stderr: dict, units: dict, cov: np.ndarray, names: list) -> None:
+    """Add ``coulomb_mean`` and ``direction_offset`` (with standard errors) to an asymmetric fit.
+
+    The two directions' mean is the seal's Coulomb level; half their difference is a
+    direction-independent force (sensor zero, p*A area error) seen as asymmetry.
+    """
+    ip, ineg = names.index("coulomb_pos"), names.index("coulomb_neg")
+    for key, sign in (("coulomb_mean", 1.0), ("direction_offset", -1.0)):
+        params[key] = 0.5 * (params["coulomb_pos"] + sign * params["coulomb_neg"])
+        block = cov[np.ix_([ip, ineg], [ip, ineg])]
+        var = 0.25 * (block[0, 0] + block[1, 1] + 2.0 * sign * block[0, 1]) if np.all(np.isfinite(block)) else np.inf
+        stderr[key] = float(np.sqrt(max(var, 0.0)))
+        units[key] = "N"
+
+
+def _sample_rms(fit: FrictionFit, bins: pd.DataFrame, samples) -> tuple[float, int]:
+    """RMS residual [N] over the samples of the populated bins, and their number."""
+    sv, sf, sp = (np.asarray(a, dtype=float) for a in samples)
+    sample_bin = bins.attrs.get("sample_bin")
+    mask = np.isin(sample_bin, np.flatnonzero(bins["populated"].to_numpy())) if sample_bin is not None else np.ones(sv.size, bool)
+    r = fit.predict(sv[mask], sp[mask]) - sf[mask]
+    return float(np.sqrt(np.mean(r**2))), int(mask.sum())
 
 
 @dataclass(frozen=True)
@@ -374,39 +337,3 @@ def characterise_friction(runs, *, asymmetric=True, v_min=1e-3, bins_per_decade=
         per_run.append((r.name, r.mean_pressure_gauge, fit))
     bins["run"] = [runs[int(i)].name for i in bins["group"]]
     return FrictionCharacterisation(runs[0].area, fits, tuple(per_run), bins, tuple(runs))
-
-
-def synthetic_friction_run(speeds, map_params: dict, *, area: float, pressure_gauge: float, stroke=0.04,
-                           sample_time=0.01, accel=0.5, force_noise=0.0, position_noise=0.0, seed=0,
-                           pressure_coefficient=0.0) -> pd.DataFrame:
-    """A single-acting cylinder stroked back and forth by a drive at the given speeds.
-
-    Each speed s [m/s] gives one stroke out at +s and one back at -s over ``stroke`` [m], with
-    ramps of ``accel`` [m/s^2]. The drive force is F = F_f(v) + p_gauge*A (inverse of Zillen
-    eq. 3), F_f the map ``stribeck_friction(v, **map_params)`` plus ``pressure_coefficient`` *
-    p_gauge on its Coulomb level. Seeded Gaussian noise on force [N] and position [m].
-
-    Returns
-    -------
-    pandas.DataFrame
-        ``time`` [s], ``position`` [m], ``pressure_a`` [Pa abs], ``force`` [N].
-    """
-    pieces = []
-    for s in speeds:
-        for sign in (1.0, -1.0):
-            ramp = s / accel
-            cruise = max(stroke / s - ramp, 0.0)
-            t = np.arange(0.0, 2 * ramp + cruise, sample_time)
-            v = np.minimum.reduce([np.full_like(t, s), accel * t, accel * (2 * ramp + cruise - t)])
-            pieces.append(sign * np.clip(v, 0.0, None))
-    v = np.concatenate(pieces)
-    t = np.arange(v.size) * sample_time
-    x = np.concatenate(([0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * sample_time)))
-    c = dict(map_params)
-    c["coulomb"] = c["coulomb"] + pressure_coefficient * pressure_gauge
-    c["static"] = c["static"] + pressure_coefficient * pressure_gauge
-    rng = np.random.default_rng(seed)
-    force = stribeck_friction(v, **c) + pressure_gauge * area + rng.normal(0.0, force_noise, v.size) * (force_noise > 0)
-    x = x + rng.normal(0.0, position_noise, v.size) * (position_noise > 0)
-    return pd.DataFrame({"time": t, "position": x, "pressure_a": np.full(v.size, pressure_gauge + ATMOSPHERE_PA),
-                         "force": force})

@@ -324,15 +324,8 @@ def format_summary(report: dict) -> str:
 
 
 # ------------------------------------------------------------------------ recordings with answers
-# parameter names an ANSWERS.json may use -> fitted keys (the practice emulator's names)
-ANSWER_ALIASES = {
-    "hA": "heat_transfer.conductance",
-    "k_int": "internal_leakage.conductance",
-    "k_ext": "external_leakage.conductance",
-    "wv": "valve_dynamics.natural_frequency",
-    "zv": "valve_dynamics.damping",
-    "td_valve": "valve_dynamics.delay",
-}
+# parameter names an ANSWERS.json may use -> fitted keys (the practice emulator's names: ``Param.aliases``)
+ANSWER_ALIASES = {alias: f"{name}.{p.name}" for name, eff in EFFECTS.items() for p in eff.params for alias in p.aliases}
 
 
 def run_practice(directory, cfg: PlantConfig, *, library=None, jobs: int = 1) -> dict:

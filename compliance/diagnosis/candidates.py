@@ -20,12 +20,6 @@ from compliance.effects import EFFECTS
 from compliance.model.parameters import BASE_BY_KEY
 
 FRICTION_LEVEL = "friction.level"  # pseudo-parameter: one factor on static and Coulomb friction together
-# LuGre pre-sliding parameters: BASE_PARAMS declares no fit_bounds for them (reported to the lead);
-# these bounds span pneumatic seals (Canudas de Wit 1995: sigma0 ~ 1e5..1e8 N/m).
-_EXTRA_FIT_BOUNDS = {
-    "friction.bristle_stiffness": (1e5, 1e8, True),
-    "friction.bristle_damping": (0.0, 1e5, False),
-}
 # Base parameters the diagnosis may recalibrate, in the order they are tried (brief, issue 6:
 # valve sonic conductance, friction levels, dead volume, mass; plus the LuGre pre-sliding pair).
 BASE_REFIT = (
@@ -129,14 +123,11 @@ def base_param(cfg: PlantConfig, key: str) -> FitParam | None:
         return FitParam(key, "base", "", 0.25, max(hi, 1.01), True, 1.0, True)
     if key.startswith("friction.bristle") and cfg.option("friction.model") != "lugre":
         return None
-    if key in _EXTRA_FIT_BOUNDS:
-        lo, hi, log = _EXTRA_FIT_BOUNDS[key]
-    else:
-        spec = BASE_BY_KEY[key]
-        if spec.fit_bounds is None:
-            return None
-        lo, hi = spec.fit_bounds
-        log = lo > 0.0 and hi / lo > 20.0
+    spec = BASE_BY_KEY[key]
+    if spec.fit_bounds is None:
+        return None
+    lo, hi = spec.fit_bounds
+    log = lo > 0.0 and hi / lo > 20.0  # a range of decades is fitted in log space
     nominal = cfg.p(key)
     if not lo <= nominal <= hi:
         lo, hi = min(lo, nominal), max(hi, nominal)
@@ -202,22 +193,8 @@ def _product(**axes):
     return tuple(out)
 
 
-# effect -> starting points (parameters not named stay at their declared default)
-SCAN_GRIDS: dict[str, tuple[dict, ...]] = {
-    "heat_transfer": _product(conductance=(0.3, 1.0, 3.0, 10.0, 30.0, 100.0)),
-    "internal_leakage": _product(conductance=(3e-12, 1e-11, 3e-11, 1e-10, 3e-10, 1e-9)),
-    "external_leakage": _product(conductance=(3e-12, 1e-11, 3e-11, 1e-10, 3e-10, 1e-9)),
-    # a spool near the loop's bandwidth trades frequency, damping and delay: start in each basin
-    "valve_dynamics": _product(natural_frequency=(20.0, 30.0, 45.0, 70.0, 120.0, 250.0), damping=(0.5, 1.0),
-                               delay=(0.0, 0.006, 0.012, 0.02)),
-    "supply_droop": _product(reservoir_volume=(0.003, 0.02, 0.1), regulator_conductance=(1e-8, 1e-7, 1e-6)),
-    "pressure_dependent_friction": _product(coefficient=(1e-4, 3e-4, 1e-3, 2e-3)),
-    "valve_offset": _product(offset=(-0.4, -0.2, -0.1, 0.1, 0.2, 0.4)),
-    "position_dependent_load": _product(stiffness=(-1e5, -3e4, -1e4, 1e4, 3e4, 1e5)),
-    "sensor_lag": _product(time_constant=(0.002, 0.004, 0.008, 0.015, 0.03, 0.06), delay=(0.0, 0.002, 0.004, 0.007)),
-    "line_dynamics": _product(volume=(1e-4, 5e-4, 2e-3), conductance=(1e-8, 3e-8, 1e-7)),
-    "linkage_compliance": _product(stiffness=(3e4, 1e5, 4e5, 1.5e6, 6e6), damping=(300.0, 3000.0)),
-}
+# effect -> starting points (parameters not named stay at their declared default): ``Effect.fit_grid``
+SCAN_GRIDS: dict[str, tuple[dict, ...]] = {name: _product(**eff.fit_grid) for name, eff in EFFECTS.items()}
 
 # multiplicative steps tried in the 1-D scan of a base parameter (factor of 10 for the LuGre
 # stiffness, which data sheets rarely give within a decade)

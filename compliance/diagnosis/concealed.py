@@ -40,22 +40,9 @@ MAX_TRUTH_RATIO = 0.5  # the true model must at least halve the nominal chi-squa
 MAX_DRAWS = 20  # tries per case before the range is declared unable to conceal
 PRE_ROLL = 2.0  # s of hold simulated before the recording starts (the bench has settled)
 
-# effect -> parameter -> (low, high, log); parameters not named keep their declared default
-EFFECT_RANGES: dict[str, dict[str, tuple[float, float, bool]]] = {
-    "heat_transfer": {"conductance": (3.0, 60.0, True)},
-    "internal_leakage": {"conductance": (5e-11, 5e-10, True)},
-    "external_leakage": {"conductance": (3e-11, 3e-10, True)},
-    "valve_dynamics": {"natural_frequency": (25.0, 80.0, True), "damping": (0.4, 1.0, False), "delay": (0.002, 0.015, False)},
-    "supply_droop": {"reservoir_volume": (0.003, 0.03, True), "regulator_conductance": (1e-8, 1e-7, True)},
-    "pressure_dependent_friction": {"coefficient": (2e-4, 1.0e-3, True)},
-    "valve_offset": {"offset": (0.05, 0.4, True)},  # sign drawn separately
-    "position_dependent_load": {"stiffness": (2e4, 1e5, True)},  # sign drawn separately
-    "sensor_lag": {"time_constant": (0.003, 0.03, True), "delay": (0.0, 0.004, False)},
-    "line_dynamics": {"volume": (1e-4, 6e-4, True), "conductance": (5e-9, 3e-8, True)},
-    # only a link soft enough for 2A2 to trail 2A1 by centimetres shows in the pressures (docs/diagnosis.md)
-    "linkage_compliance": {"stiffness": (2e4, 1e5, True), "damping": (100.0, 2000.0, True)},
-}
-SIGNED = ("valve_offset", "position_dependent_load")
+# effect -> parameter -> (low, high, log) (``Effect.draw``); parameters not named keep their declared default
+EFFECT_RANGES: dict[str, dict[str, tuple[float, float, bool]]] = {name: dict(eff.draw) for name, eff in EFFECTS.items()}
+SIGNED = tuple(name for name, eff in EFFECTS.items() if eff.draw_signed)  # sign of the first parameter drawn separately
 # base parameter -> multiplicative factors drawn from (low, high) or its reciprocal range
 MISCALIBRATIONS: dict[str, tuple[float, float]] = {
     "valve.sonic_conductance": (1.3, 1.7),

@@ -5,20 +5,8 @@ from __future__ import annotations
 from compliance.effects import EFFECTS
 from compliance.diagnosis.candidates import FRICTION_LEVEL
 
-# how each effect reads in words, with its main fitted value ({v} is filled in)
-PHYSICS = {
-    "heat_transfer": "the chamber air exchanges heat with the cylinder walls instead of staying at supply temperature (wall conductance hA {v} per side)",
-    "internal_leakage": "air leaks across the piston seals from side A to side B (laminar leak {v})",
-    "external_leakage": "both chambers leak to atmosphere through fittings or rod seals (laminar leak {v} per side)",
-    "valve_dynamics": "the servo valve does not open instantly: its spool follows the command with a delay and a second-order lag (natural frequency {v})",
-    "supply_droop": "the supply pressure sags while the valve draws air: the reservoir is finite and the regulator refills it slowly (reservoir {v})",
-    "pressure_dependent_friction": "the seal friction grows with the chamber pressure ({v} of extra friction per cylinder)",
-    "valve_offset": "the servo valve's null is shifted: the valve sees the command plus an offset of {v}",
-    "position_dependent_load": "the load changes along the stroke more than the nominal load says (stiffness {v})",
-    "sensor_lag": "the position transducer reports a delayed, low-passed position (time constant {v})",
-    "line_dynamics": "the hoses between valve and cylinders add volume and a restriction (hose volume {v} per side)",
-    "linkage_compliance": "the two cylinders are coupled through a flexible linkage (stiffness {v})",
-}
+# how each effect reads in words, with its main fitted value ({v} is filled in): ``Effect.explanation``
+PHYSICS = {name: eff.explanation for name, eff in EFFECTS.items()}
 SIGNAL_WORDS = {"position": "position", "pressure_a": "side-A pressure", "pressure_b": "side-B pressure",
                 "valve_command": "valve command", "supply_pressure": "supply pressure"}
 ALMOST_AS_WELL = 1.5  # a runner-up within this chi-square ratio of the winner is named as an alternative

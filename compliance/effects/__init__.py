@@ -7,9 +7,10 @@ switched on in a configuration with an ``[effects.NAME]`` table.
 
 from __future__ import annotations
 
-from compliance.effects.base import Effect, Lumped, Param
+from compliance.effects.base import Effect, Lumped, State
+from compliance.effects.param import Param
 from compliance.effects.catalogue import ALL_EFFECTS
 
 EFFECTS: dict[str, Effect] = {e.name: e for e in ALL_EFFECTS}
 
-__all__ = ["EFFECTS", "Effect", "Lumped", "Param"]
+__all__ = ["EFFECTS", "Effect", "Lumped", "Param", "State"]

@@ -18,6 +18,7 @@ import control
 import numpy as np
 
 from compliance import metrics as M
+from compliance.effects import EFFECTS
 from compliance.model.config import PlantConfig
 from compliance.model.pid_controller import first_order_filter_gain
 from compliance.errors import InputError
@@ -74,18 +75,19 @@ def pid_controller(cfg: PlantConfig, discrete: bool = False) -> control.StateSpa
 
 
 def _augment(cfg: PlantConfig, plant: control.StateSpace) -> control.StateSpace:
-    """u_d -> [x, x_measured]: valve delay (Pade) before the plant, sensor lag and delay after it."""
-    eff = cfg.effects
+    """u_d -> [x, x_measured]: declared input delays (Pade) before the plant, declared
+    measurement lags and delays after it (``Effect.input_delay``, ``output_lag``, ``output_delay``)."""
     g = plant
-    d_in = _pade_ss(eff["valve_dynamics"]["delay"]) if "valve_dynamics" in eff else None
-    if d_in is not None:
-        g = control.series(d_in, g)
     h = control.ss([], [], [], [[1.0]])
-    if "sensor_lag" in eff:
-        tau = eff["sensor_lag"]["time_constant"]
+    for name, values in cfg.effects.items():
+        eff = EFFECTS[name]
+        d_in = _pade_ss(values[eff.input_delay]) if eff.input_delay else None
+        if d_in is not None:
+            g = control.series(d_in, g)
+        tau = values[eff.output_lag] if eff.output_lag else 0.0
         if tau > 0.0:
-            h = control.ss([[-1.0 / tau]], [[1.0 / tau]], [[1.0]], [[0.0]])
-        d_out = _pade_ss(eff["sensor_lag"]["delay"])
+            h = control.series(h, control.ss([[-1.0 / tau]], [[1.0 / tau]], [[1.0]], [[0.0]]))
+        d_out = _pade_ss(values[eff.output_delay]) if eff.output_delay else None
         if d_out is not None:
             h = control.series(h, d_out)
     gm = control.series(g, h)

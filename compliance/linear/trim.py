@@ -20,10 +20,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from compliance.effects.catalogue import ALL_EFFECTS
 from compliance.model.config import PlantConfig
 from compliance.errors import InputError
 from compliance.model.vector_slots import *  # noqa: F403 - index constants
-from compliance.model.vector_slots import N_AUX, N_STATES, STATE_NAMES
+from compliance.model.vector_slots import EFFECT_SLOTS, N_AUX, N_STATES, STATE_NAMES
 from compliance.model.assembly import initial_state, load_curve_arrays, load_force, parameter_vector, plant_rhs
 
 GAIN_CHOICES = ("mean", "opening", "closing")
@@ -197,19 +198,13 @@ def state_scales(P: np.ndarray) -> np.ndarray:
 
 
 def kept_states(P: np.ndarray) -> list[int]:
-    """Indices of the states of the linear model: x, v, p_A, p_B plus those of switched-on effects."""
+    """Indices of the states of the linear model: x, v, p_A, p_B plus the declared states of
+    switched-on effects (``Effect.states``), in state-vector order."""
     keep = [S_X, S_V, S_PA, S_PB]
-    if P[P_HT_ON]:
-        keep += [S_TA, S_TB]
-    if P[P_LK_ON] and P[P_ARR] == 0.0:
-        keep += [S_X2, S_V2]
-    if P[P_VD_ON]:
-        keep += [S_SP, S_SV]
-    if P[P_SD_ON]:
-        keep += [S_PSUP]
-    if P[P_LD_ON]:
-        keep += [S_PLA, S_PLB]
-    return keep
+    for eff in ALL_EFFECTS:
+        if P[EFFECT_SLOTS[eff.name][0]]:
+            keep += [s.index for s in eff.states]
+    return sorted(keep)
 
 
 def state_jacobian(op: TrimPoint, cfg: PlantConfig, keep: list[int]) -> np.ndarray:

@@ -135,15 +135,32 @@ def step_response(
     marks: dict = {}
     i_step = int(np.searchsorted(time, event.t_step, side="left"))
     i_end = int(np.searchsorted(time, event.t_end, side="left"))
+    x0, noise = _start_position(time, position, event, i_step, pre_window)
+    xf, sse, mpe = _final_position(time, position, event, i_step, i_end, final_window, marks)
+    tt = time[i_step:i_end]
+    xx = position[i_step:i_end]
+    vmax = speed_extremes(time, position, event.t_step, event.t_end)[0]
+    thr = detect if detect > 0 else max(DETECT_FRACTION * abs(event.size), 5.0 * noise)
+    t_move = _motion_start(tt, xx, event, x0, thr, reasons, marks)
+    dead_time = None if t_move is None else t_move - event.t_step
+    tau, rate_limited = _time_constant(time, tt, xx, event, x0, t_move, i_step, valve_command, command_saturation,
+                                       reasons, marks)
+    rise, settle, over = _step_info(tt, xx, event, x0, xf, thr, settling_band, settling_band_abs, reasons, marks)
+    return StepMetrics(
+        event, x0, xf, dead_time, tau, rise, settle, over, sse, mpe, vmax, rate_limited, reasons, marks
+    )
+
+
+def _start_position(time, position, event: StepEvent, i_step: int, pre_window: float) -> tuple[float, float]:
+    """Position before the step [m] (mean over ``pre_window``) and its standard deviation [m]."""
     pre = time_window(time, event.t_step - pre_window, event.t_step)
     if pre.stop > pre.start:
-        x0 = float(np.mean(position[pre]))
-        noise = float(np.std(position[pre]))
-    else:
-        x0 = float(position[max(0, i_step - 1)])
-        noise = 0.0
-    dr = event.size
-    sgn = 1.0 if dr >= 0 else -1.0
+        return float(np.mean(position[pre])), float(np.std(position[pre]))
+    return float(position[max(0, i_step - 1)]), 0.0
+
+
+def _final_position(time, position, event: StepEvent, i_step: int, i_end: int, final_window: float, marks: dict):
+    """(settled position, steady-state error, max positioning error) [m] over the final window."""
     fw = time_window(time, max(event.t_step, event.t_end - final_window), event.t_end)
     if fw.stop <= fw.start:
         fw = slice(max(i_step, i_end - 1), max(i_step + 1, i_end))
@@ -152,72 +169,76 @@ def step_response(
     mpe = float(np.max(np.abs(event.r_after - position[fw])))
     marks["final_window"] = [float(time[fw.start]), float(time[fw.stop - 1])]
     marks["x_final"] = xf
+    return xf, sse, mpe
 
-    tt = time[i_step:i_end]
-    xx = position[i_step:i_end]
-    vmax = speed_extremes(time, position, event.t_step, event.t_end)[0]
 
-    # dead time: first detectable motion in the commanded direction
-    thr = detect if detect > 0 else max(DETECT_FRACTION * abs(dr), 5.0 * noise)
+def _motion_start(tt, xx, event: StepEvent, x0: float, thr: float, reasons: dict, marks: dict) -> float | None:
+    """Time of the first detectable motion in the commanded direction (ends the dead time) [s]."""
+    sgn = 1.0 if event.size >= 0 else -1.0
     t_move = crossing(tt, sgn * (xx - x0), thr, 0, +1) if tt.size else None
-    dead_time = None if t_move is None else t_move - event.t_step
     if t_move is None:
         reasons["dead_time"] = f"no motion beyond {thr * 1e3:.3g} mm after the step"
     else:
         marks["motion_start"] = [t_move, x0 + sgn * thr]
+    return t_move
 
-    # time constant: end of dead time to 63.2 % of the COMMANDED step
+
+def _time_constant(time, tt, xx, event: StepEvent, x0: float, t_move, i_step: int, valve_command, command_saturation,
+                   reasons: dict, marks: dict) -> tuple[float | None, bool]:
+    """End of dead time to 63.2 % of the COMMANDED step [s], and whether the valve saturated first."""
+    dr = event.size
+    sgn = 1.0 if dr >= 0 else -1.0
     target = x0 + TAU_FRACTION * dr
     t63 = crossing(tt, xx, target, 0, int(sgn)) if tt.size else None
-    rate_limited = False
-    tau = None
     if t63 is None:
         reached = (np.max(sgn * (xx - x0)) / abs(dr)) if tt.size and dr != 0 else 0.0
         reasons["time_constant"] = (
             f"stalled: reached {100 * reached:.0f} % of the commanded step, never 63.2 % "
             f"(steady error inside the valve dead zone)"
         )
-    elif t_move is None:
+        return None, False
+    if t_move is None:
         reasons["time_constant"] = reasons["dead_time"]
-    else:
-        tau = t63 - t_move
-        marks["tau_632"] = [t63, target]
-        if valve_command is not None and command_saturation is not None:
-            u = np.asarray(valve_command, float)[i_step : int(np.searchsorted(time, t63, side="right"))]
-            if u.size and np.max(np.abs(u)) >= command_saturation * (1.0 - 1e-9):
-                rate_limited = True
-                reasons["time_constant"] = (
-                    f"rate limited: valve command reached {np.max(np.abs(u)):.2f} V >= flow saturation "
-                    f"{command_saturation:.2f} V (valve fully open, or flow-control valve limiting) before 63.2 %"
-                )
+        return None, False
+    marks["tau_632"] = [t63, target]
+    if valve_command is not None and command_saturation is not None:
+        u = np.asarray(valve_command, float)[i_step : int(np.searchsorted(time, t63, side="right"))]
+        if u.size and np.max(np.abs(u)) >= command_saturation * (1.0 - 1e-9):
+            reasons["time_constant"] = (
+                f"rate limited: valve command reached {np.max(np.abs(u)):.2f} V >= flow saturation "
+                f"{command_saturation:.2f} V (valve fully open, or flow-control valve limiting) before 63.2 %"
+            )
+            return t63 - t_move, True
+    return t63 - t_move, False
 
-    # step_info-style metrics on the actual change
+
+def _step_info(tt, xx, event: StepEvent, x0: float, xf: float, thr: float, settling_band: float,
+               settling_band_abs: float, reasons: dict, marks: dict):
+    """step_info-style (rise time [s], settling time [s], overshoot [-]) on the actual change."""
     change = xf - x0
-    rise = settle = over = None
     if abs(change) <= max(thr, 1e-12):
         for k in ("rise_time", "settling_time", "overshoot"):
             reasons[k] = "no net motion"
+        return None, None, None
+    rise = settle = None
+    s = 1.0 if change > 0 else -1.0
+    t10 = crossing(tt, xx, x0 + 0.1 * change, 0, int(s))
+    t90 = crossing(tt, xx, x0 + 0.9 * change, 0, int(s))
+    if t10 is not None and t90 is not None:
+        rise = t90 - t10
     else:
-        s = 1.0 if change > 0 else -1.0
-        t10 = crossing(tt, xx, x0 + 0.1 * change, 0, int(s))
-        t90 = crossing(tt, xx, x0 + 0.9 * change, 0, int(s))
-        if t10 is not None and t90 is not None:
-            rise = t90 - t10
-        else:
-            reasons["rise_time"] = "did not pass 10 % and 90 % of the change"
-        band = max(settling_band * abs(change), settling_band_abs)
-        outside = np.nonzero(np.abs(xx - xf) >= band)[0]
-        if outside.size == 0:
-            settle = 0.0
-        elif outside[-1] + 1 < tt.size:
-            settle = float(tt[outside[-1] + 1] - event.t_step)
-        else:
-            reasons["settling_time"] = "not settled before the next step"
-        if settle is not None:
-            marks["settled"] = [event.t_step + settle, xf]
-        marks["band"] = [xf - band, xf + band]
-        peak = float(np.max(s * (xx - x0)))
-        over = max(0.0, (peak - abs(change)) / abs(change))
-    return StepMetrics(
-        event, x0, xf, dead_time, tau, rise, settle, over, sse, mpe, vmax, rate_limited, reasons, marks
-    )
+        reasons["rise_time"] = "did not pass 10 % and 90 % of the change"
+    band = max(settling_band * abs(change), settling_band_abs)
+    outside = np.nonzero(np.abs(xx - xf) >= band)[0]
+    if outside.size == 0:
+        settle = 0.0
+    elif outside[-1] + 1 < tt.size:
+        settle = float(tt[outside[-1] + 1] - event.t_step)
+    else:
+        reasons["settling_time"] = "not settled before the next step"
+    if settle is not None:
+        marks["settled"] = [event.t_step + settle, xf]
+    marks["band"] = [xf - band, xf + band]
+    peak = float(np.max(s * (xx - x0)))
+    over = max(0.0, (peak - abs(change)) / abs(change))
+    return rise, settle, over

@@ -2,26 +2,26 @@
 
 This is the one place where the physics functions are composed. ``plant_rhs`` is the single
 source of truth used by the simulator, the linearisation (trim + Jacobian) and the
-diagnosis (through the simulator). ``parameter_vector`` maps a validated ``PlantConfig``
-onto the layout of ``compliance.model.vector_slots``.
+diagnosis (through the simulator). Its parameter vector comes from
+``compliance.model.plant_vector.parameter_vector`` (re-exported here).
 """
 
 from __future__ import annotations
-
-import math
 
 import numpy as np
 from numba import njit
 
 from compliance.model.config import PlantConfig
+from compliance.model.plant_vector import load_curve_arrays, parameter_vector  # noqa: F401 - public here too
 from compliance.model.vector_slots import *  # noqa: F403 - index constants are the core's vocabulary
-from compliance.model.vector_slots import EFFECT_SLOTS, N_AUX, N_PARAMS, N_STATES
+from compliance.model.vector_slots import N_STATES
 from compliance.physics.chamber import chamber_pressure_rate, chamber_temperature_rate, wall_heat_flow
 from compliance.physics.friction import (
     lugre_bristle_rate,
     lugre_force,
     piecewise_stribeck_friction,
     pressure_friction_increment,
+    stribeck_magnitude,
     variable_viscous_friction,
 )
 from compliance.physics.leakage import laminar_leak, reservoir_pressure_rate
@@ -30,7 +30,6 @@ from compliance.physics.mechanics import (
     interp_curve,
     single_force,
     single_volumes,
-    tandem_volumes,
 )
 from compliance.physics.valve_flow import (
     bobrow_mass_flow,
@@ -41,122 +40,7 @@ from compliance.physics.valve_flow import (
 )
 from compliance.physics.valve_opening import openings_from_signed, signed_opening, valve_openings
 
-FLOW_LAWS = {"iso6358": 0, "sanville": 1, "bobrow": 2, "power_law": 3}
-FRICTION_MODELS = {"lugre": 0, "variable_viscous": 1, "piecewise_stribeck": 2}
-VALVE_STAGES = {"spool": 0, "opening": 1}  # where valve_dynamics acts: on the spool (command) or on the opening
 STICK_TIME_CONSTANT = 1e-3  # s; variable-viscous model: how fast a stuck body's residual speed is removed
-
-
-def parameter_vector(cfg: PlantConfig, *, load: float | str | None = None, flow_control: bool | None = None) -> np.ndarray:
-    """Flatten a configuration into the core's parameter vector (SI).
-
-    Parameters
-    ----------
-    cfg : PlantConfig
-    load : float, "curve" or None
-        Constant closing load [N], the configuration's load curve, or no load.
-    flow_control : bool or None
-        Override whether the meter-out flow-control valves are installed.
-    """
-    p = cfg.params
-    P = np.zeros(N_PARAMS)
-    d = p["cylinder.piston_diameter"]
-    dr = p["cylinder.rod_diameter"]
-    a_cap = math.pi * d * d / 4.0
-    a_rod = a_cap - math.pi * dr * dr / 4.0
-    tandem = cfg.options["cylinder.arrangement"] == "tandem"
-    P[P_STROKE] = p["cylinder.stroke"]
-    P[P_AREA_CAP] = a_cap
-    P[P_AREA_ROD] = a_rod
-    P[P_V0] = p["cylinder.dead_volume"]
-    P[P_MASS] = p["cylinder.moving_mass"]
-    P[P_ARR] = 0.0 if tandem else 1.0
-    P[P_NFR] = 2.0 if tandem else 1.0  # friction parameters are per cylinder
-    P[P_PS] = p["air.supply_pressure"]
-    P[P_PATM] = p["air.atmospheric_pressure"]
-    P[P_TS] = p["air.supply_temperature"]
-    P[P_R] = p["air.gas_constant"]
-    P[P_GAMMA] = p["air.heat_capacity_ratio"]
-    P[P_RHO0] = p["air.reference_density"]
-    P[P_T0] = p["air.reference_temperature"]
-    P[P_C] = p["valve.sonic_conductance"]
-    P[P_B] = p["valve.critical_pressure_ratio"]
-    P[P_DZP] = p["valve.dead_zone_positive"]
-    P[P_DZN] = p["valve.dead_zone_negative"]
-    P[P_SLP] = p["valve.slope_positive"]
-    P[P_SLN] = p["valve.slope_negative"]
-    P[P_USAT] = p["valve.saturation_voltage"]
-    P[P_UCEN] = p["valve.centre_voltage"]
-    P[P_LAW] = FLOW_LAWS[cfg.options["valve.flow_law"]]
-    P[P_VD_STAGE] = VALVE_STAGES[cfg.options["valve.dynamics_stage"]]
-    P[P_EFFA] = p["valve.effective_area"]
-    P[P_BOB] = p["valve.bobrow_coefficient"]
-    P[P_POW1] = p["valve.power_law_c1"]
-    P[P_POW2] = p["valve.power_law_c2"]
-    P[P_POWE] = p["valve.power_law_exponent"]
-    installed = cfg.flow_control_installed if flow_control is None else bool(flow_control)
-    P[P_FC_ON] = 1.0 if installed else 0.0
-    P[P_FC_OPEN] = p["flow_control.opening_conductance"]
-    P[P_FC_CLOSE] = p["flow_control.closing_conductance"]
-    P[P_FRM] = FRICTION_MODELS[cfg.options["friction.model"]]
-    P[P_FS] = p["friction.static_force"]
-    P[P_FC] = p["friction.coulomb_force"]
-    P[P_VS] = p["friction.stribeck_velocity"]
-    P[P_BV] = p["friction.viscous_coefficient"]
-    P[P_VLIM] = p["friction.limit_velocity"]
-    P[P_SIG0] = p["friction.bristle_stiffness"]
-    P[P_SIG1] = p["friction.bristle_damping"]
-    P[P_FJ] = p["friction.breakaway_force"]  # seed 001 eq. (8)
-    P[P_KV1] = p["friction.low_speed_coefficient"]
-    P[P_VD] = p["friction.critical_velocity"]
-    P[P_KV2] = p["friction.high_speed_coefficient"]
-    if P[P_FRM] == 2.0 and P[P_FJ] - P[P_KV1] * P[P_VD] < 0.0:
-        from compliance.errors import InputError
-
-        raise InputError(
-            f"{cfg.path or cfg.name}: friction.breakaway_force - friction.low_speed_coefficient * friction.critical_velocity "
-            f"= {P[P_FJ] - P[P_KV1] * P[P_VD]:g} N; seed 001 eq. (8) needs it >= 0 (friction never aids the motion)"
-        )
-    P[P_KSTOP] = p["end_stop.stiffness"]
-    P[P_CSTOP] = p["end_stop.damping"]
-    if isinstance(load, str):
-        if load != "curve":
-            raise ValueError(f"load must be a force, 'curve' or None, not {load!r}")
-        if cfg.load_curve is None:
-            from compliance.errors import InputError
-
-            raise InputError(f"{cfg.path or cfg.name}: the scenario asks for the load curve but [load.curve] is not defined")
-        P[P_LOADMODE] = 1.0
-    else:
-        P[P_LOAD] = 0.0 if load is None else float(load)
-    P[P_KP] = p["controller.kp"]
-    P[P_KI] = p["controller.ki"]
-    P[P_KD] = p["controller.kd"]
-    P[P_TSAMP] = p["controller.sample_time"]
-    P[P_FILT] = p["controller.filter_cutoff"]
-    P[P_LC] = p["controller.compensation_width"]
-    P[P_CDZP] = p["controller.compensation_dead_zone_positive"]
-    P[P_CDZN] = p["controller.compensation_dead_zone_negative"]
-    P[P_CSLP] = p["controller.compensation_slope_positive"]
-    P[P_CSLN] = p["controller.compensation_slope_negative"]
-    P[P_ULIM] = p["valve.command_limit"]
-    for name, values in cfg.effects.items():
-        flag, slots = EFFECT_SLOTS[name]
-        P[flag] = 1.0
-        for pname, idx in slots.items():
-            P[idx] = values[pname]
-    if P[P_LK_ON] and not tandem:
-        from compliance.errors import InputError
-
-        raise InputError(f"{cfg.path or cfg.name}: effect linkage_compliance needs cylinder.arrangement = 'tandem'")
-    return P
-
-
-def load_curve_arrays(cfg: PlantConfig) -> tuple[np.ndarray, np.ndarray]:
-    """Load-curve arrays for the core (a flat zero curve when none is configured)."""
-    if cfg.load_curve is None:
-        return np.array([0.0, 1.0]), np.array([0.0, 0.0])
-    return np.ascontiguousarray(cfg.load_curve[0], dtype=float), np.ascontiguousarray(cfg.load_curve[1], dtype=float)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -204,6 +88,8 @@ def valve_lag_input(P, u_valve):
     return signed_opening(u_valve + off - P[P_UCEN], P[P_DZP], P[P_DZN], P[P_SLP], P[P_SLN], P[P_USAT])
 
 
+# One compiled function on purpose: split into six inline="always" kernels it was bit-identical but
+# slower (benchmarks/simulator_speed.py, same run: 2 % step 0.93 -> 1.40 ms, 30 s loop 513x -> 426x real time).
 @njit(cache=True, error_model="numpy")
 def plant_rhs(y, P, u_valve, load_xs, load_ys, dy, aux):
     """Right-hand side of the plant: dy/dt for state ``y`` with valve input ``u_valve``.
@@ -462,7 +348,7 @@ def set_rest_internal_states(P: np.ndarray, y: np.ndarray, lx: np.ndarray, ly: n
         fs, fc = fs + d, fc + d
     net = f1 + f2 - load_force(P, x2, lx, ly) + end_stop_force(x, 0.0, P[P_STROKE], P[P_KSTOP], P[P_CSTOP])
     n = P[P_NFR] if not linkage else 2.0
-    g = fc + (fs - fc) * math.exp(-abs(v) / P[P_VS])  # LuGre g(v), Canudas de Wit et al. 1995
+    g = stribeck_magnitude(v, fs, fc, P[P_VS])  # LuGre g(v), Canudas de Wit et al. 1995
     z = (net / n - P[P_BV] * v) / P[P_SIG0]
     zmax = g / P[P_SIG0]
     z = min(max(z, -zmax), zmax)

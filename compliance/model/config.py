@@ -1,8 +1,10 @@
-"""Plant configuration files: load, validate at the edge, freeze; save fitted variants with provenance."""
+"""Plant configuration files: load, validate at the edge, freeze; save fitted variants with provenance.
+
+The fields themselves are read and checked in :mod:`compliance.model.config_fields`.
+"""
 
 from __future__ import annotations
 
-import hashlib
 import math
 import os
 import tomllib
@@ -14,15 +16,14 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from compliance.errors import did_you_mean
 from compliance.effects import EFFECTS
-from compliance.errors import InputError
-from compliance.model.parameters import BASE_BY_KEY, BASE_PARAMS, OPTION_DEFAULTS, OPTIONS, SOURCES
+from compliance.errors import InputError, did_you_mean
 from compliance.files.atomic import write_text_atomic
-from compliance.units import parse_quantity
+from compliance.model.config_fields import SECTIONS, effect_values, load_curve_field, section_values
+from compliance.model.parameters import BASE_BY_KEY, BASE_PARAMS, OPTIONS
+from compliance.model.toml_file import read_toml
 
 _TOP_KEYS = {"name", "description", "provenance", "effects"}
-_SECTIONS = sorted({k.split(".")[0] for k in BASE_BY_KEY} | {k.split(".")[0] for k in OPTIONS})
 
 
 _suggest = did_you_mean
@@ -171,59 +172,8 @@ def load_plant(source: str | os.PathLike) -> PlantConfig:
         With the file and key path of the first problem found.
     """
     path = resolve_plant_path(source)
-    raw_bytes = path.read_bytes()
-    try:
-        data = tomllib.loads(raw_bytes.decode("utf-8"))
-    except UnicodeDecodeError:
-        raise InputError(f"{path}: not a UTF-8 text file") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{path}: malformed TOML ({exc})") from None
-    return plant_from_dict(data, str(path), hashlib.sha256(raw_bytes).hexdigest())
-
-
-def _param_value(entry, key: str, where: str, atmosphere: float):
-    """Read ``key = "125 mm"`` or ``key = {value = "125 mm", source = "paper"}``."""
-    spec = BASE_BY_KEY[key]
-    source = "user"
-    if isinstance(entry, dict):
-        unknown = set(entry) - {"value", "source", "note"}
-        if unknown:
-            u = sorted(unknown)[0]
-            raise InputError(f"{where}.{u}: unknown field{_suggest(u, ['value', 'source', 'note'])} (expected value, source, note)")
-        if "value" not in entry:
-            raise InputError(f"{where}: missing 'value'")
-        source = entry.get("source", "user")
-        if source not in SOURCES:
-            raise InputError(f"{where}.source: '{source}' is not one of {', '.join(SOURCES)}")
-        entry = entry["value"]
-    if spec.unit == "number":
-        if isinstance(entry, bool) or not isinstance(entry, (int, float)):
-            raise InputError(f"{where}: expected a bare number in SI base units")
-        value = float(entry)
-    else:
-        value = parse_quantity(entry, spec.unit, where, pressure=spec.pressure, atmosphere=atmosphere)
-    if not math.isfinite(value):
-        raise InputError(f"{where}: value is not finite")
-    bad = value < spec.low or value > spec.high or (spec.low_open and value <= spec.low)
-    if bad:
-        lo = f"> {spec.low:g}" if spec.low_open else f">= {spec.low:g}"
-        raise InputError(f"{where}: {value:g} {spec.unit} is not physical; expected {lo} and <= {spec.high:g} ({spec.meaning})")
-    return value, source
-
-
-def _array_field(entry, where: str, si_unit: str, stroke: float | None = None):
-    if not isinstance(entry, dict) or "values" not in entry or "unit" not in entry:
-        raise InputError(f"{where}: expected {{ values = [...], unit = \"...\" }}")
-    vals = entry["values"]
-    if not isinstance(vals, list) or not vals or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in vals):
-        raise InputError(f"{where}.values: expected a non-empty list of numbers")
-    unit = entry["unit"]
-    if stroke is not None and unit in ("%", "percent", "% stroke", "fraction"):
-        scale = stroke / 100.0 if unit != "fraction" else stroke
-        return np.array(vals, dtype=float) * scale
-    from compliance.units import convert_array
-
-    return convert_array(np.array(vals, dtype=float), unit, si_unit, where)
+    data, digest = read_toml(path)
+    return plant_from_dict(data, str(path), digest)
 
 
 def plant_from_dict(data: dict[str, Any], where: str = "<configuration>", digest: str = "") -> PlantConfig:
@@ -231,95 +181,18 @@ def plant_from_dict(data: dict[str, Any], where: str = "<configuration>", digest
     if not isinstance(data, dict):
         raise InputError(f"{where}: expected a TOML table at the top level")
     for k in data:
-        if k not in _TOP_KEYS and k not in _SECTIONS:
-            raise InputError(f"{where}: unknown key '{k}'{_suggest(k, list(_TOP_KEYS) + _SECTIONS)}")
+        if k not in _TOP_KEYS and k not in SECTIONS:
+            raise InputError(f"{where}: unknown key '{k}'{_suggest(k, list(_TOP_KEYS) + SECTIONS)}")
     name = data.get("name")
     if not isinstance(name, str) or not name.strip():
         raise InputError(f"{where}: missing 'name' (a string naming the plant)")
     description = data.get("description", "")
-    params: dict[str, float] = {}
-    sources: dict[str, str] = {}
-    options = dict(OPTION_DEFAULTS)
-    atmosphere = 101325.0
-    # atmosphere first: gauge pressures convert with it
-    air = data.get("air", {})
-    if isinstance(air, dict) and "atmospheric_pressure" in air:
-        atmosphere, _ = _param_value(air["atmospheric_pressure"], "air.atmospheric_pressure", f"{where}: air.atmospheric_pressure", 101325.0)
-    load_curve_raw = None
-    for section in _SECTIONS:
-        table = data.get(section)
-        if table is None:
-            continue
-        if not isinstance(table, dict):
-            raise InputError(f"{where}: [{section}] must be a table")
-        for k, entry in table.items():
-            key = f"{section}.{k}"
-            kw = f"{where}: {key}"
-            if key == "load.curve":
-                load_curve_raw = entry
-                continue
-            if key in OPTIONS:
-                val = str(entry).lower() if isinstance(entry, bool) else entry
-                if not isinstance(val, str) or val not in OPTIONS[key]:
-                    raise InputError(f"{kw}: '{entry}' is not one of {', '.join(OPTIONS[key])}{_suggest(str(entry), OPTIONS[key])}")
-                options[key] = val
-                continue
-            if key not in BASE_BY_KEY:
-                choices = [b.key.split(".", 1)[1] for b in BASE_PARAMS if b.key.startswith(section + ".")]
-                choices += [o.split(".", 1)[1] for o in OPTIONS if o.startswith(section + ".")]
-                raise InputError(f"{kw}: unknown key '{k}' in [{section}]{_suggest(k, choices)}")
-            params[key], sources[key] = _param_value(entry, key, kw, atmosphere)
-    for spec in BASE_PARAMS:
-        if spec.key not in params:
-            if spec.default is None:
-                raise InputError(f"{where}: missing value {spec.key} ({spec.meaning}, unit {spec.unit})")
-            params[spec.key] = float(spec.default)
-            sources[spec.key] = "assumed"
+    params, sources, options, load_curve_raw = section_values(data, where)
     load_curve = None
     if load_curve_raw is not None:
-        kw = f"{where}: load.curve"
-        if not isinstance(load_curve_raw, dict):
-            raise InputError(f"{kw}: expected a table with position and force")
-        unknown = set(load_curve_raw) - {"position", "force", "source", "note"}
-        if unknown:
-            raise InputError(f"{kw}: unknown field '{sorted(unknown)[0]}' (expected position, force, source, note)")
-        if "position" not in load_curve_raw or "force" not in load_curve_raw:
-            raise InputError(f"{kw}: needs both 'position' and 'force'")
-        xs = _array_field(load_curve_raw["position"], f"{kw}.position", "m", params["cylinder.stroke"])
-        fs = _array_field(load_curve_raw["force"], f"{kw}.force", "N")
-        if xs.shape != fs.shape:
-            raise InputError(f"{kw}: position has {xs.size} values but force has {fs.size}")
-        if np.any(np.diff(xs) <= 0):
-            raise InputError(f"{kw}.position: values must be strictly increasing")
-        load_curve = (xs, fs)
+        load_curve = load_curve_field(load_curve_raw, where, params["cylinder.stroke"])
         sources["load.curve"] = load_curve_raw.get("source", "user")
-    effects: dict[str, dict[str, float]] = {}
-    eff_raw = data.get("effects", {})
-    if not isinstance(eff_raw, dict):
-        raise InputError(f"{where}: [effects] must be a table of [effects.NAME] tables")
-    for ename, table in eff_raw.items():
-        kw = f"{where}: effects.{ename}"
-        if ename not in EFFECTS:
-            raise InputError(f"{kw}: effect '{ename}' is not known{_suggest(ename, EFFECTS)} (known: {', '.join(EFFECTS)})")
-        if not isinstance(table, dict):
-            raise InputError(f"{kw}: expected a table of parameters")
-        eff = EFFECTS[ename]
-        if table.get("enabled", True) is False:
-            continue
-        vals = eff.defaults()
-        for pk, pv in table.items():
-            if pk in ("enabled", "source", "note"):
-                continue
-            names = [p.name for p in eff.params]
-            if pk not in names:
-                raise InputError(f"{kw}.{pk}: unknown parameter{_suggest(pk, names)} (expected {', '.join(names)})")
-            spec = eff.param(pk)
-            v = parse_quantity(pv["value"] if isinstance(pv, dict) else pv, spec.unit, f"{kw}.{pk}")
-            lo, hi = spec.bounds
-            if v < lo or v > hi:
-                raise InputError(f"{kw}.{pk}: {v:g} {spec.unit} is outside the admissible range [{lo:g}, {hi:g}]")
-            vals[pk] = v
-        effects[ename] = vals
+    effects = effect_values(data, where)
     cfg = PlantConfig(
         name=name.strip(),
         description=str(description),
@@ -347,7 +220,7 @@ def _check_physical(cfg: PlantConfig, where: str) -> None:
             f"air.atmospheric_pressure ({p['air.atmospheric_pressure']:.0f} Pa abs)"
         )
     for side in ("positive", "negative"):
-        if p[f"valve.saturation_voltage"] <= p[f"valve.dead_zone_{side}"]:
+        if p["valve.saturation_voltage"] <= p[f"valve.dead_zone_{side}"]:
             raise InputError(f"{where}: valve.saturation_voltage must exceed valve.dead_zone_{side}")
     if p["friction.static_force"] < p["friction.coulomb_force"]:
         raise InputError(f"{where}: friction.static_force must be >= friction.coulomb_force")
@@ -380,9 +253,9 @@ def plant_to_toml(cfg: PlantConfig) -> str:
         val = v if v not in ("true", "false") else v
         sections.setdefault(sec, []).append(f"{name} = {val}" if v in ("true", "false") else f'{name} = "{val}"')
     for spec in BASE_PARAMS:
-        sec, name = spec.key.split(".", 1)
-        v = cfg.params[spec.key]
-        src = cfg.sources.get(spec.key, "user")
+        sec, name = spec.name.split(".", 1)
+        v = cfg.params[spec.name]
+        src = cfg.sources.get(spec.name, "user")
         if spec.unit == "number":
             val = _fmt(v)
         else:

@@ -6,100 +6,70 @@ the report appendix and the diagnosis (which base parameters it may refit).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from compliance.effects.param import Param
 
 
-@dataclass(frozen=True)
-class BaseParam:
-    """A base (always present) parameter of a plant configuration.
-
-    Attributes
-    ----------
-    key : str
-        Dotted key ``section.name``.
-    unit : str
-        SI unit (pint syntax); ``""`` dimensionless; ``"number"`` a bare SI number whose unit
-        depends on another parameter (power-law coefficients).
-    meaning : str
-    default : float or None
-        None means required.
-    low, high : float
-        Admissible range (inclusive low unless ``low_open``).
-    low_open : bool
-        The low bound is excluded (strictly positive quantities).
-    pressure : bool
-        An absolute pressure: the file must say ``abs`` or ``gauge``.
-    fit_bounds : tuple of float or None
-        Range the diagnosis may refit this parameter in (None: never refitted).
-    """
-
-    key: str
-    unit: str
-    meaning: str
-    default: float | None
-    low: float = 0.0
-    high: float = float("inf")
-    low_open: bool = False
-    pressure: bool = False
-    fit_bounds: tuple[float, float] | None = None
+def _P(key, unit, meaning, default, low=0.0, high=float("inf"), low_open=False, **kw) -> Param:
+    """A base-parameter row: (key, unit, meaning, default, low, high, low_open) as the table reads."""
+    return Param(key, unit, meaning, default, (low, high), low_open=low_open, **kw)
 
 
-_P = BaseParam
-BASE_PARAMS: tuple[BaseParam, ...] = (
-    _P("cylinder.stroke", "m", "stroke L (x = 0 closed gate, x = L fully open)", None, 0.0, 5.0, True),
+BASE_PARAMS: tuple[Param, ...] = (
+    _P("cylinder.stroke", "m", "stroke L (x = 0 closed gate, x = L fully open)", None, 0.0, 5.0, True, slot="stroke"),
     _P("cylinder.piston_diameter", "m", "piston bore", None, 0.0, 1.0, True),
     _P("cylinder.rod_diameter", "m", "rod diameter", None, 0.0, 1.0),
-    _P("cylinder.dead_volume", "m^3", "dead volume per chamber including pipes", None, 0.0, 1.0, True, fit_bounds=(2e-4, 4e-3)),
-    _P("cylinder.moving_mass", "kg", "total moving mass", None, 0.0, 1e5, True, fit_bounds=(5.0, 300.0)),
-    _P("air.supply_pressure", "Pa", "regulated supply pressure", None, 0.0, 1e8, True, pressure=True),
-    _P("air.atmospheric_pressure", "Pa", "atmospheric pressure", 101300.0, 0.0, 2e5, True, pressure=True),
-    _P("air.supply_temperature", "K", "supply air temperature", 293.15, 0.0, 500.0, True),
-    _P("air.gas_constant", "J/(kg*K)", "specific gas constant R", 287.0, 0.0, 1e4, True),
-    _P("air.heat_capacity_ratio", "", "heat capacity ratio gamma", 1.4, 1.0, 2.0, True),
-    _P("air.reference_density", "kg/m^3", "density at the conductance rating conditions (NTP)", 1.204, 0.0, 10.0, True),
-    _P("air.reference_temperature", "K", "temperature at the conductance rating conditions (NTP)", 293.15, 0.0, 500.0, True),
-    _P("valve.sonic_conductance", "m^3/(s*Pa)", "ISO 6358 sonic conductance C of each port path", None, 0.0, 1e-4, True, fit_bounds=(5e-9, 8e-8)),
-    _P("valve.critical_pressure_ratio", "", "ISO 6358 critical pressure ratio b", 0.528, 0.0, 0.999),
-    _P("valve.dead_zone_positive", "V", "dead zone zmd for commands opening P->A (U > 0)", 0.0, 0.0, 10.0, fit_bounds=(0.0, 2.0)),
-    _P("valve.dead_zone_negative", "V", "dead zone zme for commands opening P->B (U < 0), magnitude", 0.0, 0.0, 10.0, fit_bounds=(0.0, 2.0)),
-    _P("valve.slope_positive", "", "dead-zone slope md", 1.0, 0.0, 100.0, True),
-    _P("valve.slope_negative", "", "dead-zone slope me", 1.0, 0.0, 100.0, True),
-    _P("valve.saturation_voltage", "V", "command magnitude at which a path is fully open", None, 0.0, 100.0, True),
-    _P("valve.command_limit", "V", "command saturation +/-", 10.0, 0.0, 100.0, True),
-    _P("valve.centre_voltage", "V", "command at the valve null (0 for a +/-10 V valve, 5 V for a 0-10 V valve)", 0.0, -100.0, 100.0),
-    _P("valve.effective_area", "m^2", "Sanville law: effective area at full opening", 0.0, 0.0, 1.0),
-    _P("valve.bobrow_coefficient", "kg/(s*Pa^0.5)", "Bobrow law: C_f*A at full opening", 0.0, 0.0, 1.0),
-    _P("valve.power_law_c1", "number", "power law: C_f1 at full opening [kg/(s*Pa^lambda)]", 0.0, 0.0, 1.0),
-    _P("valve.power_law_c2", "kg/(s*Pa)", "power law: linear term C_f2 at full opening", 0.0, 0.0, 1.0),
-    _P("valve.power_law_exponent", "", "power law: exponent lambda", 0.25, 0.0, 1.0, True),
-    _P("flow_control.opening_conductance", "m^3/(s*Pa)", "meter-out throttle 2V3 on side B exhaust (sets the opening time); 0 = wide open", 0.0, 0.0, 1e-4),
-    _P("flow_control.closing_conductance", "m^3/(s*Pa)", "meter-out throttle 2V2 on side A exhaust (sets the closing time); 0 = wide open", 0.0, 0.0, 1e-4),
-    _P("friction.static_force", "N", "static (breakaway) friction F_S per cylinder", None, 0.0, 1e6, fit_bounds=(0.0, 3000.0)),
-    _P("friction.coulomb_force", "N", "Coulomb friction F_C per cylinder", None, 0.0, 1e6, fit_bounds=(0.0, 3000.0)),
-    _P("friction.stribeck_velocity", "m/s", "Stribeck velocity v_s", None, 0.0, 10.0, True),
-    _P("friction.viscous_coefficient", "N*s/m", "viscous coefficient b per cylinder", None, 0.0, 1e7, fit_bounds=(0.0, 5000.0)),
-    _P("friction.limit_velocity", "m/s", "limit speed below which the body sticks (variable viscous model)", 0.001, 0.0, 1.0, True),
-    _P("friction.bristle_stiffness", "N/m", "LuGre bristle stiffness sigma0", 1e6, 0.0, 1e12, True, fit_bounds=(1e5, 1e8)),
-    _P("friction.bristle_damping", "N*s/m", "LuGre bristle damping sigma1", 3.873e3, 0.0, 1e9, fit_bounds=(0.0, 1e5)),
-    _P("end_stop.stiffness", "N/m", "end-stop contact stiffness", 1e8, 0.0, 1e12, True),
-    _P("end_stop.damping", "N*s/m", "end-stop contact damping", 5e4, 0.0, 1e10),
+    _P("cylinder.dead_volume", "m^3", "dead volume per chamber including pipes", None, 0.0, 1.0, True, fit_bounds=(2e-4, 4e-3), slot="dead_volume"),
+    _P("cylinder.moving_mass", "kg", "total moving mass", None, 0.0, 1e5, True, fit_bounds=(5.0, 300.0), slot="mass"),
+    _P("air.supply_pressure", "Pa", "regulated supply pressure", None, 0.0, 1e8, True, pressure=True, slot="p_supply"),
+    _P("air.atmospheric_pressure", "Pa", "atmospheric pressure", 101300.0, 0.0, 2e5, True, pressure=True, slot="p_atm"),
+    _P("air.supply_temperature", "K", "supply air temperature", 293.15, 0.0, 500.0, True, slot="t_supply"),
+    _P("air.gas_constant", "J/(kg*K)", "specific gas constant R", 287.0, 0.0, 1e4, True, slot="r_gas"),
+    _P("air.heat_capacity_ratio", "", "heat capacity ratio gamma", 1.4, 1.0, 2.0, True, slot="gamma"),
+    _P("air.reference_density", "kg/m^3", "density at the conductance rating conditions (NTP)", 1.204, 0.0, 10.0, True, slot="rho0"),
+    _P("air.reference_temperature", "K", "temperature at the conductance rating conditions (NTP)", 293.15, 0.0, 500.0, True, slot="t0"),
+    _P("valve.sonic_conductance", "m^3/(s*Pa)", "ISO 6358 sonic conductance C of each port path", None, 0.0, 1e-4, True, fit_bounds=(5e-9, 8e-8), slot="conductance"),
+    _P("valve.critical_pressure_ratio", "", "ISO 6358 critical pressure ratio b", 0.528, 0.0, 0.999, slot="b_crit"),
+    _P("valve.dead_zone_positive", "V", "dead zone zmd for commands opening P->A (U > 0)", 0.0, 0.0, 10.0, fit_bounds=(0.0, 2.0), slot="dz_pos"),
+    _P("valve.dead_zone_negative", "V", "dead zone zme for commands opening P->B (U < 0), magnitude", 0.0, 0.0, 10.0, fit_bounds=(0.0, 2.0), slot="dz_neg"),
+    _P("valve.slope_positive", "", "dead-zone slope md", 1.0, 0.0, 100.0, True, slot="slope_pos"),
+    _P("valve.slope_negative", "", "dead-zone slope me", 1.0, 0.0, 100.0, True, slot="slope_neg"),
+    _P("valve.saturation_voltage", "V", "command magnitude at which a path is fully open", None, 0.0, 100.0, True, slot="u_sat"),
+    _P("valve.command_limit", "V", "command saturation +/-", 10.0, 0.0, 100.0, True, slot="u_lim"),
+    _P("valve.centre_voltage", "V", "command at the valve null (0 for a +/-10 V valve, 5 V for a 0-10 V valve)", 0.0, -100.0, 100.0, slot="u_centre"),
+    _P("valve.effective_area", "m^2", "Sanville law: effective area at full opening", 0.0, 0.0, 1.0, slot="eff_area"),
+    _P("valve.bobrow_coefficient", "kg/(s*Pa^0.5)", "Bobrow law: C_f*A at full opening", 0.0, 0.0, 1.0, slot="bobrow_coef"),
+    _P("valve.power_law_c1", "number", "power law: C_f1 at full opening [kg/(s*Pa^lambda)]", 0.0, 0.0, 1.0, slot="pow_c1"),
+    _P("valve.power_law_c2", "kg/(s*Pa)", "power law: linear term C_f2 at full opening", 0.0, 0.0, 1.0, slot="pow_c2"),
+    _P("valve.power_law_exponent", "", "power law: exponent lambda", 0.25, 0.0, 1.0, True, slot="pow_exp"),
+    _P("flow_control.opening_conductance", "m^3/(s*Pa)", "meter-out throttle 2V3 on side B exhaust (sets the opening time); 0 = wide open", 0.0, 0.0, 1e-4, slot="fc_open"),
+    _P("flow_control.closing_conductance", "m^3/(s*Pa)", "meter-out throttle 2V2 on side A exhaust (sets the closing time); 0 = wide open", 0.0, 0.0, 1e-4, slot="fc_close"),
+    _P("friction.static_force", "N", "static (breakaway) friction F_S per cylinder", None, 0.0, 1e6, fit_bounds=(0.0, 3000.0), slot="f_static"),
+    _P("friction.coulomb_force", "N", "Coulomb friction F_C per cylinder", None, 0.0, 1e6, fit_bounds=(0.0, 3000.0), slot="f_coulomb"),
+    _P("friction.stribeck_velocity", "m/s", "Stribeck velocity v_s", None, 0.0, 10.0, True, slot="v_stribeck"),
+    _P("friction.viscous_coefficient", "N*s/m", "viscous coefficient b per cylinder", None, 0.0, 1e7, fit_bounds=(0.0, 5000.0), slot="viscous"),
+    _P("friction.limit_velocity", "m/s", "limit speed below which the body sticks (variable viscous model)", 0.001, 0.0, 1.0, True, slot="v_limit"),
+    # LuGre pre-sliding fit ranges span pneumatic seals (Canudas de Wit et al. 1995: sigma0 ~ 1e5..1e8 N/m)
+    _P("friction.bristle_stiffness", "N/m", "LuGre bristle stiffness sigma0", 1e6, 0.0, 1e12, True, fit_bounds=(1e5, 1e8), slot="sigma0"),
+    _P("friction.bristle_damping", "N*s/m", "LuGre bristle damping sigma1", 3.873e3, 0.0, 1e9, fit_bounds=(0.0, 1e5), slot="sigma1"),
+    _P("end_stop.stiffness", "N/m", "end-stop contact stiffness", 1e8, 0.0, 1e12, True, slot="k_stop"),
+    _P("end_stop.damping", "N*s/m", "end-stop contact damping", 5e4, 0.0, 1e10, slot="c_stop"),
     _P("load.nominal_force", "N", "nominal closing load F_Cn", 0.0, -1e7, 1e7),
-    _P("controller.kp", "V/m", "proportional gain K_P", 0.0, 0.0, 1e7),
-    _P("controller.ki", "V/(m*s)", "integral gain K_I", 0.0, 0.0, 1e7),
-    _P("controller.kd", "V*s/m", "derivative gain K_D", 0.0, 0.0, 1e7),
-    _P("controller.sample_time", "s", "controller sample time (zero-order hold)", None, 0.0, 1.0, True),
-    _P("controller.filter_cutoff", "Hz", "first-order position filter cut-off (0 = no filter)", 0.0, 0.0, 1e5),
-    _P("controller.compensation_width", "V", "dead-zone compensation smoothing width lc", 0.0, 0.0, 10.0),
-    _P("controller.compensation_dead_zone_positive", "V", "compensator's zmd", 0.0, 0.0, 10.0),
-    _P("controller.compensation_dead_zone_negative", "V", "compensator's |zme|", 0.0, 0.0, 10.0),
-    _P("controller.compensation_slope_positive", "", "compensator's md", 1.0, 0.0, 100.0, True),
-    _P("controller.compensation_slope_negative", "", "compensator's me", 1.0, 0.0, 100.0, True),
+    _P("controller.kp", "V/m", "proportional gain K_P", 0.0, 0.0, 1e7, slot="kp"),
+    _P("controller.ki", "V/(m*s)", "integral gain K_I", 0.0, 0.0, 1e7, slot="ki"),
+    _P("controller.kd", "V*s/m", "derivative gain K_D", 0.0, 0.0, 1e7, slot="kd"),
+    _P("controller.sample_time", "s", "controller sample time (zero-order hold)", None, 0.0, 1.0, True, slot="ts"),
+    _P("controller.filter_cutoff", "Hz", "first-order position filter cut-off (0 = no filter)", 0.0, 0.0, 1e5, slot="filt_hz"),
+    _P("controller.compensation_width", "V", "dead-zone compensation smoothing width lc", 0.0, 0.0, 10.0, slot="lc"),
+    _P("controller.compensation_dead_zone_positive", "V", "compensator's zmd", 0.0, 0.0, 10.0, slot="cdz_pos"),
+    _P("controller.compensation_dead_zone_negative", "V", "compensator's |zme|", 0.0, 0.0, 10.0, slot="cdz_neg"),
+    _P("controller.compensation_slope_positive", "", "compensator's md", 1.0, 0.0, 100.0, True, slot="cslope_pos"),
+    _P("controller.compensation_slope_negative", "", "compensator's me", 1.0, 0.0, 100.0, True, slot="cslope_neg"),
     _P("simulation.step", "s", "fixed integration step (pinned for determinism)", 1e-4, 0.0, 0.01, True),
     # --- piecewise Stribeck friction, seed 001 eq. (8) (friction.model = "piecewise_stribeck")
-    _P("friction.breakaway_force", "N", "seed 001 eq. (8) F_j: friction at rest (piecewise Stribeck model)", 0.0, 0.0, 1e6),
-    _P("friction.low_speed_coefficient", "N*s/m", "seed 001 eq. (8) k_v1: friction drop per speed below v_d", 0.0, 0.0, 1e7),
-    _P("friction.critical_velocity", "m/s", "seed 001 eq. (8) v_d: speed where the friction stops falling", 0.01, 0.0, 10.0, True),
-    _P("friction.high_speed_coefficient", "N*s/m", "seed 001 eq. (8) k_v2: viscous slope above v_d", 0.0, 0.0, 1e7),
+    _P("friction.breakaway_force", "N", "seed 001 eq. (8) F_j: friction at rest (piecewise Stribeck model)", 0.0, 0.0, 1e6, slot="f_breakaway"),
+    _P("friction.low_speed_coefficient", "N*s/m", "seed 001 eq. (8) k_v1: friction drop per speed below v_d", 0.0, 0.0, 1e7, slot="kv_low"),
+    _P("friction.critical_velocity", "m/s", "seed 001 eq. (8) v_d: speed where the friction stops falling", 0.01, 0.0, 10.0, True, slot="v_critical"),
+    _P("friction.high_speed_coefficient", "N*s/m", "seed 001 eq. (8) k_v2: viscous slope above v_d", 0.0, 0.0, 1e7, slot="kv_high"),
     # --- state feedback with observers, seed 001 eqs. (10)-(11) (controller.type = "state_feedback")
     _P("controller.closed_loop_bandwidth", "rad/s", "state feedback: magnitude of the three placed closed-loop poles", 0.0, 0.0, 1e5),
     _P("controller.closed_loop_damping", "", "state feedback: damping ratio of the placed complex pole pair", 0.7, 0.0, 1.0, True),
@@ -108,7 +78,7 @@ BASE_PARAMS: tuple[BaseParam, ...] = (
     _P("controller.velocity_filter_cutoff", "Hz", "first-order filter on the differentiated position (0 = no filter)", 0.0, 0.0, 1e5),
 )
 
-BASE_BY_KEY: dict[str, BaseParam] = {p.key: p for p in BASE_PARAMS}
+BASE_BY_KEY: dict[str, Param] = {p.name: p for p in BASE_PARAMS}
 
 # option keys (strings / booleans) and their allowed values
 OPTIONS: dict[str, tuple[str, ...]] = {

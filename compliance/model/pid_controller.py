@@ -6,6 +6,8 @@ import math
 
 from numba import njit
 
+from compliance.model.vector_slots import P_CDZN, P_CDZP, P_CSLN, P_CSLP, P_LC
+
 
 @njit(cache=True, error_model="numpy", inline="always")
 def dead_zone_compensation(u_d, dz_pos, dz_neg, slope_pos, slope_neg, width):
@@ -63,3 +65,35 @@ def pid_step(error, filtered_rate, integral, kp, ki, kd, sample_time):
     """
     integral = integral + error * sample_time
     return kp * error + ki * integral - kd * filtered_rate, integral
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def pid_sample(P, xm, ref_k, x_filt, integral, alpha, kp, ki, kd, ts):
+    """One controller sample of plant A's PID: filter, PID, dead-zone compensation (seed 000 eq. 3).
+
+    Parameters
+    ----------
+    P : ndarray
+        Plant parameter vector (the compensator's dead-zone slots).
+    xm, ref_k : float
+        Measured position and reference [m].
+    x_filt, integral : float
+        Filtered position [m] and error integral [m*s] from the previous sample.
+    alpha : float
+        Position filter gain (:func:`first_order_filter_gain`).
+    kp, ki, kd, ts : float
+        Gains and sample time [s].
+
+    Returns
+    -------
+    tuple
+        (u_d demanded [V], u_c compensated [V], new x_filt [m], new integral [m*s]).
+    """
+    x_new = x_filt + alpha * (xm - x_filt)
+    rate = (x_new - x_filt) / ts
+    u_d, integral = pid_step(ref_k - xm, rate, integral, kp, ki, kd, ts)
+    if P[P_LC] > 0.0:
+        u_c = dead_zone_compensation(u_d, P[P_CDZP], P[P_CDZN], P[P_CSLP], P[P_CSLN], P[P_LC])
+    else:
+        u_c = u_d
+    return u_d, u_c, x_new, integral

@@ -156,30 +156,55 @@ def controller_vector(cfg: PlantConfig, *, mode: str | None = None, compensation
     C[C_PID_ALPHA] = first_order_filter_gain(p("controller.filter_cutoff"), ts)
     C[C_FF] = 1.0 if ff else 0.0
     where = cfg.path or cfg.name
-    gains = np.zeros(3)
-    poles = np.zeros(0)
-    ao = fo = design.ReducedObserver(np.zeros(2), -1.0, np.zeros(1), np.zeros(2))
-    force_gain = 0.0
     needs_sf = mode == "state_feedback" or comp
     if needs_sf:
-        for key in ("controller.closed_loop_bandwidth", "controller.acceleration_observer_bandwidth",
-                    "controller.friction_observer_bandwidth"):
-            if not p(key) > 0:
-                raise InputError(f"{where}: {key} must be > 0 for the state-feedback controller (seed 001)")
-        bw = p("controller.closed_loop_bandwidth")
-        zeta = p("controller.closed_loop_damping")
-        poles = design.design_poles(bw, zeta)
-        gains = design.state_feedback_gains(model, bw, zeta)
-        ao = design.acceleration_observer(model, p("controller.acceleration_observer_bandwidth"))
-        fo = design.friction_observer(model, p("controller.friction_observer_bandwidth"))
-        force_gain = design.friction_compensation_gain(model, gains)
-        for pole, key in ((ao.pole, "acceleration"), (fo.pole, "friction")):
-            if abs(pole) * ts > 1.0:
-                raise InputError(f"{where}: controller.{key}_observer_bandwidth {abs(pole):.0f} rad/s is too fast for "
-                                 f"controller.sample_time {ts*1e3:g} ms (needs bandwidth * sample time <= 1)")
+        poles, gains, ao, fo, force_gain = _state_feedback_design(cfg, model, where)
+    else:
+        gains, poles, force_gain = np.zeros(3), np.zeros(0), 0.0
+        ao = fo = design.ReducedObserver(np.zeros(2), -1.0, np.zeros(1), np.zeros(2))
     if comp and mode != "state_feedback":
         raise InputError(f"{where}: controller.friction_compensation needs controller.type = 'state_feedback' (seed 001 fig. 6)")
     C[C_KX], C[C_KV], C[C_KA] = gains
+    _pack_observers(C, ao, fo)
+    C[C_FORCE_GAIN] = force_gain
+    C[C_FORCE_RATE_GAIN] = model.mass * model.n0
+    C[C_VISCOUS] = model.viscous
+    C[C_RATE_ALPHA] = 1.0 - math.exp(RATE_FILTER_FACTOR * fo.pole * ts) if needs_sf else 1.0  # low-pass of dF^/dt
+    C[C_COMP] = COMPENSATION_FORMS[compensation_form] if comp else 0.0
+    pid = (C[C_KP], C[C_KI], C[C_KD])
+    return ControllerDesign(mode, comp, ff, model, gains, poles, ao, fo, force_gain, pid, C)
+
+
+def _state_feedback_design(cfg: PlantConfig, model, where: str):
+    """Seed 001's design: placed poles, state-feedback gains, both observers, friction force gain.
+
+    Returns
+    -------
+    tuple
+        (poles [rad/s], gains [k_x, k_v, k_a], acceleration observer, friction observer, K_F [N/V]).
+    """
+    p = cfg.p
+    ts = p("controller.sample_time")
+    for key in ("controller.closed_loop_bandwidth", "controller.acceleration_observer_bandwidth",
+                "controller.friction_observer_bandwidth"):
+        if not p(key) > 0:
+            raise InputError(f"{where}: {key} must be > 0 for the state-feedback controller (seed 001)")
+    bw = p("controller.closed_loop_bandwidth")
+    zeta = p("controller.closed_loop_damping")
+    poles = design.design_poles(bw, zeta)
+    gains = design.state_feedback_gains(model, bw, zeta)
+    ao = design.acceleration_observer(model, p("controller.acceleration_observer_bandwidth"))
+    fo = design.friction_observer(model, p("controller.friction_observer_bandwidth"))
+    force_gain = design.friction_compensation_gain(model, gains)
+    for pole, key in ((ao.pole, "acceleration"), (fo.pole, "friction")):
+        if abs(pole) * ts > 1.0:
+            raise InputError(f"{where}: controller.{key}_observer_bandwidth {abs(pole):.0f} rad/s is too fast for "
+                             f"controller.sample_time {ts*1e3:g} ms (needs bandwidth * sample time <= 1)")
+    return poles, gains, ao, fo, force_gain
+
+
+def _pack_observers(C: np.ndarray, ao, fo) -> None:
+    """Write the two reduced observers into the controller vector."""
     C[C_AO_LX], C[C_AO_LV] = ao.gain
     C[C_AO_POLE] = ao.pole
     C[C_AO_IN] = ao.input_gain[0]
@@ -188,13 +213,6 @@ def controller_vector(cfg: PlantConfig, *, mode: str | None = None, compensation
     C[C_FO_POLE] = fo.pole
     C[C_FO_IN] = fo.input_gain[0]
     C[C_FO_SV] = fo.state_gain[0]
-    C[C_FORCE_GAIN] = force_gain
-    C[C_FORCE_RATE_GAIN] = model.mass * model.n0
-    C[C_VISCOUS] = model.viscous
-    C[C_RATE_ALPHA] = 1.0 - math.exp(RATE_FILTER_FACTOR * fo.pole * ts) if needs_sf else 1.0  # low-pass of dF^/dt
-    C[C_COMP] = COMPENSATION_FORMS[compensation_form] if comp else 0.0
-    pid = (C[C_KP], C[C_KI], C[C_KD])
-    return ControllerDesign(mode, comp, ff, model, gains, poles, ao, fo, force_gain, pid, C)
 
 
 @njit(cache=True, error_model="numpy", inline="always")

@@ -7,8 +7,15 @@ layout to Python code (assembly, linearisation, diagnosis).
 
 from __future__ import annotations
 
+from compliance.effects.catalogue import ALL_EFFECTS
+from compliance.model.parameters import BASE_PARAMS
+
 # ---- parameter vector ------------------------------------------------------------------------
-PARAM_NAMES = (
+# Entries are never renumbered: numba caches compiled kernels with these integers frozen in and
+# does not notice when this module changes, so new entries are appended (a new effect's after the
+# last one). Base parameters fill their declared ``slot`` (``parameters.BASE_PARAMS``); the other
+# core entries are computed by ``parameter_vector``.
+_CORE_HEAD = (
     # geometry and mass
     "stroke", "area_cap", "area_rod", "dead_volume", "mass", "arrangement", "n_friction",
     # air
@@ -26,23 +33,24 @@ PARAM_NAMES = (
     "load_mode", "load_const",
     # controller
     "kp", "ki", "kd", "ts", "filt_hz", "lc", "cdz_pos", "cdz_neg", "cslope_pos", "cslope_neg", "u_lim",
-    # effects: flag then parameters
-    "ht_on", "ht_ha",
-    "il_on", "il_k",
-    "el_on", "el_k",
-    "vd_on", "vd_wn", "vd_zeta", "vd_delay",
-    "sd_on", "sd_vol", "sd_cond",
-    "pf_on", "pf_coef",
-    "vo_on", "vo_offset",
-    "pl_on", "pl_stiff",
-    "sl_on", "sl_tau", "sl_delay",
-    "ld_on", "ld_vol", "ld_cond",
-    "lc_on", "lc_stiff", "lc_damp",
-    # piecewise Stribeck friction, seed 001 eq. (8) (appended: earlier indices unchanged)
+)
+_CORE_TAIL = (
+    # piecewise Stribeck friction, seed 001 eq. (8)
     "f_breakaway", "kv_low", "v_critical", "kv_high",
     # valve dynamics stage: 0 the spool filters the command (before the dead zone), 1 the lag acts on the opening
     "vd_stage",
 )
+# the first effects' entries sit between the head and the tail (their indices predate the tail)
+_EFFECTS_BEFORE_TAIL = 11
+
+
+def _effect_entries(effects) -> list[str]:
+    """Flag then parameters of each effect: ``<short>_on``, ``<short>_<slot>``."""
+    return [n for e in effects for n in (f"{e.short}_on", *(f"{e.short}_{p.slot}" for p in e.params))]
+
+
+PARAM_NAMES = (*_CORE_HEAD, *_effect_entries(ALL_EFFECTS[:_EFFECTS_BEFORE_TAIL]), *_CORE_TAIL,
+               *_effect_entries(ALL_EFFECTS[_EFFECTS_BEFORE_TAIL:]))
 N_PARAMS = len(PARAM_NAMES)
 PI = {n: i for i, n in enumerate(PARAM_NAMES)}
 
@@ -100,63 +108,43 @@ P_CDZN = PI["cdz_neg"]
 P_CSLP = PI["cslope_pos"]
 P_CSLN = PI["cslope_neg"]
 P_ULIM = PI["u_lim"]
-P_HT_ON = PI["ht_on"]
-P_HT_HA = PI["ht_ha"]
-P_IL_ON = PI["il_on"]
-P_IL_K = PI["il_k"]
-P_EL_ON = PI["el_on"]
-P_EL_K = PI["el_k"]
-P_VD_ON = PI["vd_on"]
-P_VD_WN = PI["vd_wn"]
-P_VD_Z = PI["vd_zeta"]
-P_VD_TD = PI["vd_delay"]
-P_SD_ON = PI["sd_on"]
-P_SD_VOL = PI["sd_vol"]
-P_SD_COND = PI["sd_cond"]
-P_PF_ON = PI["pf_on"]
-P_PF_COEF = PI["pf_coef"]
-P_VO_ON = PI["vo_on"]
-P_VO_OFF = PI["vo_offset"]
-P_PL_ON = PI["pl_on"]
-P_PL_K = PI["pl_stiff"]
-P_SL_ON = PI["sl_on"]
-P_SL_TAU = PI["sl_tau"]
-P_SL_TD = PI["sl_delay"]
-P_LD_ON = PI["ld_on"]
-P_LD_VOL = PI["ld_vol"]
-P_LD_COND = PI["ld_cond"]
-P_LK_ON = PI["lc_on"]
-P_LK_K = PI["lc_stiff"]
-P_LK_C = PI["lc_damp"]
 P_FJ = PI["f_breakaway"]
 P_KV1 = PI["kv_low"]
 P_VD = PI["v_critical"]
 P_KV2 = PI["kv_high"]
 P_VD_STAGE = PI["vd_stage"]
 
-# effect name -> (flag index, {param name: index}) — the bridge from declarations to the core
-EFFECT_SLOTS = {
-    "heat_transfer": (P_HT_ON, {"conductance": P_HT_HA}),
-    "internal_leakage": (P_IL_ON, {"conductance": P_IL_K}),
-    "external_leakage": (P_EL_ON, {"conductance": P_EL_K}),
-    "valve_dynamics": (P_VD_ON, {"natural_frequency": P_VD_WN, "damping": P_VD_Z, "delay": P_VD_TD}),
-    "supply_droop": (P_SD_ON, {"reservoir_volume": P_SD_VOL, "regulator_conductance": P_SD_COND}),
-    "pressure_dependent_friction": (P_PF_ON, {"coefficient": P_PF_COEF}),
-    "valve_offset": (P_VO_ON, {"offset": P_VO_OFF}),
-    "position_dependent_load": (P_PL_ON, {"stiffness": P_PL_K}),
-    "sensor_lag": (P_SL_ON, {"time_constant": P_SL_TAU, "delay": P_SL_TD}),
-    "line_dynamics": (P_LD_ON, {"volume": P_LD_VOL, "conductance": P_LD_COND}),
-    "linkage_compliance": (P_LK_ON, {"stiffness": P_LK_K, "damping": P_LK_C}),
-}
+# base parameter key -> index: what parameter_vector copies straight from the configuration
+BASE_SLOTS = {p.name: PI[p.slot] for p in BASE_PARAMS if p.slot is not None}
+
+# effect name -> (flag index, {param name: index}) — the bridge from declarations to the core.
+# Each effect entry also gets its constant P_<SHORT>_ON / P_<SHORT>_<SLOT> (e.g. P_VO_ON, P_VO_OFF)
+# for the compiled code, named by the declaration.
+EFFECT_SLOTS: dict[str, tuple[int, dict[str, int]]] = {}
+for _e in ALL_EFFECTS:
+    EFFECT_SLOTS[_e.name] = (PI[f"{_e.short}_on"], {p.name: PI[f"{_e.short}_{p.slot}"] for p in _e.params})
+    globals()[f"P_{_e.short.upper()}_ON"] = PI[f"{_e.short}_on"]
+    for _p in _e.params:
+        globals()[f"P_{_e.short.upper()}_{_p.slot.upper()}"] = PI[f"{_e.short}_{_p.slot}"]
 
 # ---- state vector ----------------------------------------------------------------------------
-STATE_NAMES = (
-    "position", "velocity", "pressure_a", "pressure_b", "temperature_a", "temperature_b",
-    "bristle_1", "bristle_2", "position_2", "velocity_2", "spool_position", "spool_velocity",
-    "supply_pressure", "line_pressure_a", "line_pressure_b",
-)
+# core states by index; effects declare theirs (name, constant suffix, fixed index)
+_CORE_STATES = {0: ("position", "X"), 1: ("velocity", "V"), 2: ("pressure_a", "PA"), 3: ("pressure_b", "PB"),
+                6: ("bristle_1", "Z1"), 7: ("bristle_2", "Z2")}
+_STATE_SLOTS = dict(_CORE_STATES)
+for _e in ALL_EFFECTS:
+    for _s in _e.states:
+        if _s.index in _STATE_SLOTS:
+            raise ValueError(f"effect {_e.name}: state {_s.name} takes index {_s.index}, already {_STATE_SLOTS[_s.index][0]}")
+        _STATE_SLOTS[_s.index] = (_s.name, _s.slot)
+if sorted(_STATE_SLOTS) != list(range(len(_STATE_SLOTS))):
+    raise ValueError(f"state indices must be 0..n-1 without gaps, got {sorted(_STATE_SLOTS)}")
+STATE_NAMES = tuple(_STATE_SLOTS[i][0] for i in range(len(_STATE_SLOTS)))
 N_STATES = len(STATE_NAMES)
-S_X, S_V, S_PA, S_PB, S_TA, S_TB, S_Z1, S_Z2, S_X2, S_V2, S_SP, S_SV, S_PSUP, S_PLA, S_PLB = range(N_STATES)
+S_X, S_V, S_PA, S_PB, S_Z1, S_Z2 = 0, 1, 2, 3, 6, 7
+for _e in ALL_EFFECTS:
+    for _s in _e.states:
+        globals()[f"S_{_s.slot}"] = _s.index  # S_TA, S_SP, ...: named by the declaration
 
 # ---- auxiliary outputs of the right-hand side ---------------------------------------------------
 AUX_NAMES = ("friction_force", "load_force", "flow_a", "flow_b", "opening", "pneumatic_force", "supply_flow")

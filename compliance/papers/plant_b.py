@@ -70,10 +70,6 @@ def _run_all(cfg, kind, **settings):
 
 def tracking_figures(cfg, out: Path) -> list[str]:
     """Figures and tables of claim (2)."""
-    import matplotlib.pyplot as plt
-
-    from compliance.report.figures_tracking import draw_path
-
     lines = ["| path | controller | path RMS [mm] | path max [mm] | axis RMS (worst) [mm] | stick-slip episodes | "
              "stuck / moving (worst axis) |", "|---|---|---|---|---|---|---|"]
     runs = {}
@@ -86,35 +82,53 @@ def tracking_figures(cfg, out: Path) -> list[str]:
             lines.append(f"| {label} | {name} | {s['path_rms_error']*MM:.3f} | {s['path_max_error']*MM:.3f} | "
                          f"{s['axis_rms_error']*MM:.3f} | {s['stick_slip_episodes']:.0f} | {s['stick_slip_fraction']*100:.1f} % |")
     for kind, fname in (("circle_tracking", "circle.png"), ("stroke_tracking", "character.png")):
-        fig, axes = plt.subplots(1, 3, figsize=(12, 3.6), gridspec_kw={"width_ratios": [1, 1, 1.6]})
-        for name, r in runs[kind].items():
-            tr = [t for t in r["traces"] if t.get("kind") == "path3d"][0]
-            if name == "PID":
-                draw_path(axes[0], axes[2], tr, label="PID", color=_COLORS[name], errors=False)
-                axes[0].set_title("PID (the error is visible at this scale)", fontsize=9)
-            else:
-                axes[2].plot(tr["time"], np.asarray(tr["path_deviation"]) * MM, color=_COLORS[name], lw=1.0, label=name)
-                ref = np.column_stack([tr["reference_x"], tr["reference_y"]])
-                pos = np.column_stack([tr["position_x"], tr["position_y"]])
-                mag = (ref + MAGNIFY * (pos - ref)) * MM
-                axes[1].plot(mag[:, 0], mag[:, 1], color=_COLORS[name], lw=0.9, label=name)
-        axes[1].plot(np.asarray(tr["path_x"]) * MM, np.asarray(tr["path_y"]) * MM, color="#555555", lw=0.6, label="reference")
-        axes[1].set_aspect("equal", adjustable="datalim")
-        axes[1].set_title(f"state feedback, error x{MAGNIFY:g} about the reference", fontsize=9)
-        axes[1].set_xlabel("x [mm]")
-        axes[1].legend(fontsize=6, loc="lower left")
-        axes[2].set_yscale("log")
-        axes[2].set_ylim(1e-3, 20)
-        axes[2].set_ylabel("path deviation [mm]")
-        axes[2].set_title("distance of the tool point from the reference path", fontsize=9)
-        axes[2].legend(fontsize=7)
-        fig.tight_layout()
-        fig.savefig(out / fname, dpi=110)
-        plt.close(fig)
-    # one reversal of the circle's x axis, with and without compensation
+        _path_figure(runs[kind], out / fname)
+    _reversal_figure(runs["circle_tracking"], out / "reversal.png")
+    lines += _slow_ramps(cfg, out / "slow-ramp.png")
+    lines += _compensation_forms(cfg)
+    return lines
+
+
+def _path_figure(runs: dict, path: Path) -> None:
+    """PID path, magnified state-feedback error about the reference, path deviation over time."""
+    import matplotlib.pyplot as plt
+
+    from compliance.report.figures_tracking import draw_path
+
+    fig, axes = plt.subplots(1, 3, figsize=(12, 3.6), gridspec_kw={"width_ratios": [1, 1, 1.6]})
+    for name, r in runs.items():
+        tr = [t for t in r["traces"] if t.get("kind") == "path3d"][0]
+        if name == "PID":
+            draw_path(axes[0], axes[2], tr, label="PID", color=_COLORS[name], errors=False)
+            axes[0].set_title("PID (the error is visible at this scale)", fontsize=9)
+        else:
+            axes[2].plot(tr["time"], np.asarray(tr["path_deviation"]) * MM, color=_COLORS[name], lw=1.0, label=name)
+            ref = np.column_stack([tr["reference_x"], tr["reference_y"]])
+            pos = np.column_stack([tr["position_x"], tr["position_y"]])
+            mag = (ref + MAGNIFY * (pos - ref)) * MM
+            axes[1].plot(mag[:, 0], mag[:, 1], color=_COLORS[name], lw=0.9, label=name)
+    axes[1].plot(np.asarray(tr["path_x"]) * MM, np.asarray(tr["path_y"]) * MM, color="#555555", lw=0.6, label="reference")
+    axes[1].set_aspect("equal", adjustable="datalim")
+    axes[1].set_title(f"state feedback, error x{MAGNIFY:g} about the reference", fontsize=9)
+    axes[1].set_xlabel("x [mm]")
+    axes[1].legend(fontsize=6, loc="lower left")
+    axes[2].set_yscale("log")
+    axes[2].set_ylim(1e-3, 20)
+    axes[2].set_ylabel("path deviation [mm]")
+    axes[2].set_title("distance of the tool point from the reference path", fontsize=9)
+    axes[2].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def _reversal_figure(circle_runs: dict, path: Path) -> None:
+    """One reversal of the circle's x axis, with and without compensation."""
+    import matplotlib.pyplot as plt
+
     fig, axes = plt.subplots(1, 3, figsize=(12, 3.2), sharex=True)
     for name in ("state feedback", "state feedback + compensation"):
-        tr = [t for t in runs["circle_tracking"][name]["traces"] if t["label"].endswith("axis x")][0]
+        tr = [t for t in circle_runs[name]["traces"] if t["label"].endswith("axis x")][0]
         t = np.asarray(tr["time"])
         sl = (t > 2.9) & (t < 3.4)
         err = (np.asarray(tr["reference"]) - np.asarray(tr["position"])) * MM
@@ -132,12 +146,17 @@ def tracking_figures(cfg, out: Path) -> list[str]:
         ax.legend(fontsize=6)
     fig.suptitle("circle, x axis through its velocity reversal (reference speed crosses zero at t = 3.015 s)", fontsize=9)
     fig.tight_layout()
-    fig.savefig(out / "reversal.png", dpi=110)
+    fig.savefig(path, dpi=110)
     plt.close(fig)
-    # slow ramps: single axis through the falling branch of eq. (8)
+
+
+def _slow_ramps(cfg, path: Path) -> list[str]:
+    """Slow ramps: single axis through the falling branch of eq. (8); table rows and the 5 mm/s figure."""
+    import matplotlib.pyplot as plt
+
     ts = cfg.p("controller.sample_time")
-    lines += ["", "| ramp speed | controller | axis RMS [mm] | axis max [mm] | episodes | stuck / moving |",
-              "|---|---|---|---|---|---|"]
+    lines = ["", "| ramp speed | controller | axis RMS [mm] | axis max [mm] | episodes | stuck / moving |",
+             "|---|---|---|---|---|---|"]
     fig, axes = plt.subplots(1, 2, figsize=(12, 3.0))
     for vr in (0.005, 0.02):
         traj = time_parameterise(np.array([[0, 0, 0], [3 * vr, 0, 0]]), speed_limit=vr, acceleration_limit=0.5,
@@ -162,13 +181,18 @@ def tracking_figures(cfg, out: Path) -> list[str]:
         ax.legend(fontsize=7)
     fig.suptitle("one axis, ramp at 5 mm/s (inside the falling branch of eq. 8, v < v_d = 10 mm/s)", fontsize=9)
     fig.tight_layout()
-    fig.savefig(out / "slow-ramp.png", dpi=110)
+    fig.savefig(path, dpi=110)
     plt.close(fig)
-    # the static-gain compensation (the lead's first reading of G_f) for the record
+    return lines
+
+
+def _compensation_forms(cfg) -> list[str]:
+    """The static-gain compensation (the lead's first reading of G_f) beside the inverse, for the record."""
+    ts = cfg.p("controller.sample_time")
     t = np.arange(int(6.0 / ts) + 1) * ts
     w = 2 * np.pi * 0.2
     ref = AxisReference(0.15 + 0.05 * np.sin(w * t), 0.05 * w * np.cos(w * t), -0.05 * w * w * np.sin(w * t))
-    lines += ["", "| compensation form (50 mm sine, 0.2 Hz, one axis) | axis RMS after 1 s [mm] |", "|---|---|"]
+    lines = ["", "| compensation form (50 mm sine, 0.2 Hz, one axis) | axis RMS after 1 s [mm] |", "|---|---|"]
     for form in ("inverse", "static"):
         df = simulate_axis(cfg, ref, compensation=True, compensation_form=form)
         m = axis_metrics(df, "x", 1.0)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 
@@ -26,6 +27,12 @@ def stribeck_map(velocity, static_force, coulomb_force, stribeck_velocity, visco
         return 0.0
     s = 1.0 if velocity > 0.0 else -1.0
     return s * stribeck_magnitude(velocity, static_force, coulomb_force, stribeck_velocity) + viscous * velocity
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def stick_force(applied_force, breakaway_force):
+    """Friction of a stuck body [N]: it balances the applied force up to +/- the breakaway force."""
+    return min(max(applied_force, -breakaway_force), breakaway_force)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -52,11 +59,7 @@ def variable_viscous_friction(velocity, applied_force, static_force, coulomb_for
         Limit speed below which the body is considered stuck [m/s].
     """
     if abs(velocity) < limit_velocity:
-        if applied_force > static_force:
-            return static_force
-        if applied_force < -static_force:
-            return -static_force
-        return applied_force
+        return stick_force(applied_force, static_force)
     return stribeck_map(velocity, static_force, coulomb_force, stribeck_velocity, viscous)
 
 
@@ -109,13 +112,38 @@ def piecewise_stribeck_friction(velocity, applied_force, breakaway_force, low_sp
         Stick band [m/s].
     """
     if abs(velocity) < limit_velocity:
-        if applied_force > breakaway_force:
-            return breakaway_force
-        if applied_force < -breakaway_force:
-            return -breakaway_force
-        return applied_force
+        return stick_force(applied_force, breakaway_force)
     s = 1.0 if velocity > 0.0 else -1.0
     speed = abs(velocity)
     if speed < critical_velocity:
         return s * (breakaway_force - low_speed_coefficient * speed)
     return s * (breakaway_force - low_speed_coefficient * critical_velocity + high_speed_coefficient * (speed - critical_velocity))
+
+
+# ---- the same kernels over numpy arrays (bench characterisation, plots): one loop, one formula
+@njit(cache=True, error_model="numpy")
+def _stribeck_loop(velocity, static_force, coulomb_force, stribeck_velocity, viscous, signed, out):
+    for i in range(out.size):
+        if signed:
+            out[i] = stribeck_map(velocity[i], static_force[i], coulomb_force[i], stribeck_velocity[i], viscous[i])
+        else:
+            out[i] = stribeck_magnitude(velocity[i], static_force[i], coulomb_force[i], stribeck_velocity[i])
+    return out
+
+
+def _over_arrays(signed: bool, velocity, static_force, coulomb_force, stribeck_velocity, viscous):
+    arrays = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (velocity, static_force, coulomb_force,
+                                                                          stribeck_velocity, viscous)))
+    flat = [np.ascontiguousarray(a).ravel() for a in arrays]
+    out = np.empty(flat[0].size)
+    return _stribeck_loop(*flat, signed, out).reshape(arrays[0].shape)[()]  # a scalar for scalar inputs
+
+
+def stribeck_magnitude_array(speed, static_force, coulomb_force, stribeck_velocity):
+    """:func:`stribeck_magnitude` element-wise over numpy arrays (broadcast) [N]."""
+    return _over_arrays(False, speed, static_force, coulomb_force, stribeck_velocity, 0.0)
+
+
+def stribeck_map_array(velocity, static_force, coulomb_force, stribeck_velocity, viscous):
+    """:func:`stribeck_map` element-wise over numpy arrays (broadcast) [N]."""
+    return _over_arrays(True, velocity, static_force, coulomb_force, stribeck_velocity, viscous)

@@ -6,16 +6,6 @@ from numba import njit
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def tandem_volumes(x, stroke, dead_volume, area_cap, area_rod):
-    """Side volumes of the tandem pair 2A1 + 2A2 [m^3] (reference-plant.md, decoded eqs. 4-5).
-
-    V_A = 2*V0 + (A_cap + A_rod)*x and V_B = 2*V0 + (A_cap + A_rod)*(L - x).
-    """
-    at = area_cap + area_rod
-    return 2.0 * dead_volume + at * x, 2.0 * dead_volume + at * (stroke - x)
-
-
-@njit(cache=True, error_model="numpy", inline="always")
 def single_volumes(x, stroke, dead_volume, area_cap, area_rod):
     """Chamber volumes of one double-acting cylinder [m^3] (seed 001 fig. 1: V_a = V0 + A1*x, V_b = V0 + A2*(L - x))."""
     return dead_volume + area_cap * x, dead_volume + area_rod * (stroke - x)

@@ -129,12 +129,36 @@ def synthesise(
     df = simulate(cfg, Scenario(duration=duration, initial_position=x0, reference=reference, load=load, noise=noise, seed=seed))
     rec = df[list(CANONICAL_COLUMNS)].copy()
     rec.attrs = {}
+    return rec, synthesis_metadata(cfg, kind, x0, load, noise, seed, description)
+
+
+def synthesis_metadata(cfg: PlantConfig, kind: str, x0: float, load, noise: SensorNoise | None, seed: int,
+                       description: str | None = None) -> dict:
+    """Sidecar metadata of a synthetic recording: plant, test conditions, controller, how it was made.
+
+    Parameters
+    ----------
+    cfg : PlantConfig
+        The plant simulated (gains already replaced).
+    kind : str
+        ``practice``, ``steps`` or ``custom`` (the set-point).
+    x0 : float
+        Initial position [m].
+    load : float, "curve" or None
+        Closing load [N].
+    noise : SensorNoise or None
+        Sensor noise applied.
+    seed : int
+        Noise seed.
+    description : str, optional
+        Default: the practice test written out.
+    """
     if description is None:
         description = (
             "Synthetic closed-loop test (govcheck recording_synth): 2 s hold, 2/5/10 % steps (3 s each, back to "
             "the start position)" + (", then an 8 mm sinusoid at pi/10 rad/s" if kind == "practice" else "")
         )
-    meta = {
+    return {
         "plant": cfg.name,
         "description": description,
         "conditions": {
@@ -158,7 +182,6 @@ def synthesise(
             "pressure_quantum": noise.pressure_quantum if noise else 0.0,
         },
     }
-    return rec, meta
 
 
 # ----------------------------------------------------------------------------------- writing

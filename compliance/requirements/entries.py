@@ -122,10 +122,8 @@ def build_requirement(rid, e, origin, defined_in, ops, procs, hist) -> Requireme
     Parameters
     ----------
     rid : str
-    e : dict
-        Merged keys of ``[requirements.ID]``.
-    origin : dict
-        (section, name, key) -> file that set it, for messages.
+    e, origin : dict
+        The merged keys of ``[requirements.ID]`` and who set each, as for :func:`build_operating_point`.
     defined_in : str
         File that first declared the requirement.
     ops, procs : dict
@@ -139,81 +137,29 @@ def build_requirement(rid, e, origin, defined_in, ops, procs, hist) -> Requireme
         A missing or unknown value, a metric the named procedures cannot measure, an
         operating point without the initial position a procedure needs, an unknown option.
     """
-    sec = "requirements"
-
-    def need(key, choices=None):
-        v = e.get(key)
-        if v is None:
-            raise InputError(f"{defined_in}: {sec}.{rid}: missing '{key}'" + (f" (one of {', '.join(choices)})" if choices else ""))
-        if choices is not None and v not in choices:
-            raise InputError(f"{_where(origin, sec, rid, key)}: '{v}' is not one of {', '.join(choices)}{did_you_mean(v, choices)}")
-        return v
-
-    title = need("title")
-    metric = need("metric", list(METRICS))
-    comparator = need("comparator", list(COMPARATORS))
-    severity = e.get("severity", "mandatory")
-    if severity not in SEVERITIES:
-        raise InputError(f"{_where(origin, sec, rid, 'severity')}: '{severity}' is not one of {', '.join(SEVERITIES)}")
-    source = e.get("source", "simulation")
-    if source not in SOURCES:
-        raise InputError(f"{_where(origin, sec, rid, 'source')}: '{source}' is not one of {', '.join(SOURCES)}")
-    limit = parse_limit(e, _where(origin, sec, rid, "limit"), metric, comparator)
+    where = _RequirementWhere(rid, origin, defined_in)
+    title = where.need(e, "title")
+    metric = where.need(e, "metric", list(METRICS))
+    comparator = where.need(e, "comparator", list(COMPARATORS))
+    severity = where.choice(e, "severity", "mandatory", SEVERITIES)
+    source = where.choice(e, "source", "simulation", SOURCES)
+    limit = parse_limit(e, where.key("limit"), metric, comparator)
     op_names = tuple(e.get("operating_points") or ())
     if not op_names:
-        raise InputError(f"{defined_in}: {sec}.{rid}: missing 'operating_points' (a list of names from [operating_points])")
+        raise InputError(f"{where.entry}: missing 'operating_points' (a list of names from [operating_points])")
     for n in op_names:
         if n not in ops:
-            raise InputError(f"{_where(origin, sec, rid, 'operating_points')}: operating point '{n}' is not declared{did_you_mean(n, ops)}")
+            raise InputError(f"{where.key('operating_points')}: operating point '{n}' is not declared{did_you_mean(n, ops)}")
     proc_names = tuple(e.get("procedures") or ())
-    info = METRICS[metric]
     if source == "simulation":
-        if not proc_names:
-            raise InputError(f"{defined_in}: {sec}.{rid}: missing 'procedures' (a list of names from [procedures])")
-        for n in proc_names:
-            if n not in procs:
-                raise InputError(f"{_where(origin, sec, rid, 'procedures')}: procedure '{n}' is not declared{did_you_mean(n, procs)}")
-            if procs[n].kind not in info.kinds:
-                raise InputError(
-                    f"{_where(origin, sec, rid, 'procedures')}: metric '{metric}' cannot be measured by procedure "
-                    f"'{n}' of kind '{procs[n].kind}' (it needs one of: {', '.join(info.kinds)})"
-                )
-            if procs[n].kind != "full_stroke" and procs[n].kind != "independent_adjustment":
-                for o in op_names:
-                    if ops[o].initial_position is None:
-                        raise InputError(
-                            f"{_where(origin, sec, rid, 'operating_points')}: operating point '{o}' has no "
-                            f"initial_position, which procedure '{n}' ({procs[n].kind}) needs"
-                        )
-    options = {}
-    for k, v in (e.get("options") or {}).items():
-        if k not in info.options:
-            raise InputError(
-                f"{_where(origin, sec, rid, 'options')}.{k}: metric '{metric}' takes no option '{k}'"
-                + (f"{did_you_mean(k, info.options)} (options: {', '.join(info.options)})" if info.options else "")
-            )
-        options[k] = parse_amount(v, STEP_OPTION_DEFAULTS[k][0], f"{_where(origin, sec, rid, 'options')}.{k}")
-    history = []
-    for fpath, snap in hist:
-        try:
-            lim = parse_limit(snap, f"{fpath}: {sec}.{rid}.limit", metric, snap.get("comparator", comparator))
-        except InputError:
-            lim = None if str(snap.get("limit", "")).lower() == OPEN_LIMIT else limit
-        history.append(
-            LimitHistory(
-                fpath,
-                snap.get("comparator", comparator),
-                lim,
-                snap.get("severity", "mandatory"),
-                bool(snap.get("enabled", True)),
-                bool(snap.get("allow_loosen", False)),
-            )
-        )
+        _check_procedures(where, metric, proc_names, op_names, ops, procs)
+    options = _metric_options(where, metric, e.get("options") or {})
+    history = _limit_history(rid, metric, comparator, limit, hist)
     return Requirement(
         id=rid,
         title=title,
         standard=e.get("standard", ""),
-        clause=need("clause"),
+        clause=where.need(e, "clause"),
         metric=metric,
         comparator=comparator,
         limit=limit,
@@ -225,5 +171,82 @@ def build_requirement(rid, e, origin, defined_in, ops, procs, hist) -> Requireme
         note=e.get("note", ""),
         enabled=bool(e.get("enabled", True)),
         defined_in=defined_in,
-        history=tuple(history),
+        history=history,
     )
+
+
+class _RequirementWhere:
+    """Locations and required values of one requirement's keys, for messages."""
+
+    def __init__(self, rid: str, origin, defined_in: str):
+        self.rid, self.origin = rid, origin
+        self.entry = f"{defined_in}: requirements.{rid}"
+
+    def key(self, key: str) -> str:
+        """``"FILE: requirements.ID.key"`` naming the file that set the key last."""
+        return _where(self.origin, "requirements", self.rid, key)
+
+    def need(self, e: dict, key: str, choices=None):
+        """The value of a required key, one of ``choices`` when given."""
+        v = e.get(key)
+        if v is None:
+            raise InputError(f"{self.entry}: missing '{key}'" + (f" (one of {', '.join(choices)})" if choices else ""))
+        if choices is not None and v not in choices:
+            raise InputError(f"{self.key(key)}: '{v}' is not one of {', '.join(choices)}{did_you_mean(v, choices)}")
+        return v
+
+    def choice(self, e: dict, key: str, default: str, choices) -> str:
+        """The value of an optional key with a default, one of ``choices``."""
+        v = e.get(key, default)
+        if v not in choices:
+            raise InputError(f"{self.key(key)}: '{v}' is not one of {', '.join(choices)}")
+        return v
+
+
+def _check_procedures(where: _RequirementWhere, metric: str, proc_names, op_names, ops, procs) -> None:
+    """The named procedures exist, can measure ``metric`` and find the initial position they need."""
+    if not proc_names:
+        raise InputError(f"{where.entry}: missing 'procedures' (a list of names from [procedures])")
+    info = METRICS[metric]
+    for n in proc_names:
+        if n not in procs:
+            raise InputError(f"{where.key('procedures')}: procedure '{n}' is not declared{did_you_mean(n, procs)}")
+        if procs[n].kind not in info.kinds:
+            raise InputError(
+                f"{where.key('procedures')}: metric '{metric}' cannot be measured by procedure "
+                f"'{n}' of kind '{procs[n].kind}' (it needs one of: {', '.join(info.kinds)})"
+            )
+        if procs[n].kind != "full_stroke" and procs[n].kind != "independent_adjustment":
+            for o in op_names:
+                if ops[o].initial_position is None:
+                    raise InputError(
+                        f"{where.key('operating_points')}: operating point '{o}' has no "
+                        f"initial_position, which procedure '{n}' ({procs[n].kind}) needs"
+                    )
+
+
+def _metric_options(where: _RequirementWhere, metric: str, given: dict) -> dict:
+    """The requirement's metric options (``options = { band = "2 %" }``) as amounts."""
+    info = METRICS[metric]
+    options = {}
+    for k, v in given.items():
+        if k not in info.options:
+            raise InputError(
+                f"{where.key('options')}.{k}: metric '{metric}' takes no option '{k}'"
+                + (f"{did_you_mean(k, info.options)} (options: {', '.join(info.options)})" if info.options else "")
+            )
+        options[k] = parse_amount(v, STEP_OPTION_DEFAULTS[k][0], f"{where.key('options')}.{k}")
+    return options
+
+
+def _limit_history(rid: str, metric: str, comparator: str, limit, hist) -> tuple[LimitHistory, ...]:
+    """The limit as each file of the chain left it (for the tighten / loosen check)."""
+    history = []
+    for fpath, snap in hist:
+        try:
+            lim = parse_limit(snap, f"{fpath}: requirements.{rid}.limit", metric, snap.get("comparator", comparator))
+        except InputError:
+            lim = None if str(snap.get("limit", "")).lower() == OPEN_LIMIT else limit
+        history.append(LimitHistory(fpath, snap.get("comparator", comparator), lim, snap.get("severity", "mandatory"),
+                                    bool(snap.get("enabled", True)), bool(snap.get("allow_loosen", False))))
+    return tuple(history)

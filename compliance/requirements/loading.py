@@ -15,9 +15,7 @@ This module finds, reads and merges the files; the rest lives beside it:
 
 from __future__ import annotations
 
-import hashlib
 import os
-import tomllib
 from importlib import resources
 from pathlib import Path
 
@@ -26,6 +24,7 @@ from pydantic import BaseModel
 from compliance.units.amounts import Amount, parse_amount
 from compliance.errors import did_you_mean
 from compliance.errors import InputError
+from compliance.model.toml_file import read_toml
 from compliance.requirements.tightening import check_tightening
 from compliance.requirements.entries import SEVERITIES, SOURCES, build_operating_point, build_procedure, build_requirement
 from compliance.requirements.schema import OPEN_LIMIT, SCHEMA, validate_file
@@ -80,26 +79,12 @@ def resolve_requirements_path(source: str | os.PathLike, relative_to: Path | Non
     return Path(str(ref))
 
 
-def _read_file(path: Path) -> tuple[dict, str]:
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise InputError(f"{path}: cannot read ({exc.strerror})") from None
-    try:
-        data = tomllib.loads(raw.decode("utf-8"))
-    except UnicodeDecodeError:
-        raise InputError(f"{path}: not a UTF-8 text file") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{path}: malformed TOML ({exc})") from None
-    return data, hashlib.sha256(raw).hexdigest()
-
-
 def _load_chain(path: Path, seen: tuple[str, ...]) -> list[tuple[Path, str, dict]]:
     """Files in merge order (bases first), each (path, digest, raw dict) validated structurally."""
     key = str(path.resolve())
     if key in seen:
         raise InputError(f"{path}: extends itself through {' -> '.join(seen)}")
-    data, digest = _read_file(path)
+    data, digest = read_toml(path)
     model = validate_file(data, path)
     chain: list[tuple[Path, str, dict]] = []
     bases = model.extends if isinstance(model.extends, list) else ([model.extends] if model.extends else [])

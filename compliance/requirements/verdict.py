@@ -13,7 +13,7 @@ Conventions (docs/metrics.md, "Verdicts"):
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 
 COMPARATORS = ("<=", "<", ">=", ">", "within")
 EQUAL_REL_TOL = 1e-9  # round-off of unit conversions; far below any measurement resolution
@@ -35,15 +35,7 @@ class Verdict:
 
     def as_dict(self) -> dict:
         """Plain-JSON form."""
-        return {
-            "value": self.value,
-            "comparator": self.comparator,
-            "limit": list(self.limit),
-            "margin": self.margin,
-            "margin_pct": self.margin_pct,
-            "status": self.status,
-            "reason": self.reason,
-        }
+        return {**asdict(self), "limit": list(self.limit)}
 
 
 def _equal(a: float, b: float) -> bool:

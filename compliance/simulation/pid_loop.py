@@ -7,7 +7,6 @@ profiled valve command.
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 import pandas as pd
@@ -16,10 +15,10 @@ from numba import njit
 from compliance.errors import SimulationError
 from compliance.model.assembly import initial_state, load_curve_arrays, parameter_vector, plant_rhs, valve_lag_input
 from compliance.model.config import PlantConfig
-from compliance.model.pid_controller import dead_zone_compensation, first_order_filter_gain, pid_step, saturate
-from compliance.model.vector_slots import *  # noqa: F403
-from compliance.model.vector_slots import N_AUX, N_STATES
-from compliance.simulation.rk4 import N_OUT, OUTPUT_COLUMNS, interp_uniform, record_sample, rk4_step, zoh_average
+from compliance.model.pid_controller import first_order_filter_gain, pid_sample, saturate
+from compliance.model.vector_slots import P_FILT, P_KD, P_KI, P_KP, P_SL_ON, P_SL_TD, P_TSAMP, P_UCEN, P_ULIM, P_VD_ON, P_VD_TD, S_SP, S_X
+from compliance.simulation.rk4 import N_OUT, OUTPUT_COLUMNS, measured_position, non_physical, record_sample, rk4_step, rk4_workspace
+from compliance.simulation.rk4 import sensor_lag_advance, sensor_lag_coefficients, zoh_average
 from compliance.simulation.scenario import Scenario, sample_profile
 
 
@@ -56,80 +55,50 @@ def simulate_core(P, y0, ref, cmd, closed_loop, pos_noise, pos_quantum, lx, ly, 
     ts = P[P_TSAMP]
     h = ts / n_sub
     y = y0.copy()
-    k1 = np.zeros(N_STATES)
-    k2 = np.zeros(N_STATES)
-    k3 = np.zeros(N_STATES)
-    k4 = np.zeros(N_STATES)
-    tmp = np.zeros(N_STATES)
-    aux = np.zeros(N_AUX)
+    k1, k2, k3, k4, tmp, aux = rk4_workspace()
     u_hist = np.zeros(n_samples + 1)
     sensor = P[P_SL_ON] != 0.0
     x_hist = np.zeros(n_samples * n_sub + 1) if sensor else np.zeros(1)
     x_hist[0] = y[S_X]
-    x_sensor = y[S_X]
-    xd_prev = y[S_X]
-    lag_decay = 0.0  # exp(-h/tau): 0 = no lag
-    lag_ramp = 1.0  # tau -> 0 limit: the sensor reads the (delayed) position itself
-    if sensor and P[P_SL_TAU] > 0.0:
-        lag_decay = math.exp(-h / P[P_SL_TAU])
-        lag_ramp = 1.0 - P[P_SL_TAU] / h * (1.0 - lag_decay)
+    x_sensor = xd_prev = y[S_X]  # the sensor starts at rest on the true position
+    lag_decay, lag_ramp = sensor_lag_coefficients(P, h)
     alpha = first_order_filter_gain(P[P_FILT], ts)
-    x_filt = 0.0
-    integral = 0.0
+    x_filt, integral = 0.0, 0.0
     valve_delay = P[P_VD_TD] if P[P_VD_ON] != 0.0 else 0.0
     sensor_delay = P[P_SL_TD] if sensor else 0.0
     if P[P_VD_ON] != 0.0:
         y[S_SP] = valve_lag_input(P, cmd[0] if not closed_loop else P[P_UCEN])
     step_index = 0
     for k in range(n_samples + 1):
-        # --- measurement at t_k
-        xm = x_sensor if sensor else y[S_X]
-        xm += pos_noise[k]
-        if pos_quantum > 0.0:
-            xm = pos_quantum * math.floor(xm / pos_quantum + 0.5)
-        # --- controller
+        # --- measurement and controller at t_k
+        xm = measured_position(x_sensor if sensor else y[S_X], pos_noise[k], pos_quantum)
         u_d = 0.0
         if closed_loop:
             if k == 0:
                 x_filt = xm
-            x_new = x_filt + alpha * (xm - x_filt)
-            rate = (x_new - x_filt) / ts
-            x_filt = x_new
-            u_d, integral = pid_step(ref[k] - xm, rate, integral, P[P_KP], P[P_KI], P[P_KD], ts)
-            if P[P_LC] > 0.0:
-                u_c = dead_zone_compensation(u_d, P[P_CDZP], P[P_CDZN], P[P_CSLP], P[P_CSLN], P[P_LC])
-            else:
-                u_c = u_d
+            u_d, u_c, x_filt, integral = pid_sample(P, xm, ref[k], x_filt, integral, alpha, P[P_KP], P[P_KI], P[P_KD], ts)
             u = saturate(u_c, P[P_ULIM]) + P[P_UCEN]
         else:
             u = cmd[k]
         if k == 0 and P[P_VD_ON] != 0.0 and closed_loop:
             y[S_SP] = valve_lag_input(P, u)
         u_hist[k] = u
-        # --- record the sample
+        # --- record the sample; its slope is also the first RK4 slope when there is no valve delay
         u_now = u if valve_delay <= 0.0 else zoh_average(u_hist, ts, k * ts - valve_delay, k * ts - valve_delay)
-        plant_rhs(y, P, u_now, lx, ly, k1, aux)  # also the first RK4 slope when there is no valve delay
+        plant_rhs(y, P, u_now, lx, ly, k1, aux)
         record_sample(out, k, ts, xm, ref[k], u, u_d, y, aux, P)
         if k == n_samples:
             break
         # --- integrate to t_{k+1}
         for j in range(n_sub):
             t0 = (k * n_sub + j) * h
-            if valve_delay > 0.0:
-                u_step = zoh_average(u_hist, ts, t0 - valve_delay, t0 + h - valve_delay)
-            else:
-                u_step = u
+            u_step = u if valve_delay <= 0.0 else zoh_average(u_hist, ts, t0 - valve_delay, t0 + h - valve_delay)
             rk4_step(y, P, u_step, lx, ly, h, k1, k2, k3, k4, tmp, aux, j == 0 and valve_delay <= 0.0)
             step_index += 1
             if sensor:
-                x_hist[step_index] = y[S_X]
-                xd = interp_uniform(x_hist, h, step_index * h - sensor_delay)
-                # first-order lag integrated exactly for an input linear over the step
-                x_sensor = lag_decay * x_sensor + (1.0 - lag_decay) * xd_prev + (xd - xd_prev) * lag_ramp
-                xd_prev = xd
-        if not (math.isfinite(y[S_X]) and math.isfinite(y[S_PA]) and math.isfinite(y[S_PB])):
-            return k
-        if y[S_PA] <= 0.0 or y[S_PB] <= 0.0 or abs(y[S_V]) > 100.0:
+                x_sensor, xd_prev = sensor_lag_advance(x_hist, step_index, y[S_X], h, sensor_delay, x_sensor, xd_prev,
+                                                       lag_decay, lag_ramp)
+        if non_physical(y):
             return k
     return -1
 

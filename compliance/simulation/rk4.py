@@ -9,10 +9,12 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from compliance.model.assembly import plant_rhs
-from compliance.model.vector_slots import A_FRIC, A_LOAD, A_OPEN, A_QA, A_QB, P_HT_ON, P_PS, P_SD_ON, P_TS, S_PA, S_PB, S_PSUP, S_TA, S_TB, S_V, S_X
+from compliance.model.vector_slots import A_FRIC, A_LOAD, A_OPEN, A_QA, A_QB, N_AUX, N_STATES, P_HT_ON, P_PS, P_SD_ON, P_SL_TAU, P_TS
+from compliance.model.vector_slots import S_PA, S_PB, S_PSUP, S_TA, S_TB, S_V, S_X
 
 OUTPUT_COLUMNS = (
     "time", "position", "reference", "valve_command", "pressure_a", "pressure_b", "supply_pressure",
@@ -95,3 +97,56 @@ def rk4_step(y, P, u, lx, ly, h, k1, k2, k3, k4, tmp, aux, k1_ready=False):
     for i in range(n):
         y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
 
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def rk4_workspace():
+    """Scratch arrays of :func:`rk4_step`: k1, k2, k3, k4, tmp (N_STATES each) and aux (N_AUX)."""
+    return (np.zeros(N_STATES), np.zeros(N_STATES), np.zeros(N_STATES), np.zeros(N_STATES), np.zeros(N_STATES),
+            np.zeros(N_AUX))
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def measured_position(x, noise, quantum):
+    """What the position sensor reports [m]: ``x`` plus additive noise, rounded to ``quantum`` (0 = none)."""
+    xm = x + noise
+    if quantum > 0.0:
+        xm = quantum * math.floor(xm / quantum + 0.5)
+    return xm
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def non_physical(y):
+    """Whether the state has left physics: non-finite, a non-positive chamber pressure or |v| > 100 m/s."""
+    if not (math.isfinite(y[S_X]) and math.isfinite(y[S_PA]) and math.isfinite(y[S_PB])):
+        return True
+    return y[S_PA] <= 0.0 or y[S_PB] <= 0.0 or abs(y[S_V]) > 100.0
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def sensor_lag_coefficients(P, h):
+    """(decay, ramp) of the sensor's first-order lag over one step ``h`` [s], exact for a ramp input.
+
+    decay = exp(-h/tau) (0 = no lag); ramp = 1 - tau/h (1 - decay), 1 in the tau -> 0 limit where
+    the sensor reads the (delayed) position itself.
+    """
+    tau = P[P_SL_TAU]
+    if tau <= 0.0:
+        return 0.0, 1.0
+    decay = math.exp(-h / tau)
+    return decay, 1.0 - tau / h * (1.0 - decay)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def sensor_lag_advance(x_hist, step_index, x, h, delay, x_sensor, xd_prev, decay, ramp):
+    """Store the true position of step ``step_index`` and advance the delayed, lagged sensor one step.
+
+    Returns
+    -------
+    tuple
+        (sensor reading [m], delayed position at this step [m]).
+    """
+    x_hist[step_index] = x
+    xd = interp_uniform(x_hist, h, step_index * h - delay)
+    # first-order lag integrated exactly for an input linear over the step
+    return decay * x_sensor + (1.0 - decay) * xd_prev + (xd - xd_prev) * ramp, xd

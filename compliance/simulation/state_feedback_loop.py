@@ -9,20 +9,19 @@ sample (tests), so the two controllers are compared on one footing.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 from numba import njit
 
+from compliance.effects import EFFECTS
 from compliance.model.config import PlantConfig
-from compliance.model.pid_controller import dead_zone_compensation, pid_step, saturate
+from compliance.model.pid_controller import pid_sample, saturate
 from compliance.errors import InputError, SimulationError
-from compliance.model.vector_slots import N_AUX, N_STATES, P_CDZN, P_CDZP, P_CSLN, P_CSLP, P_LC
-from compliance.model.vector_slots import P_UCEN, P_ULIM, P_VD_ON, S_PA, S_PB, S_SP, S_V, S_X
+from compliance.model.vector_slots import N_STATES, P_UCEN, P_ULIM, P_VD_ON, S_PA, S_PB, S_SP, S_V, S_X
 from compliance.model.assembly import initial_state, load_curve_arrays, parameter_vector, plant_rhs, valve_lag_input
-from compliance.simulation.rk4 import OUTPUT_COLUMNS, record_sample, rk4_step
+from compliance.simulation.rk4 import OUTPUT_COLUMNS, measured_position, non_physical, record_sample, rk4_step, rk4_workspace
 from compliance.simulation.scenario import Scenario, SensorNoise, sample_profile
 from compliance.model.state_feedback import (
     C_AO_IN, C_AO_LV, C_AO_LX, C_AO_POLE, C_AO_SV, C_AO_SX, C_AREA_RATIO, C_FO_IN, C_FO_L, C_FO_POLE, C_FO_SV, C_KD, C_KI,
@@ -39,6 +38,79 @@ N_COL = len(COLUMNS)
 _COL = {c: i for i, c in enumerate(COLUMNS)}
 (O_T, O_XM, O_REF, O_U, O_PA, O_PB, O_PS, O_X, O_V, O_LOAD, O_FRIC, O_QA, O_QB, O_OPEN, O_TA, O_TB, O_UD,
  O_RV, O_RA, O_ACC, O_VH, O_AH, O_FH, O_UF) = range(N_COL)
+
+
+# the seed 001 estimator's memory between samples (one small array, so one helper can advance it)
+(E_XPREV, E_VHAT, E_VPREV, E_UPPREV, E_WA, E_WF, E_FNL_PREV, E_FRATE) = range(8)
+N_EST = 8
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def estimator_step(C, est, k, pid, xm, u_p, u_rel):
+    """Advance the seed 001 estimates to sample ``k``: velocity filter, acceleration and friction observers.
+
+    Parameters
+    ----------
+    C : ndarray
+        Controller vector.
+    est : ndarray
+        (N_EST,) estimator memory, updated in place (zeros before sample 0).
+    k : int
+        Sample index; at k = 0 the observers start from rest (a^ = 0, F^ = 0).
+    pid : bool
+        PID mode: the observers are not advanced (as the PID does not read them).
+    xm : float
+        Measured position [m].
+    u_p : float
+        Gauge pressure input of the friction observer (load pressure removed) [Pa].
+    u_rel : float
+        Command held over the last period, relative to the valve centre [V].
+
+    Returns
+    -------
+    tuple
+        (v^ [m/s], a^ [m/s^2], F^ [N], filtered d(F^ - viscous)/dt [N/s]).
+    """
+    ts = C[C_TS]
+    if k == 0:
+        est[E_XPREV] = xm
+        est[E_WA] = -(C[C_AO_LX] * xm)  # a^ = 0 at rest
+        est[E_WF] = 0.0  # F^ = 0 at rest
+    # velocity: differentiated and filtered position (seed 001, "status variable v")
+    v_prev = est[E_VHAT]
+    v_hat = v_prev + C[C_VEL_ALPHA] * ((xm - est[E_XPREV]) / ts - v_prev)
+    if k > 0 and not pid:
+        # observers advance over [t_{k-1}, t_k]: command held, measurements on a straight line
+        base_a = C[C_AO_IN] * u_rel
+        est[E_WA] = observer_foh_step(est[E_WA], C[C_AO_POLE], base_a + C[C_AO_SX] * est[E_XPREV] + C[C_AO_SV] * v_prev,
+                                      base_a + C[C_AO_SX] * xm + C[C_AO_SV] * v_hat, ts)
+        est[E_WF] = observer_foh_step(est[E_WF], C[C_FO_POLE], C[C_FO_IN] * est[E_UPPREV] + C[C_FO_SV] * v_prev,
+                                      C[C_FO_IN] * u_p + C[C_FO_SV] * v_hat, ts)
+    est[E_XPREV] = xm
+    est[E_UPPREV] = u_p
+    est[E_VHAT] = v_hat
+    a_hat = est[E_WA] + C[C_AO_LX] * xm + C[C_AO_LV] * v_hat  # seed 001 eq. (10): a^ = w + K1 x1
+    f_hat = est[E_WF] + C[C_FO_L] * v_hat  # seed 001 eq. (11): F^ = w + K_f v
+    f_nl = f_hat - C[C_VISCOUS] * v_hat  # friction beyond the linear model's viscous part
+    if k == 0:
+        est[E_FNL_PREV] = f_nl
+    # d/dt by a backward difference, low-passed (controller.RATE_FILTER_FACTOR x the observer's
+    # bandwidth): the derivative would otherwise pass the differentiated position noise to the valve
+    est[E_FRATE] += C[C_RATE_ALPHA] * ((f_nl - est[E_FNL_PREV]) / ts - est[E_FRATE])
+    est[E_FNL_PREV] = f_nl
+    return v_hat, a_hat, f_hat, est[E_FRATE]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def record_estimates(out, k, dref_k, ddref_k, acc, v_hat, a_hat, f_hat, u_f):
+    """Write the tracking loop's extra columns (``EXTRA_COLUMNS``) of sample ``k``."""
+    out[k, O_RV] = dref_k
+    out[k, O_RA] = ddref_k
+    out[k, O_ACC] = acc
+    out[k, O_VH] = v_hat
+    out[k, O_AH] = a_hat
+    out[k, O_FH] = f_hat
+    out[k, O_UF] = u_f
 
 
 @njit(cache=True, error_model="numpy")
@@ -74,72 +146,26 @@ def tracking_core(P, C, y0, ref, dref, ddref, pos_noise, pos_quantum, pa_noise, 
     ts = C[C_TS]
     h = ts / n_sub
     y = y0.copy()
-    k1 = np.zeros(N_STATES)
-    k2 = np.zeros(N_STATES)
-    k3 = np.zeros(N_STATES)
-    k4 = np.zeros(N_STATES)
-    tmp = np.zeros(N_STATES)
+    k1, k2, k3, k4, tmp, aux = rk4_workspace()
     dy = np.zeros(N_STATES)
-    aux = np.zeros(N_AUX)
+    est = np.zeros(N_EST)
     pid = C[C_MODE] == 0.0
-    x_prev = 0.0
-    v_hat = 0.0
     x_filt = 0.0
     integral = 0.0
-    w_a = 0.0
-    w_f = 0.0
-    f_nl_prev = 0.0
-    f_rate = 0.0
-    v_prev = 0.0
-    up_prev = 0.0
     u_rel = 0.0
     if P[P_VD_ON] != 0.0:
         y[S_SP] = valve_lag_input(P, P[P_UCEN])
     for k in range(n_samples + 1):
-        # --- measurements at t_k
-        xm = y[S_X] + pos_noise[k]
-        if pos_quantum > 0.0:
-            xm = pos_quantum * math.floor(xm / pos_quantum + 0.5)
-        pa_m = y[S_PA] + pa_noise[k]
-        pb_m = y[S_PB] + pb_noise[k]
+        # --- measurements and estimates at t_k
+        xm = measured_position(y[S_X], pos_noise[k], pos_quantum)
+        u_p = gauge_pressure_input(y[S_PA] + pa_noise[k], y[S_PB] + pb_noise[k], C[C_AREA_RATIO], C[C_PATM]) - C[C_LOAD_PRESSURE]
         if k == 0:
-            x_prev = xm
             x_filt = xm
-            w_a = -(C[C_AO_LX] * xm)  # a^ = 0 at rest
-            w_f = 0.0  # F^ = 0 at rest
-        # velocity: differentiated and filtered position (seed 001, "status variable v")
-        v_prev = v_hat
-        v_hat += C[C_VEL_ALPHA] * ((xm - x_prev) / ts - v_hat)
-        u_p = gauge_pressure_input(pa_m, pb_m, C[C_AREA_RATIO], C[C_PATM]) - C[C_LOAD_PRESSURE]
-        if k > 0 and not pid:
-            # observers advance over [t_{k-1}, t_k]: command held, measurements on a straight line
-            base_a = C[C_AO_IN] * u_rel
-            w_a = observer_foh_step(w_a, C[C_AO_POLE], base_a + C[C_AO_SX] * x_prev + C[C_AO_SV] * v_prev,
-                                    base_a + C[C_AO_SX] * xm + C[C_AO_SV] * v_hat, ts)
-            w_f = observer_foh_step(w_f, C[C_FO_POLE], C[C_FO_IN] * up_prev + C[C_FO_SV] * v_prev,
-                                    C[C_FO_IN] * u_p + C[C_FO_SV] * v_hat, ts)
-        x_prev = xm
-        up_prev = u_p
-        a_hat = w_a + C[C_AO_LX] * xm + C[C_AO_LV] * v_hat  # seed 001 eq. (10): a^ = w + K1 x1
-        f_hat = w_f + C[C_FO_L] * v_hat  # seed 001 eq. (11): F^ = w + K_f v
-        f_nl = f_hat - C[C_VISCOUS] * v_hat  # friction beyond the linear model's viscous part
-        if k == 0:
-            f_nl_prev = f_nl
-        # d/dt by a backward difference, low-passed (controller.RATE_FILTER_FACTOR x the observer's
-        # bandwidth): the derivative would otherwise pass the differentiated position noise to the valve
-        f_rate += C[C_RATE_ALPHA] * ((f_nl - f_nl_prev) / ts - f_rate)
-        f_nl_prev = f_nl
+        v_hat, a_hat, f_hat, f_rate = estimator_step(C, est, k, pid, xm, u_p, u_rel)
         # --- controller
         u_f = 0.0
         if pid:
-            x_new = x_filt + C[C_PID_ALPHA] * (xm - x_filt)
-            rate = (x_new - x_filt) / ts
-            x_filt = x_new
-            u_d, integral = pid_step(ref[k] - xm, rate, integral, C[C_KP], C[C_KI], C[C_KD], ts)
-            if P[P_LC] > 0.0:
-                u_c = dead_zone_compensation(u_d, P[P_CDZP], P[P_CDZN], P[P_CSLP], P[P_CSLN], P[P_LC])
-            else:
-                u_c = u_d
+            u_d, u_c, x_filt, integral = pid_sample(P, xm, ref[k], x_filt, integral, C[C_PID_ALPHA], C[C_KP], C[C_KI], C[C_KD], ts)
         else:
             u_d, u_f = state_feedback_command(C, ref[k], dref[k], ddref[k], xm, v_hat, a_hat, f_hat, f_rate)
             u_c = u_d
@@ -148,21 +174,13 @@ def tracking_core(P, C, y0, ref, dref, ddref, pos_noise, pos_quantum, pa_noise, 
         # --- record
         plant_rhs(y, P, u, lx, ly, dy, aux)
         record_sample(out, k, ts, xm, ref[k], u, u_d, y, aux, P)
-        out[k, O_RV] = dref[k]
-        out[k, O_RA] = ddref[k]
-        out[k, O_ACC] = dy[S_V]
-        out[k, O_VH] = v_hat
-        out[k, O_AH] = a_hat
-        out[k, O_FH] = f_hat
-        out[k, O_UF] = u_f
+        record_estimates(out, k, dref[k], ddref[k], dy[S_V], v_hat, a_hat, f_hat, u_f)
         if k == n_samples:
             break
         # --- integrate the plant to t_{k+1}
         for j in range(n_sub):
             rk4_step(y, P, u, lx, ly, h, k1, k2, k3, k4, tmp, aux)
-        if not (math.isfinite(y[S_X]) and math.isfinite(y[S_PA]) and math.isfinite(y[S_PB])):
-            return k
-        if y[S_PA] <= 0.0 or y[S_PB] <= 0.0 or abs(y[S_V]) > 100.0:
+        if non_physical(y):
             return k
     return -1
 
@@ -190,9 +208,6 @@ class AxisReference:
         object.__setattr__(self, "position", arrays[0])
         object.__setattr__(self, "velocity", arrays[1])
         object.__setattr__(self, "acceleration", arrays[2])
-
-
-_UNSUPPORTED_EFFECTS = ("sensor_lag",)
 
 
 def simulate_axis(cfg: PlantConfig, reference: AxisReference, *, mode: str | None = None, compensation: bool | None = None,
@@ -239,11 +254,11 @@ def simulate_axis(cfg: PlantConfig, reference: AxisReference, *, mode: str | Non
         Non-physical state.
     """
     where = cfg.path or cfg.name
-    for e in _UNSUPPORTED_EFFECTS:
-        if e in cfg.effects:
+    for e, values in cfg.effects.items():  # the declarations say what this loop can run (Effect.plant_b, input_delay)
+        if not EFFECTS[e].plant_b:
             raise InputError(f"{where}: effect {e} is not supported by the tracking loop (use govcheck simulate)")
-    if "valve_dynamics" in cfg.effects and cfg.effects["valve_dynamics"].get("delay", 0.0) > 0.0:
-        raise InputError(f"{where}: a valve_dynamics delay is not supported by the tracking loop")
+        if EFFECTS[e].input_delay and values.get(EFFECTS[e].input_delay, 0.0) > 0.0:
+            raise InputError(f"{where}: a {e} delay is not supported by the tracking loop")
     stroke = cfg.p("cylinder.stroke")
     r = reference
     if np.min(r.position) < 0.0 or np.max(r.position) > stroke:

@@ -34,7 +34,7 @@ from scipy.signal import butter, filtfilt
 
 from compliance.model.config import PlantConfig
 from compliance.errors import InputError
-from compliance.validation.replay import is_uniform
+from compliance.validation.resampling import is_uniform
 
 SIGNAL_UNITS = {"position": "m", "valve_command": "V", "pressure_a": "Pa", "pressure_b": "Pa", "supply_pressure": "Pa"}
 WINDOW_KINDS = ("steady", "transient")

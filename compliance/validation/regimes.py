@@ -36,7 +36,8 @@ import pandas as pd
 from scipy.signal import savgol_coeffs, savgol_filter
 
 from compliance.model.config import PlantConfig
-from compliance.validation.replay import is_uniform, resample_uniform, robust_std
+from compliance.validation.recorded_noise import robust_std
+from compliance.validation.resampling import is_uniform, resample_uniform
 
 VELOCITY_WINDOW = 0.051  # s; Savitzky-Golay window of the velocity estimate (quadratic)
 REVERSAL_SPAN = 0.5  # s; how long "after a reversal" lasts

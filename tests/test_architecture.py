@@ -1,0 +1,104 @@
+"""The package layout as a checked contract (docs/internals.md, "The layout").
+
+Every ``compliance`` package imports only from packages below it in ``LAYERS``; no module
+imports itself back through a cycle. These read the source with ``ast`` (nothing is run), so
+a lazy import inside a function counts like any other.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+PACKAGE = Path(__file__).resolve().parents[1] / "compliance"
+
+# bottom first: a package may import from itself and from packages before it in this list
+LAYERS = ["errors", "units", "files", "physics", "effects", "model", "simulation", "metrics", "linear",
+          "tracking", "procedures", "requirements", "campaign", "sweep", "recordings", "validation",
+          "characterise", "diagnosis", "report", "papers", "cli", "__main__"]
+
+
+def _modules() -> dict[str, Path]:
+    out = {}
+    for path in sorted(PACKAGE.rglob("*.py")):
+        parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
+        name = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+        out[name] = path
+    return out
+
+
+def _imports(name: str, path: Path, modules: dict[str, Path]) -> set[str]:
+    """Modules of ``compliance`` that ``name`` imports (resolved to existing modules)."""
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        targets = []
+        if isinstance(node, ast.Import):
+            targets = [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            targets = [f"{node.module}.{a.name}" for a in node.names]
+        for t in targets:
+            while t and t not in modules:
+                t = t.rpartition(".")[0]
+            if t.startswith("compliance") and t != name:
+                found.add(t)
+    return found
+
+
+def _graph() -> dict[str, set[str]]:
+    modules = _modules()
+    return {name: _imports(name, path, modules) for name, path in modules.items()}
+
+
+def _layer(module: str) -> str | None:
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else None  # None: the root package (version, numba cache)
+
+
+def test_every_package_is_placed_in_the_layers():
+    tops = {_layer(m) for m in _modules()} - {None}
+    assert tops <= set(LAYERS), f"packages missing from LAYERS: {sorted(tops - set(LAYERS))}"
+
+
+def test_packages_import_only_downwards():
+    rank = {name: i for i, name in enumerate(LAYERS)}
+    upward = []
+    for module, deps in _graph().items():
+        here = _layer(module)
+        for dep in deps:
+            there = _layer(dep)
+            if here is None or there is None or here == there:
+                continue
+            if rank[there] > rank[here]:
+                upward.append(f"{module} -> {dep}")
+    assert not upward, "imports against the layer order:\n" + "\n".join(sorted(upward))
+
+
+def test_no_import_cycles():
+    graph = _graph()
+    index, low, stack, on_stack, cycles = {}, {}, [], set(), []
+
+    def visit(v):  # Tarjan's strongly connected components
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on_stack.add(v)
+        for w in graph[v]:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on_stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on_stack.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                cycles.append(sorted(comp))
+
+    for v in graph:
+        if v not in index:
+            visit(v)
+    assert not cycles, f"import cycles: {cycles}"
