@@ -222,7 +222,7 @@ def _decide(st: _Stage) -> dict:
         reason = (f"{' and '.join(ambiguous)} explain the recording equally well (every signal within "
                   f"{RESIDUAL_LIMIT:g} x its floor, or BIC within {AMBIGUOUS_BIC:g}); another test tells them apart")
     return {"scores": scores, "verdict": verdict_name, "winner": winner, "reason": reason, "search": search,
-            "ambiguous": ambiguous, "left": signals_left(after)}
+            "ambiguous": ambiguous, "left": signals_left(after if winner else _objective(st, "nominal"))}
 
 
 def _suggest(st: _Stage, ambiguous: list) -> dict | None:
