@@ -29,7 +29,8 @@ from compliance.errors import InputError, SimulationError
 from compliance.diagnosis.candidates import Candidate, apply, base_params, effect_candidate, signature_order
 from compliance.diagnosis.fit import FitContext, FitResult, chi2_parts
 from compliance.diagnosis.fitted_model import fitted_plant, save_fitted
-from compliance.diagnosis.multi import CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_enough, contributions, set_effects, set_name
+from compliance.diagnosis.multi import (CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_enough, contributions, screen_additions,
+                                        set_effects, set_name)
 from compliance.diagnosis.discriminate import design_test
 from compliance.diagnosis.empirical import empirical_term
 from compliance.diagnosis.replay_fit import ReplaySetup, prepare_replay, replay_config, run_replay
@@ -169,8 +170,10 @@ def _search_sets(st: _Stage, winner: str) -> list[dict]:
         if not signals_left(_objective(st, current.name)):
             break
         have = set(set_effects(current.name))
-        singles = sorted((f for f in st.fits.values() if f.name in EFFECTS and f.name not in have), key=lambda f: f.chi2)
-        tasks = [("extend", current, f) for f in singles[:CANDIDATES_PER_ROUND]]
+        singles = [f for f in st.fits.values() if f.name in EFFECTS and f.name not in have]
+        screen = screen_additions(FitContext(st.rc, st.setup, st.model), current, singles)
+        st.sims += 2 * len(singles)
+        tasks = [("extend", current, f) for f in sorted(singles, key=lambda f: screen[f.name])[:CANDIDATES_PER_ROUND]]
         if not tasks:
             break
         _run(st, tasks)

@@ -1,7 +1,8 @@
 """Several effects at once: greedy forward selection of effect sets, with re-fitting.
 
-After the best single explanation, the diagnosis searches again on what is left: each of the
-next-best single effects is added to the current set and the whole set is refitted (starting
+After the best single explanation, the diagnosis searches again on what is left: the effects
+that lower the set's chi-square most when simply switched on at their single-effect optimum or
+default (``screen_additions``, two replays each) are each added to the current set and the whole set is refitted (starting
 at the set's optimum plus the added effect at its own single-effect optimum, or at its
 declared default when that starts better). An added effect is kept only when
 
@@ -23,7 +24,7 @@ from compliance.diagnosis.select import RESIDUAL_LIMIT, SIGNIFICANCE
 
 ADD_GAIN = 0.3  # share of the current set's excess chi-square an added effect must remove
 NO_WORSE = 1.25  # no signal's chi-square may rise by more than this factor when an effect is added
-CANDIDATES_PER_ROUND = 4  # next-best single effects tried in each round
+CANDIDATES_PER_ROUND = 4  # best-screened effects refitted in each round
 MAX_EFFECTS = 3  # at most this many effects in one explanation
 SET_SIMPLEX_FEV = 8  # simplex evaluations per parameter of a set refit (it starts near the optimum)
 
@@ -38,16 +39,34 @@ def set_effects(name: str) -> list[str]:
     return [e for e in name.split("+") if e in EFFECTS]
 
 
+def _start_points(current: FitResult, single: FitResult) -> tuple[tuple, list[list[float]]]:
+    """Parameters of ``current`` plus ``single``'s effect, and the two starts: its single optimum, its default."""
+    added = tuple(fp for fp in single.params if fp.kind == "effect")
+    params = tuple(current.params) + added
+    return params, [list(current.values) + [v for fp, v in zip(single.params, single.values) if fp.kind == "effect"],
+                    list(current.values) + [fp.nominal for fp in added]]
+
+
+def screen_additions(ctx: FitContext, current: FitResult, singles) -> dict[str, float]:
+    """Effect -> chi-square of the current set with that effect added, unfitted (the better of its two starts).
+
+    Which effects a round refits: an effect whose single fit was poor because another effect
+    dominated the recording can still complete the set (two replays per effect, no fit).
+    """
+    out = {}
+    for f in singles:
+        params, starts = _start_points(current, f)
+        out[f.name] = min(scan_points(ctx, params, starts))
+    return out
+
+
 def extend_fit(ctx: FitContext, current: FitResult, single: FitResult) -> FitResult:
     """Refit ``current`` (an effect set, possibly with base parameters) with ``single``'s effect added.
 
     The added effect starts at its single-effect optimum or its declared default, whichever
     leaves the lower chi-square with the current set held at its optimum.
     """
-    added = tuple(fp for fp in single.params if fp.kind == "effect")
-    params = tuple(current.params) + added
-    starts = [list(current.values) + [v for fp, v in zip(single.params, single.values) if fp.kind == "effect"],
-              list(current.values) + [fp.nominal for fp in added]]
+    params, starts = _start_points(current, single)
     chis = scan_points(ctx, params, starts)
     start = starts[0] if chis[0] <= chis[1] else starts[1]
     names = set_effects(current.name) + set_effects(single.name)
@@ -87,4 +106,4 @@ def contributions(ctx: FitContext, fit: FitResult) -> dict[str, float]:
 
 
 __all__ = ["extend_fit", "adds_enough", "contributions", "set_name", "set_effects", "ADD_GAIN", "NO_WORSE",
-           "CANDIDATES_PER_ROUND", "MAX_EFFECTS"]
+           "CANDIDATES_PER_ROUND", "MAX_EFFECTS", "screen_additions"]
