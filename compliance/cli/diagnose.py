@@ -60,6 +60,8 @@ def register(sub):
                                                             "nothing is saved when the diagnosis finds no mismatch)")
     add_quiet(p, "print only the verdict line")
     add_reproducible(p)
+    p.add_argument("--suggest-test", action="store_true",
+                   help="design and print the test that best tells the two leading explanations apart")
     return p
 
 
@@ -97,7 +99,8 @@ def run(args) -> int:
     from compliance.cli.progress import progress
 
     with progress(1, "diagnose", quiet=args.quiet, unit="stage", first="replay, locate, fit every candidate") as bar:
-        diag = diagnose(cfg, frame, meta, effects=effects, jobs=args.jobs, recalibrate=not args.no_recalibration)
+        diag = diagnose(cfg, frame, meta, effects=effects, jobs=args.jobs, recalibrate=not args.no_recalibration,
+                        suggest_test=args.suggest_test)
         bar.update(1)
     unsaved = None
     if args.save_model:
@@ -113,6 +116,10 @@ def run(args) -> int:
     _print_servo(data, args.quiet)
     if unsaved:
         print(f"note: {unsaved}")
+    if args.suggest_test:
+        from compliance.diagnosis.discriminate import suggestion_lines
+
+        print("\n".join(suggestion_lines(diag.suggested_test)))
     return 0
 
 

@@ -90,10 +90,12 @@ def run(args) -> int:
     if args.practice:
         rep = run_practice(args.practice, cfg, library=library, jobs=jobs)
         for row in rep["recordings"]:
-            mark = "OK " if row["correct"] else "BAD"
+            mark = "OK " if row["correct"] else ("AMB" if row.get("ambiguous_with_truth") else "BAD")
             print(f"{mark} {row['name']:32s} truth {row['truth']:18s} -> {row['verdict']:16s} {row['winner'] or '-':28s} "
                   f"{row['seconds']:5.1f} s  {row['parameters']}")
-        print(f"\n{rep['correct']}/{len(rep['recordings'])} practice recordings diagnosed correctly")
+        amb = sum(bool(r.get("ambiguous_with_truth")) for r in rep["recordings"])
+        print(f"\n{rep['correct']}/{len(rep['recordings'])} practice recordings diagnosed correctly"
+              + (f"; {amb} more called ambiguous with the truth among the explanations named" if amb else ""))
         if args.json:
             _write(args, rep)
         return 0 if rep["correct"] == len(rep["recordings"]) else 1

@@ -10,11 +10,15 @@ Public API:
   concealed-effect cases and on recordings with answers).
 
 Modules, one job each: ``replay_fit`` (fast re-synchronised replay with matched noise),
-``noise_floor`` / ``residuals`` (normalised residuals), ``candidates`` (what may be fitted),
-``fit`` (scan, simplex, least squares), ``select`` (information criteria, verdict),
-``located`` (where the model misses), ``explain`` (the paragraph), ``engine`` (the chain),
-``concealed`` / ``benchmark`` (the proof), ``friction_models`` / ``friction_diagnosis`` (the friction
-bench; its report is compliance/report/friction.py).
+``operating_point`` (the stated load holds at the recording's start), ``noise_floor`` /
+``residuals`` (normalised residuals), ``candidates`` (what may be fitted), ``fit`` (scan,
+simplex, least squares), ``recalibration`` (base parameters), ``multi`` (several effects),
+``workers`` (parallel fits), ``select`` (information criteria, honest verdicts, ambiguity),
+``discriminate`` (the test that tells two explanations apart), ``empirical`` (the missing force
+outside the library), ``located`` (where the model misses), ``explain`` (the paragraph),
+``fitted_model`` (the fitted plant), ``engine`` (the chain),
+``concealed`` / ``benchmark`` (the proof), ``friction_models`` / ``friction_diagnosis`` /
+(the friction bench; its report is compliance/report/friction.py).
 """
 
 from __future__ import annotations

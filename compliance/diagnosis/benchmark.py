@@ -341,6 +341,7 @@ def run_practice(directory, cfg: PlantConfig, *, library=None, jobs: int = 1) ->
     from compliance.errors import InputError
     from compliance.recordings.reader import read_recording
     from compliance.diagnosis.engine import diagnose
+    from compliance.diagnosis.practice_score import practice_correct
 
     folder = Path(directory)
     answers_path = folder / "ANSWERS.json"
@@ -358,11 +359,7 @@ def run_practice(directory, cfg: PlantConfig, *, library=None, jobs: int = 1) ->
         frame, meta = read_recording(files[0])
         d = diagnose(cfg, frame, meta, effects=library, jobs=jobs)
         truth = list(ans.get("effects") or [])
-        winner_effects = [e for e in (d.winner or "").split("+") if e in EFFECTS]
-        if truth:
-            correct = d.verdict == "missing_physics" and winner_effects == truth
-        else:
-            correct = d.verdict in ("no_mismatch", "parameters_only")
+        correct, ambiguous_ok = practice_correct(d, truth)
         fitted = {}
         if d.winner:
             fit = d.fits[d.winner]
@@ -373,6 +370,7 @@ def run_practice(directory, cfg: PlantConfig, *, library=None, jobs: int = 1) ->
             got = fitted.get(key)
             params[alias] = {"true": value, "fitted": got, "error": None if got is None else abs(got - value) / abs(value)}
         rows.append({"name": name, "truth": ", ".join(truth) or "none", "verdict": d.verdict, "winner": d.winner,
-                     "correct": bool(correct), "parameters": params, "seconds": d.seconds, "explanation": d.explanation,
+                     "correct": bool(correct), "ambiguous_with_truth": ambiguous_ok, "ambiguity": list(d.ambiguous),
+                     "signals_left": dict(d.signals_left), "parameters": params, "seconds": d.seconds, "explanation": d.explanation,
                      "fit_before": d.fit_before, "fit_after": d.fit_after})
     return {"recordings": rows, "correct": sum(r["correct"] for r in rows)}

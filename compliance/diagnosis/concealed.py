@@ -28,6 +28,7 @@ import numpy as np
 from compliance.model.config import PlantConfig
 from compliance.effects import EFFECTS
 from compliance.errors import SimulationError
+from compliance.diagnosis.operating_point import load_at_start
 from compliance.recordings.synth import PRACTICE_NOISE, practice_profile, synthesise
 from compliance.simulation import Scenario, simulate
 
@@ -110,7 +111,8 @@ def _clean_run(cfg: PlantConfig, op: dict):
     stroke = cfg.p("cylinder.stroke")
     ref = practice_profile(op["x0"], stroke)
     c = cfg.replace(params={"controller.kd": op["kd"]})
-    return simulate(c, Scenario(duration=30.0, initial_position=op["x0"], reference=ref, load=op["load"]))
+    return simulate(c, Scenario(duration=30.0, initial_position=op["x0"], reference=ref,
+                                load=load_at_start(c, op["load"], op["x0"])))
 
 
 def visibility(cfg_truth: PlantConfig, cfg_nominal: PlantConfig, op: dict) -> dict:
@@ -139,8 +141,11 @@ def _record(cfg_truth: PlantConfig, op: dict, seed: int, description: str):
 
     ref = practice_profile(op["x0"], cfg_truth.p("cylinder.stroke"))
     shifted = Profile(ref.times + PRE_ROLL, ref.values)
-    frame, meta = synthesise(cfg_truth, "practice", x0=op["x0"], load=op["load"], kd=op["kd"], noise=PRACTICE_NOISE,
-                             seed=seed, description=description, duration=30.0 + PRE_ROLL, reference=shifted)
+    # the stated load is the load at the start position (operating_point.py), as a bench states it
+    frame, meta = synthesise(cfg_truth, "practice", x0=op["x0"], load=load_at_start(cfg_truth, op["load"], op["x0"]),
+                             kd=op["kd"], noise=PRACTICE_NOISE, seed=seed, description=description,
+                             duration=30.0 + PRE_ROLL, reference=shifted)
+    meta["conditions"]["load_force"] = float(op["load"])
     ts = meta["controller"]["sample_time"]
     k0 = int(round(PRE_ROLL / ts))
     frame = frame.iloc[k0:].reset_index(drop=True)

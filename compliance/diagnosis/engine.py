@@ -18,26 +18,28 @@ Stages:
 from __future__ import annotations
 
 import math
-import os
 import time
-import tomllib
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field, replace as dc_replace
-from datetime import datetime, timezone
-from pathlib import Path
 
 import numpy as np
 
-from compliance.model.config import PlantConfig, plant_from_dict, plant_to_toml, save_plant
+from compliance.model.config import PlantConfig, plant_to_toml
 from compliance.effects import EFFECTS
 from compliance.errors import InputError, SimulationError
-from compliance.diagnosis.candidates import Candidate, apply, base_params, effect_candidate, expand_base, signature_order
-from compliance.diagnosis.fit import FitContext, FitResult, fit_candidate, forward_select_base, least_squares_fit
+from compliance.diagnosis.candidates import Candidate, apply, base_params, effect_candidate, signature_order
+from compliance.diagnosis.fit import FitContext, FitResult, chi2_parts
+from compliance.diagnosis.fitted_model import fitted_plant, save_fitted
+from compliance.diagnosis.multi import (CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_enough, contributions, screen_additions,
+                                        set_effects, set_name)
+from compliance.diagnosis.discriminate import design_test
+from compliance.diagnosis.empirical import empirical_term
 from compliance.diagnosis.replay_fit import ReplaySetup, prepare_replay, replay_config, run_replay
-from compliance.diagnosis.residuals import UNITS, build_residual_model, signal_fit, with_fail_level
-from compliance.diagnosis.select import NOISE_TOLERANCE, score_all, verdict
+from compliance.diagnosis.residuals import UNITS, build_residual_model, null_recording, signal_fit, with_fail_level
+from compliance.diagnosis.select import (AMBIGUOUS_BIC, EXPLAINED_ENOUGH, NOISE_TOLERANCE, RESIDUAL_LIMIT, ambiguity_set, honest, same_physics,
+                                         score_all, signals_left, verdict)
 from compliance.diagnosis.report_data import SCHEMA, diagnosis_to_dict
 from compliance.diagnosis.located import event_rms, locate_mismatch, mask_agreement, where_words
+from compliance.diagnosis.workers import default_jobs, map_tasks
 
 COMBINE_LEVEL = 3.0  # chi2/N of the best single explanation above which effects are refitted with the recalibration
 COMBINE_TOP = 1  # how many effects are refitted with the recalibration
@@ -69,6 +71,14 @@ class Diagnosis:
     notes: list = field(default_factory=list)
     traces: dict = field(default_factory=dict)
     saved_model: str | None = None
+    agreement: dict = field(default_factory=dict)  # candidate -> share of its chi-square gain inside the windows
+    located_regimes: list = field(default_factory=list)
+    ambiguous: list = field(default_factory=list)  # explanations the recording cannot tell apart (winner first)
+    signals_left: dict = field(default_factory=dict)  # signal -> normalised RMS above select.RESIDUAL_LIMIT after the winner
+    search: list = field(default_factory=list)  # rounds of the multi-effect search (multi.py)
+    contributions: dict = field(default_factory=dict)  # effect -> its own contribution in the winning set
+    suggested_test: dict | None = None  # discriminate.design_test for an ambiguous recording
+    empirical: dict | None = None  # empirical.empirical_term when the library leaves residual
 
     def ranked(self) -> list[str]:
         """Candidate names by BIC, best first (nominal included)."""
@@ -80,60 +90,178 @@ class Diagnosis:
         return diagnosis_to_dict(self)
 
 
-# ------------------------------------------------------------------------------- worker side
-_WORKER: dict = {}
+@dataclass
+class _Stage:
+    """What every stage of one diagnosis shares (built once by ``_prepare``)."""
+
+    setup: ReplaySetup
+    rc: PlantConfig
+    nominal_sim: dict
+    model: object
+    events: list
+    event_mask: np.ndarray
+    nominal_rms: dict
+    nvec: np.ndarray
+    payload: tuple
+    jobs: int
+    fits: dict = field(default_factory=dict)
+    vecs: dict = field(default_factory=dict)
+    sims: int = 2
 
 
-def _init_worker(toml_text: str, setup: ReplaySetup, model) -> None:
-    cfg = plant_from_dict(tomllib.loads(toml_text), "<diagnosis>")
-    _WORKER["ctx"] = FitContext(cfg, setup, model)
+def _check_effects(cfg: PlantConfig, effects) -> list[str]:
+    names = [e for e in EFFECTS if e not in cfg.effects] if effects is None else list(effects)
+    for e in names:
+        if e not in EFFECTS:
+            from compliance.model.config import _suggest
+
+            raise InputError(f"--effects: '{e}' is not a declared effect{_suggest(e, EFFECTS)} (known: {', '.join(EFFECTS)})")
+    return names
 
 
-def _run_task(task):
-    """One unit of parallel work: ('base', params) | ('effect', Candidate) | ('combo', Candidate, FitResult)."""
-    ctx: FitContext = _WORKER["ctx"]
-    kind = task[0]
-    if kind == "base":
-        penalty = task[2]
-        res, log = forward_select_base(ctx, task[1], penalty=penalty)
-        res.scan = log
-    elif kind == "effect":
-        res = fit_candidate(ctx, task[1], None)
-    else:  # combination: effect + recalibrated base parameters, from both fits' values
-        cand, eff_fit, base_fit = task[1], task[2], task[3]
-        params = tuple(eff_fit.params) + tuple(base_fit.params)
-        # start exactly at the effect's optimum (base parameters nominal): the combination can only improve on it
-        start = list(eff_fit.values) + [fp.nominal for fp in base_fit.params]
-        res = least_squares_fit(ctx, cand.name, params, start, simplex_fev=8)
-    vec, _ = ctx.residual(res.params, res.values)
-    return res, vec
+def _prepare(cfg: PlantConfig, frame, meta: dict, stride: int, jobs: int) -> _Stage:
+    """Stages 1-2: the nominal replay, floors, located windows."""
+    setup = prepare_replay(cfg, frame, meta)
+    rc = replay_config(cfg, setup)
+    nominal_sim = run_replay(rc, setup)
+    model = build_residual_model(rc, setup, stride=stride, nominal=nominal_sim)
+    model = with_fail_level(model, model.vector(nominal_sim))
+    events, event_mask, _ = locate_mismatch(rc, setup, model.signals, nominal_sim)
+    nominal_rms = {s: v["rms_normalised"] for s, v in signal_fit(model, nominal_sim).items()}
+    nvec = model.vector(nominal_sim)
+    st = _Stage(setup, rc, nominal_sim, model, events, event_mask, nominal_rms, nvec, (plant_to_toml(rc), setup, model), jobs)
+    chi2, parts = chi2_parts(model, nvec)
+    st.fits["nominal"] = FitResult("nominal", (), [], [], chi2, parts, model.size, 0, 0.0, "nominal model")
+    return st
 
 
-# ------------------------------------------------------------------------------- the chain
-def _map(tasks, jobs: int, payload):
-    if jobs <= 1 or len(tasks) <= 1:
-        _init_worker(*payload)
-        return [_run_task(t) for t in tasks]
-    import multiprocessing as mp
+def _run(st: _Stage, tasks) -> None:
+    for res, v in map_tasks(tasks, st.jobs, st.payload):
+        st.fits[res.name] = res
+        st.vecs[res.name] = v
+        st.sims += res.sims + 1
 
+
+def _fit_singles(st: _Stage, names, recalibrate: bool) -> None:
+    """Stages 3-4: the recalibration, one fit per effect, and the best effect with the recalibration."""
+    n = st.model.size
+    chi2 = st.fits["nominal"].chi2
+    excess = {s: v * v - 1.0 for s, v in st.nominal_rms.items()}
+    tasks = []
+    bparams = base_params(st.rc) if recalibrate else ()
+    if bparams:
+        tasks.append(("base", bparams, 2.0 * math.log(n) * max(1.0, chi2 / n)))
+    tasks += [("effect", effect_candidate(e)) for e in signature_order(names, excess)]
+    _run(st, tasks)
+    base_fit = st.fits.get("base")
+    singles = [f for f in st.fits.values() if f.name != "nominal"]
+    best = min(singles, key=lambda f: f.chi2, default=None)
+    if base_fit is not None and base_fit.k > 0 and best is not None and best.chi2 / n > COMBINE_LEVEL:
+        top = sorted((f for f in singles if f.name in EFFECTS), key=lambda f: f.chi2)[:COMBINE_TOP]
+        _run(st, [("combo", Candidate(f"{f.name}+base"), f, base_fit) for f in top])
+
+
+def _search_sets(st: _Stage, winner: str) -> list[dict]:
+    """Stage 5: greedy forward selection of further effects on what the winner leaves (multi.py)."""
+    n = st.model.size
+    log = []
+    current = st.fits[winner]
+    while len(set_effects(current.name)) < MAX_EFFECTS:
+        if not signals_left(_objective(st, current.name)):
+            break
+        have = set(set_effects(current.name))
+        singles = [f for f in st.fits.values() if f.name in EFFECTS and f.name not in have]
+        screen = screen_additions(FitContext(st.rc, st.setup, st.model), current, singles)
+        st.sims += 2 * len(singles)
+        tasks = [("extend", current, f) for f in sorted(singles, key=lambda f: screen[f.name])[:CANDIDATES_PER_ROUND]]
+        if not tasks:
+            break
+        _run(st, tasks)
+        c = max(1.0, min(f.chi2 / max(n - f.k, 1) for f in st.fits.values() if math.isfinite(f.chi2)))
+        tried = sorted((_extended(st, t[1], t[2]) for t in tasks),
+                       key=lambda f: f.chi2)
+        best = tried[0]
+        ok, why = adds_enough(best, current, n, math.log(n), c)
+        log.append({"round": len(have) + 1, "tried": [f.name for f in tried], "best": best.name, "kept": ok, "why": why})
+        if not ok:
+            break
+        current = best
+    return log
+
+
+def _extended(st: _Stage, current: FitResult, single: FitResult) -> FitResult:
+    effects = set_effects(current.name) + set_effects(single.name)
+    name = set_name(effects) + ("+base" if any(fp.kind == "base" for fp in current.params) else "")
+    return st.fits[name]
+
+
+def _objective(st: _Stage, name: str) -> dict:
+    """Signal -> normalised RMS of the re-synchronised replay of candidate ``name``."""
+    m = st.model.index.size
+    return {s: math.sqrt(st.fits[name].chi2_signal[s] / m) for s in st.model.signals}
+
+
+def _decide(st: _Stage) -> dict:
+    """Verdict, winner, ambiguity set, each effect's own contribution (stage 5-6)."""
+    n = st.model.size
+    scores = score_all(st.fits, n)
+    effect_like = [k for k in st.fits if k not in ("nominal", "base")]
+    verdict_name, winner, reason = verdict(scores, n, st.nominal_rms, effect_like)
+    search = []
+    if winner is not None and winner != "base" and verdict_name != "no_mismatch":
+        search = _search_sets(st, winner)
+        scores = score_all(st.fits, n)  # the sets tried are candidates too
+        kept = [r for r in search if r["kept"]]
+        if kept:
+            winner = kept[-1]["best"]
+            reason = f"{' and '.join(set_effects(winner))} together explain {100*scores[winner].explained:.0f} % of the excess residual"
+            verdict_name = "missing_physics" if scores[winner].explained >= EXPLAINED_ENOUGH else "unexplained"
+    after = _objective(st, winner) if winner else None
+    verdict_name, reason = honest(verdict_name, winner, reason, after)
+    objectives = {k: _objective(st, k) for k in st.fits if k != "nominal"}
+    ambiguous = ambiguity_set(scores, winner, objectives) if verdict_name != "no_mismatch" else []
+    if ambiguous and verdict_name in ("missing_physics", "parameters_only"):
+        verdict_name = "ambiguous"
+        reason = (f"{' and '.join(ambiguous)} explain the recording equally well (every signal within "
+                  f"{RESIDUAL_LIMIT:g} x its floor, or BIC within {AMBIGUOUS_BIC:g}); another test tells them apart")
+    return {"scores": scores, "verdict": verdict_name, "winner": winner, "reason": reason, "search": search,
+            "ambiguous": ambiguous, "left": signals_left(after if winner else _objective(st, "nominal"))}
+
+
+def _suggest(st: _Stage, ambiguous: list) -> dict | None:
+    """The discriminating test between the two best explanations of an ambiguous recording."""
+    if len(ambiguous) < 2:
+        return None
+    a, b = st.fits[ambiguous[0]], st.fits[ambiguous[1]]
+    load = st.setup.load if not isinstance(st.setup.load, str) else 0.0
+    return design_test(apply(st.rc, a.params, a.values), apply(st.rc, b.params, b.values), st.model.floors,
+                       x0=st.setup.initial_position, load=float(load), names=(a.name, b.name))
+
+
+def _window_rows(st: _Stage, seg_win) -> list:
+    model = st.model
+    before_rows = event_rms(st.events, model.recorded, st.nominal_sim, model.floors, model.signals)
+    after_rows = event_rms(st.events, model.recorded, seg_win, model.floors, model.signals)
+    return [{"index": i, "start": e["start"], "end": e["end"], "duration": e["duration"], "signals": dict(e["signals"]),
+             "regimes": list(e["dominant"]), "before": b, "after": a}
+            for i, (e, b, a) in enumerate(zip(st.events, before_rows, after_rows))]
+
+
+def _empirical(st: _Stage, dec: dict) -> dict | None:
+    """Stage 7: outside the library, the missing force the recording implies (empirical.py)."""
+    if dec["verdict"] not in ("unexplained", "partially_explained"):
+        return None
+    w = dec["winner"]
+    cfg = apply(st.rc, st.fits[w].params, st.fits[w].values) if w else st.rc
     try:
-        ctx = mp.get_context("fork")
-    except ValueError:  # pragma: no cover - platforms without fork
-        ctx = mp.get_context()
-    with ProcessPoolExecutor(max_workers=min(jobs, len(tasks)), mp_context=ctx, initializer=_init_worker, initargs=payload) as ex:
-        return list(ex.map(_run_task, tasks))
-
-
-def default_jobs() -> int:
-    """Worker processes by default: the cores this process may use."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:  # pragma: no cover
-        return max(1, os.cpu_count() or 1)
+        null = null_recording(cfg, st.setup, st.model.sensor_noise)
+        return empirical_term(cfg, st.setup, null)
+    except (SimulationError, InputError) as exc:
+        return {"label": "empirical suggestion, not a declared effect", "words": f"not estimated: {exc}", "terms": []}
 
 
 def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | None = None, stride: int = 5,
-             recalibrate: bool = True) -> Diagnosis:
+             recalibrate: bool = True, suggest_test: bool = False) -> Diagnosis:
     """Diagnose one recording of the servo against a plant configuration.
 
     Parameters
@@ -152,6 +280,9 @@ def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | N
         Residual subsampling (every ``stride``-th sample).
     recalibrate : bool
         Also consider recalibrating base parameters.
+    suggest_test : bool
+        Design a discriminating test between the winner and the runner-up even when the
+        recording tells them apart (an ambiguous recording always gets one).
 
     Returns
     -------
@@ -164,105 +295,59 @@ def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | N
     """
     t0 = time.perf_counter()
     jobs = default_jobs() if jobs is None else max(1, int(jobs))
-    names = [e for e in EFFECTS if e not in cfg.effects] if effects is None else list(effects)
-    for e in names:
-        if e not in EFFECTS:
-            from compliance.model.config import _suggest
-
-            raise InputError(f"--effects: '{e}' is not a declared effect{_suggest(e, EFFECTS)} (known: {', '.join(EFFECTS)})")
-    setup = prepare_replay(cfg, frame, meta)
-    rc = replay_config(cfg, setup)
-    nominal_sim = run_replay(rc, setup)
-    model = build_residual_model(rc, setup, stride=stride, nominal=nominal_sim)
-    model = with_fail_level(model, model.vector(nominal_sim))
-    n = model.size
-    events, event_mask, _ = locate_mismatch(rc, setup, model.signals, nominal_sim)
-    nominal_fit = signal_fit(model, nominal_sim)
-    nominal_rms = {s: v["rms_normalised"] for s, v in nominal_fit.items()}
-    excess = {s: v * v - 1.0 for s, v in nominal_rms.items()}
-    order = signature_order(names, excess)
-    sims = 2
-    fits: dict[str, FitResult] = {}
-    vecs: dict[str, np.ndarray] = {}
-    nvec = model.vector(nominal_sim)
-    from compliance.diagnosis.fit import chi2_parts
-
-    chi2, parts = chi2_parts(model, nvec)
-    fits["nominal"] = FitResult("nominal", (), [], [], chi2, parts, n, 0, 0.0, "nominal model")
-    payload = (plant_to_toml(rc), setup, model)
-    tasks = []
-    bparams = base_params(rc) if recalibrate else ()
-    if bparams:
-        tasks.append(("base", bparams, 2.0 * math.log(n) * max(1.0, chi2 / n)))
-    tasks += [("effect", effect_candidate(e)) for e in order]
-    for res, v in _map(tasks, jobs, payload):
-        fits[res.name] = res
-        vecs[res.name] = v
-        sims += res.sims + 1
-    # stage 4: effects together with the recalibration when neither explains it alone
-    base_fit = fits.get("base")
-    singles = [f for f in fits.values() if f.name != "nominal"]
-    best = min(singles, key=lambda f: f.chi2, default=None)
-    if (base_fit is not None and base_fit.k > 0 and best is not None and best.chi2 / n > COMBINE_LEVEL):
-        top = sorted((f for f in singles if f.name in EFFECTS), key=lambda f: f.chi2)[:COMBINE_TOP]
-        ctasks = [("combo", Candidate(f"{f.name}+base"), f, base_fit) for f in top]
-        for res, v in _map(ctasks, jobs, payload):
-            fits[res.name] = res
-            vecs[res.name] = v
-            sims += res.sims + 1
-    scores = score_all(fits, n)
-    effect_like = [k for k in fits if k not in ("nominal", "base")]
-    verdict_name, winner, reason = verdict(scores, n, nominal_rms, effect_like)
-    agreement = {k: mask_agreement(model, nvec, vecs[k], event_mask) for k in fits if k in vecs}
-    ranked = sorted((k for k in fits if k != "nominal"), key=lambda k: (scores[k].bic, -agreement.get(k, 0.0)))
-    if winner is None:
-        runner = ranked[0] if ranked else None
-    else:
-        runner = next((k for k in ranked if k != winner and k.split("+")[0] != winner.split("+")[0]), None)
-    # stage 6: full closed-loop replays for the figures a test engineer reproduces
-    full = dc_replace(setup, resets=np.array([0]))
-    full_nom = run_replay(rc, full)
-    fitted_cfg = None
-    full_win = None
-    notes = list(setup.notes)
-    if winner is not None and verdict_name in ("missing_physics", "parameters_only"):
-        wf = fits[winner]
-        full_win = _safe_replay(apply(rc, wf.params, wf.values), full, notes, "full closed-loop replay of the winner")
-        fitted_cfg = _fitted_plant(cfg, wf, meta)
-    sims += 2 if full_win is not None else 1
-    fit_before = signal_fit(model, full_nom)
-    fit_after = signal_fit(model, full_win) if full_win is not None else None
-    seg_win = None
+    names = _check_effects(cfg, effects)
+    st = _prepare(cfg, frame, meta, stride, jobs)
+    _fit_singles(st, names, recalibrate)
+    dec = _decide(st)
+    winner, verdict_name = dec["winner"], dec["verdict"]
+    agreement = {k: mask_agreement(st.model, st.nvec, st.vecs[k], st.event_mask) for k in st.fits if k in st.vecs}
+    ranked = sorted((k for k in st.fits if k != "nominal"), key=lambda k: (dec["scores"][k].bic, -agreement.get(k, 0.0)))
+    runner = (ranked[0] if ranked else None) if winner is None else next(
+        (k for k in ranked if k != winner and not same_physics(k, winner)), None)
+    # full closed-loop replays for the figures a test engineer reproduces
+    full = dc_replace(st.setup, resets=np.array([0]))
+    full_nom = run_replay(st.rc, full)
+    notes = list(st.setup.notes)
+    fitted_cfg = full_win = seg_win = None
     if winner is not None:
-        seg_win = _safe_replay(apply(rc, fits[winner].params, fits[winner].values), setup, notes, "replay of the winner")
-        sims += 1
-    before_rows = event_rms(events, model.recorded, nominal_sim, model.floors, model.signals)
-    after_rows = event_rms(events, model.recorded, seg_win, model.floors, model.signals)
-    windows_out = []
-    for i, (e, b, a) in enumerate(zip(events, before_rows, after_rows)):
-        windows_out.append({
-            "index": i, "start": e["start"], "end": e["end"], "duration": e["duration"],
-            "signals": dict(e["signals"]), "regimes": list(e["dominant"]),
-            "before": b, "after": a,
-        })
-    objective_before = {s: math.sqrt(fits["nominal"].chi2_signal[s] / model.index.size) for s in model.signals}
-    objective_after = ({s: math.sqrt(fits[winner].chi2_signal[s] / model.index.size) for s in model.signals}
-                       if winner else None)
+        wcfg = apply(st.rc, st.fits[winner].params, st.fits[winner].values)
+        if verdict_name in ("missing_physics", "parameters_only", "partially_explained", "ambiguous"):
+            full_win = _safe_replay(wcfg, full, notes, "full closed-loop replay of the winner")
+            fitted_cfg = fitted_plant(cfg, st.fits[winner], meta)
+        seg_win = _safe_replay(wcfg, st.setup, notes, "replay of the winner")
+    st.sims += 1 + (full_win is not None) + (seg_win is not None)
     diag = Diagnosis(
-        verdict=verdict_name, reason=reason, winner=winner, runner_up=runner, fits=fits, scores=scores,
-        fit_before=fit_before, fit_after=fit_after, objective_before=objective_before, objective_after=objective_after,
-        windows=windows_out, floors=dict(model.floors), explanation="", cfg=cfg, fitted_cfg=fitted_cfg,
-        recording=setup.source, seconds=0.0, simulations=sims, jobs=jobs, notes=notes,
-        traces={"time": setup.time, "recorded": model.recorded, "before": full_nom, "after": full_win,
-                "objective_before": nominal_sim, "objective_after": seg_win},
+        verdict=verdict_name, reason=dec["reason"], winner=winner, runner_up=runner, fits=st.fits, scores=dec["scores"],
+        fit_before=signal_fit(st.model, full_nom), fit_after=signal_fit(st.model, full_win) if full_win is not None else None,
+        objective_before=_objective(st, "nominal"), objective_after=_objective(st, winner) if winner else None,
+        windows=_window_rows(st, seg_win), floors=dict(st.model.floors), explanation="", cfg=cfg, fitted_cfg=fitted_cfg,
+        recording=st.setup.source, seconds=0.0, simulations=st.sims, jobs=jobs, notes=notes,
+        traces={"time": st.setup.time, "recorded": st.model.recorded, "before": full_nom, "after": full_win,
+                "objective_before": st.nominal_sim, "objective_after": seg_win},
     )
-    diag.agreement = agreement  # type: ignore[attr-defined]
-    diag.located_regimes = where_words(events)  # type: ignore[attr-defined]
+    diag.agreement = agreement
+    diag.located_regimes = where_words(st.events)
+    diag.ambiguous, diag.signals_left, diag.search = dec["ambiguous"], dec["left"], dec["search"]
+    diag.contributions = _contributions(st, winner)
+    pair = dec["ambiguous"] or ([winner, runner] if suggest_test and winner and runner else [])
+    diag.suggested_test = _suggest(st, pair)
+    diag.empirical = _empirical(st, dec)
     from compliance.diagnosis.explain import explain
 
     diag.explanation = explain(diag)
     diag.seconds = time.perf_counter() - t0
     return diag
+
+
+def _contributions(st: _Stage, winner: str | None) -> dict:
+    """Effect -> its own share of the nominal excess in the winning set (switched off alone)."""
+    if winner is None or not set_effects(winner):
+        return {}
+    ctx = FitContext(st.rc, st.setup, st.model)
+    raw = contributions(ctx, st.fits[winner])
+    st.sims += ctx.sims
+    excess = max(st.fits["nominal"].chi2 - st.model.size, 1e-12)
+    return {e: {"chi2_increase_when_removed": v, "share_of_excess": v / excess} for e, v in raw.items()}
 
 
 def _safe_replay(cfg: PlantConfig, setup: ReplaySetup, notes: list, what: str):
@@ -272,35 +357,6 @@ def _safe_replay(cfg: PlantConfig, setup: ReplaySetup, notes: list, what: str):
     except SimulationError as exc:
         notes.append(f"{what} failed: {exc}")
         return None
-
-
-def _fitted_plant(cfg: PlantConfig, fit: FitResult, meta: dict) -> PlantConfig:
-    """The plant (not the test's controller overrides) with the winner's values, with provenance."""
-    params = expand_base(cfg, fit.params, fit.values)
-    effects: dict[str, dict] = {}
-    for fp, v in zip(fit.params, fit.values):
-        if fp.kind == "effect":
-            effects.setdefault(fp.effect, {})[fp.name] = v
-    prov = dict(cfg.provenance)
-    prov.update({
-        "fitted_by": "govcheck diagnose",
-        "parent": str(cfg.path or cfg.name),
-        "parent_digest": cfg.digest or "(in-memory configuration)",
-        "recording": str(meta.get("source_path", "<recording>")),
-        "date": datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
-        "explanation": fit.name,
-    })
-    return cfg.replace(params=params or None, effects=effects or None, provenance=prov,
-                       sources={k: "derived" for k in params}, name=f"{cfg.name}-fitted")
-
-
-def save_fitted(diag: Diagnosis, path) -> Path:
-    """Write the fitted configuration (never overwrites; ``save_plant`` refuses)."""
-    if diag.fitted_cfg is None:
-        raise InputError(f"{path}: nothing to save: the verdict is '{diag.verdict}' (no fitted model)")
-    out = save_plant(diag.fitted_cfg, path)
-    diag.saved_model = str(out)
-    return out
 
 
 __all__ = ["Diagnosis", "diagnose", "save_fitted", "default_jobs", "SCHEMA", "UNITS", "NOISE_TOLERANCE"]

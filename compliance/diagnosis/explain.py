@@ -107,14 +107,56 @@ def _library(d) -> str:
     return what + (" and the recalibrated base parameters" if "base" in d.fits else "")
 
 
+def _left(d) -> str:
+    """'the side-B pressure (3.1 times its floor) and the valve command (2.4 times)' for the signals left."""
+    items = sorted(d.signals_left.items(), key=lambda kv: -kv[1])
+    return " and ".join(f"the {SIGNAL_WORDS.get(s, s)} ({v:.1f} times its floor)" for s, v in items)
+
+
+def _empirical(d) -> str:
+    e = d.empirical
+    if not e or not e.get("words"):
+        return ""
+    return f" Empirical suggestion (not a declared effect): {e['words']}"
+
+
+def _contribution_words(d) -> str:
+    if len(d.contributions) < 2:
+        return ""
+    parts = [f"{e.replace('_', ' ')} {100*c['share_of_excess']:.0f} %" for e, c in d.contributions.items()]
+    return (" Each effect's own contribution (share of the nominal excess lost when it alone is switched off): "
+            + ", ".join(parts) + ".")
+
+
+def _ambiguity_words(d) -> str:
+    if len(d.ambiguous) < 2:
+        return ""
+    alts = ", ".join(a.replace("_", " ") for a in d.ambiguous[1:])
+    text = f" This recording cannot tell it from {alts} (information criteria within the ambiguity margin)."
+    t = d.suggested_test
+    if t and t.get("recommended"):
+        r = t["recommended"]
+        text += (f" Suggested test: {r['test']}; the two explanations' predictions differ there by {r['difference']:.1f} "
+                 f"times the noise floor on the {SIGNAL_WORDS.get(r['signal'], r['signal'])}"
+                 + ("." if t.get("separates") else ", which may still not separate them."))
+    return text
+
+
 def explain(d) -> str:
     """The paragraph for ``engine.Diagnosis`` ``d``."""
+    text = _explain_core(d)
+    if d.verdict == "partially_explained":
+        text += f" It does not explain everything: what is left sits on {_left(d)}."
+    return text + _contribution_words(d) + _ambiguity_words(d) + _empirical(d)
+
+
+def _explain_core(d) -> str:
     worst_sig, worst = _worst(d, objective=d.verdict == "no_mismatch")
     if d.verdict == "no_mismatch":
         return (f"Nothing is wrong: the nominal model reproduces the recording to within the sensor noise on every "
                 f"measured signal (the largest residual is {worst:.2f} times its noise floor, on the {SIGNAL_WORDS[worst_sig]}). "
                 f"No physics is missing and no parameter needs refitting.")
-    if d.verdict == "unexplained":
+    if d.verdict == "unexplained" or d.winner is None:
         best = d.winner or (d.runner_up or "none")
         share = d.scores[best].explained * 100 if best in d.scores else 0.0
         return (f"The model misses the recording {_where(d)} (the {SIGNAL_WORDS[worst_sig]} residual is {worst:.1f} times its "
@@ -122,10 +164,12 @@ def explain(d) -> str:
                 f"{share:.0f} % of the excess. The physics behind it is outside {_library(d)}; look at the located windows.")
     fit = d.fits[d.winner]
     change = _signal_change(d, list(d.fit_before))
-    if d.verdict == "parameters_only":
+    if d.verdict == "parameters_only" or d.winner == "base":
         return (f"No physics is missing. The model misses the recording {_where(d)} (the {SIGNAL_WORDS[worst_sig]} residual is "
                 f"{worst:.1f} times its noise floor) because base parameters are off: {_base_changes(d, fit)}. "
                 f"With them {change}." if change else f"No physics is missing: {_base_changes(d, fit)}.")
+    if len([e for e in d.winner.split("+") if e in EFFECTS]) > 1:
+        return _explain_set(d, fit, worst_sig, worst, change)
     effect = d.winner.split("+")[0]
     eff = EFFECTS[effect]
     main = next(i for i, fp in enumerate(fit.params) if fp.kind == "effect")
@@ -155,4 +199,21 @@ def explain(d) -> str:
                      f"winner's); a test at another operating point (supply pressure, load) tells them apart.")
         else:
             text += f" The runner-up, {d.runner_up}, fits worse by {ru.bic - w.bic:.0f} in BIC."
+    return text
+
+
+def _explain_set(d, fit, worst_sig, worst, change) -> str:
+    """Several effects together (the multi-effect search)."""
+    effects = [e for e in d.winner.split("+") if e in EFFECTS]
+    parts = []
+    for e in effects:
+        vals = [f"{q.name} {_pm(v, err, q.unit)}" for q, v, err in zip(fit.params, fit.values, fit.stderr) if q.effect == e]
+        parts.append(f"{e.replace('_', ' ')} ({', '.join(vals)})")
+    text = (f"The model misses the recording {_where(d)} (the {SIGNAL_WORDS[worst_sig]} residual is {worst:.1f} times its noise "
+            f"floor), and no single effect explains it; {len(effects)} effects together do: " + "; ".join(parts) + ".")
+    base = _base_changes(d, fit)
+    if base:
+        text += f" Together with them, {base}."
+    if change:
+        text += f" Adding them, {change}."
     return text

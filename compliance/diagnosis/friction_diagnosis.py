@@ -35,11 +35,16 @@ from compliance.diagnosis.friction_fit import LAWS, PRESLIDING, PRESSURE_EFFECT,
 from compliance.diagnosis.friction_runs import Run
 from compliance.diagnosis.noise_floor import sensor_noise_std
 from compliance.diagnosis.report_data import SCHEMA
+from compliance.diagnosis.friction_structure import friction_structure
 from compliance.diagnosis.select import EXPLAINED_ENOUGH, NOISE_TOLERANCE, score_all
 
 REVERSAL_TRAVEL = 2e-3  # m of travel after a change of direction counted as "after reversal"
 VELOCITY_WINDOW = 0.05  # s; Savitzky-Golay (quadratic) derivative window of the position
 MIN_SLIDING_SPEED = 1e-3  # m/s; slower samples are not "steady sliding"
+# a friction law is complete when its residual is within 3 x the force noise (issue 13's target for the
+# real seals): the floor here is the force sensor alone, while the law is evaluated on a velocity
+# differentiated from a noisy position, whose error adds ~1-2 x the force noise near the Stribeck hump
+FRICTION_RESIDUAL_LIMIT = 3.0
 UNITS = {"bias": "N", "bias_per_pressure": "N/Pa", "coulomb": "N", "static": "N", "stribeck_velocity": "m/s",
          "viscous": "N*s/m", "pressure_coefficient": "N/Pa", "bristle_stiffness": "N/m"}
 MEANING = {
@@ -177,6 +182,7 @@ class SealDiagnosis:
     located_after: dict | None
     explanation: str
     noise_floor: float
+    structure: dict | None = None  # friction_structure: what the law leaves, named (empirical)
 
     def to_dict(self) -> dict:
         """JSON-ready (SI units; see docs/diagnosis-schema.md, friction)."""
@@ -205,6 +211,7 @@ class SealDiagnosis:
                            for r, a in zip(self.runs, win.rms_per_run())} if win else None),
             "windows": self.located, "windows_after": self.located_after,
             "noise_floor": {"value": _num(self.noise_floor), "unit": "N"},
+            "structure_left": self.structure,
         }
 
 
@@ -260,8 +267,17 @@ def diagnose_seal(runs: list[Run]) -> SealDiagnosis:
     ranked = sorted(cands, key=lambda k: scores[k].bic)
     runner = next((k for k in ranked if k != winner), None)
     located_after = locate_friction(runs, fits[winner]) if winner else None
+    after = math.sqrt(fits[winner].chi2 / n) if winner else rms_norm
+    if verdict == "missing_physics" and after > FRICTION_RESIDUAL_LIMIT:
+        verdict = "partially_explained"  # as select.honest: complete only within the stated multiple of the noise
     diag = SealDiagnosis(runs[0].seal, runs, fits, scores, verdict, winner, runner, located, located_after, "", floor)
+    if verdict != "no_mismatch":
+        diag.structure = friction_structure(runs, fits[winner or "baseline"])
     diag.explanation = explain_friction(diag)
+    if diag.structure:
+        diag.explanation += (f" The law leaves {after:.1f} times the force noise (complete only within "
+                             f"{FRICTION_RESIDUAL_LIMIT:g});"
+                             f" empirical suggestion, not a declared effect: {diag.structure['words']}")
     return diag
 
 
@@ -333,7 +349,7 @@ class FrictionDiagnosis:
     def to_dict(self) -> dict:
         """JSON document (docs/diagnosis-schema.md, ``kind = "friction"``)."""
         verdicts = [s.verdict for s in self.seals]
-        overall = "missing_physics" if "missing_physics" in verdicts else ("unexplained" if "unexplained" in verdicts else "no_mismatch")
+        overall = next((v for v in ("unexplained", "partially_explained", "missing_physics") if v in verdicts), "no_mismatch")
         return {"schema": SCHEMA, "kind": "friction", "recordings": self.files, "verdict": overall,
                 "seals": [s.to_dict() for s in self.seals], "timing": {"seconds": self.seconds}}
 

@@ -21,6 +21,8 @@ import math
 import numpy as np
 from numba import njit
 
+from compliance.physics.friction import stribeck_magnitude
+
 
 @njit(cache=True)
 def _lugre_force(v, g, dt, sigma0, n_sub):
@@ -48,11 +50,25 @@ def _lugre_force(v, g, dt, sigma0, n_sub):
     return out
 
 
+@njit(cache=True)
+def _stribeck_levels(speed, coulomb, static, stribeck_velocity):
+    """The core's one Stribeck kernel over arrays of speed and (pressure-dependent) levels [N]."""
+    out = np.empty(speed.size)
+    for k in range(speed.size):
+        out[k] = max(stribeck_magnitude(speed[k], static[k], coulomb[k], stribeck_velocity), 1e-6)
+    return out
+
+
 def stribeck_level(speed, pressure_gauge, coulomb0, static0, stribeck_velocity, pressure_coefficient=0.0):
-    """g(v, p) = F_C(p) + (F_S(p) - F_C(p)) exp(-|v|/v_s) [N] (both levels rise by k_p p_g)."""
-    fc = coulomb0 + pressure_coefficient * pressure_gauge
-    fs = static0 + pressure_coefficient * pressure_gauge
-    return np.maximum(fc + (fs - fc) * np.exp(-np.abs(speed) / stribeck_velocity), 1e-6)
+    """g(v, p) = F_C(p) + (F_S(p) - F_C(p)) exp(-|v|/v_s) [N] (both levels rise by k_p p_g).
+
+    Evaluated by ``compliance.physics.friction.stribeck_magnitude``, the simulator's kernel.
+    """
+    v = np.ascontiguousarray(speed, dtype=float).ravel()
+    p = np.broadcast_to(np.asarray(pressure_gauge, dtype=float), np.shape(speed)).ravel()
+    fc = np.ascontiguousarray(coulomb0 + pressure_coefficient * p, dtype=float)
+    fs = np.ascontiguousarray(static0 + pressure_coefficient * p, dtype=float)
+    return _stribeck_levels(v, fc, fs, float(stribeck_velocity)).reshape(np.shape(speed))
 
 
 def friction_force(velocity, pressure_gauge, time, params: dict, *, presliding: bool, n_sub: int = 2) -> np.ndarray:

@@ -37,6 +37,7 @@ from compliance.model.config import PlantConfig
 from compliance.errors import InputError, SimulationError
 from compliance.model.vector_slots import P_KI, P_KP, P_SD_ON, P_STROKE, S_PSUP, S_TA, S_TB, S_V, S_V2
 from compliance.model.assembly import initial_state, load_curve_arrays, parameter_vector, set_rest_internal_states
+from compliance.diagnosis.operating_point import load_at_start
 from compliance.simulation.rk4 import N_OUT, OUTPUT_COLUMNS
 from compliance.simulation.pid_loop import simulate_core
 from compliance.diagnosis.noise_floor import position_noise_estimate
@@ -263,7 +264,7 @@ def run_replay(cfg: PlantConfig, setup: ReplaySetup, *, noise: np.ndarray | None
     SimulationError
         The state became non-physical (the fit treats it as a very poor fit).
     """
-    P = parameter_vector(cfg, load=setup.load)
+    P = parameter_vector(cfg, load=load_at_start(cfg, setup.load, setup.initial_position))
     ts = cfg.p("controller.sample_time")
     n_sub = int(round(ts / cfg.p("simulation.step")))
     lx, ly = load_curve_arrays(cfg)

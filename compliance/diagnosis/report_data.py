@@ -8,6 +8,7 @@ from compliance.effects import EFFECTS
 from compliance.model.parameters import BASE_BY_KEY
 from compliance.diagnosis.candidates import FRICTION_LEVEL
 from compliance.diagnosis.residuals import UNITS
+from compliance.diagnosis.select import RESIDUAL_LIMIT
 
 SCHEMA = "govcheck-diagnosis/1"  # docs/diagnosis-schema.md
 
@@ -55,10 +56,30 @@ def _fit_table(fit: dict | None) -> dict | None:
                 "nrmse": _num(v["nrmse"]), "fit_percent": _num(v["fit_percent"])} for s, v in fit.items()}
 
 
+def _clean(obj):
+    """Plain JSON of nested dicts/lists (non-finite floats -> null)."""
+    if isinstance(obj, dict):
+        return {str(k): _clean(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_clean(v) for v in obj]
+    if isinstance(obj, (float, int)) and not isinstance(obj, bool):
+        return _num(obj) if isinstance(obj, float) else obj
+    return obj
+
+
+def _ambiguity(d) -> dict | None:
+    """The explanations the recording cannot tell apart and the test that would (docs/diagnosis-schema.md)."""
+    if not d.ambiguous:
+        return None
+    return {"explanations": list(d.ambiguous),
+            "delta_bic": {k: _num(d.scores[k].bic - d.scores[d.ambiguous[0]].bic) for k in d.ambiguous},
+            "suggested_test": _clean(d.suggested_test)}
+
+
 def diagnosis_to_dict(d) -> dict:
     """Serialise a ``engine.Diagnosis`` (see docs/diagnosis-schema.md)."""
     ranked = d.ranked()
-    agreement = getattr(d, "agreement", {})
+    agreement = d.agreement
     effects = []
     for rank, name in enumerate(ranked, start=1):
         f = d.fits[name]
@@ -104,7 +125,13 @@ def diagnosis_to_dict(d) -> dict:
              for k, v in w.items()}
             for w in d.windows
         ],
-        "located_regimes": list(getattr(d, "located_regimes", [])),
+        "located_regimes": list(d.located_regimes),
+        "ambiguity": _ambiguity(d),
+        "signals_left": {s: _num(v) for s, v in d.signals_left.items()},
+        "residual_limit": RESIDUAL_LIMIT,
+        "contributions": {e: {k: _num(v) for k, v in c.items()} for e, c in d.contributions.items()},
+        "effect_search": _clean(d.search),
+        "empirical": _clean(d.empirical),
         "saved_model": d.saved_model,
         "notes": list(d.notes),
         "timing": {"seconds": _num(d.seconds), "simulations": d.simulations, "jobs": d.jobs},

@@ -18,6 +18,7 @@ import numpy as np
 from compliance.model.config import PlantConfig
 from compliance.errors import InputError, SimulationError
 from compliance.diagnosis.noise_floor import sensor_noise_std
+from compliance.diagnosis.operating_point import load_at_start
 from compliance.diagnosis.replay_fit import ReplaySetup, run_replay
 
 # lowest floors we accept (instrument resolution a logger rarely beats): keeps one signal from
@@ -115,6 +116,15 @@ def null_replay_errors(cfg: PlantConfig, setup: ReplaySetup, sensor: dict, seed:
     dict
         signal -> (recorded - replayed) of the null recording at every sample [SI].
     """
+    syn_setup = null_recording(cfg, setup, sensor, seed)
+    frame = syn_setup.recorded
+    n = syn_setup.time.size
+    out = run_replay(cfg, syn_setup)
+    return {s_: frame[s_] - out[s_][:n] for s_ in frame if s_ in setup.recorded}
+
+
+def null_recording(cfg: PlantConfig, setup: ReplaySetup, sensor: dict, seed: int = 7) -> ReplaySetup:
+    """The same test recorded by the nominal model with sensors like the recording's, prepared for replay."""
     import pandas as pd
 
     from compliance.simulation.profiles import Profile
@@ -135,11 +145,11 @@ def null_replay_errors(cfg: PlantConfig, setup: ReplaySetup, sensor: dict, seed:
     if setup.closed_loop:
         ref = np.concatenate([np.full(pre, setup.reference[0]), setup.reference])
         sc = Scenario(duration=float(tt[-1]), initial_position=setup.initial_position, reference=Profile(tt, ref),
-                      load=setup.load, noise=noise, seed=seed)
+                      load=load_at_start(cfg, setup.load, setup.initial_position), noise=noise, seed=seed)
     else:
         cmd = np.concatenate([np.full(pre, setup.command[0]), setup.command])
         sc = Scenario(duration=float(tt[-1]), initial_position=setup.initial_position, command=Profile(tt, cmd),
-                      load=setup.load, noise=noise, seed=seed)
+                      load=load_at_start(cfg, setup.load, setup.initial_position), noise=noise, seed=seed)
     syn = simulate(cfg, sc).iloc[pre:].reset_index(drop=True)
     n = min(len(syn), t.size)
     frame = pd.DataFrame({"time": t[:n], "position": syn["position"].to_numpy()[:n], "valve_command": syn["valve_command"].to_numpy()[:n]})
@@ -150,8 +160,7 @@ def null_replay_errors(cfg: PlantConfig, setup: ReplaySetup, sensor: dict, seed:
             frame[s_] = syn[s_].to_numpy()[:n]
     meta = {"conditions": {"load_force": setup.load}, "source_path": "<null replay>"}
     syn_setup = prepare_replay(cfg, frame, meta)
-    out = run_replay(cfg, syn_setup)
-    return {s_: frame[s_].to_numpy() - out[s_][:n] for s_ in frame.columns if s_ in rec}
+    return syn_setup
 
 
 def null_replay_floors(cfg: PlantConfig, setup: ReplaySetup, sensor: dict) -> tuple[dict, dict]:

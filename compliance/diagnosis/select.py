@@ -22,6 +22,17 @@ NOISE_TOLERANCE = 1.5  # nominal normalised RMS at or below which a signal agree
 SIGNIFICANCE = 10.0  # BIC difference counted as strong evidence (Kass & Raftery 1995)
 MIN_GAIN = 0.25  # share of the simpler model's excess chi-square a more complex one must remove
 EXPLAINED_ENOUGH = 0.5  # share of the nominal excess the winner must remove, else "unexplained"
+# an explanation is complete only when it brings every signal's re-synchronised residual to within this
+# multiple of its noise floor (normalised RMS; chi2/N per signal <= 4): the null bootstrap's floors are what
+# a correct model leaves, so a complete explanation sits near 1 and model-form differences of an
+# independent bench add a little; above it the verdict is "partially_explained" naming the signals left
+RESIDUAL_LIMIT = 2.0
+AMBIGUOUS_BIC = SIGNIFICANCE  # explanations within this BIC of the winner are not told apart by the recording
+# ... nor are two that both bring every signal within RESIDUAL_LIMIT with chi-squares within this ratio: the
+# BIC counts every residual as independent, while a replay's misfit comes in correlated bursts (the
+# Newey-West factor of fit.py is 5-30), so a BIC gap between two explanations that both sit at the
+# noise floor measures model-form detail of the bench, not physics
+AMBIGUOUS_RATIO = 1.5
 
 
 @dataclass(frozen=True)
@@ -108,3 +119,73 @@ def verdict(scores: dict[str, Score], n: int, nominal_rms: dict, effect_names) -
     if winner == "base":
         return "parameters_only", "base", "recalibrating base parameters explains the recording; no physics is missing"
     return "missing_physics", winner, f"{winner} explains {100*scores[winner].explained:.0f} % of the excess residual"
+
+
+def signals_left(objective: dict | None) -> dict[str, float]:
+    """Signal -> normalised RMS of the signals an explanation leaves above ``RESIDUAL_LIMIT``."""
+    return {s: v for s, v in (objective or {}).items() if v > RESIDUAL_LIMIT}
+
+
+def honest(verdict_name: str, winner: str | None, reason: str, objective_after: dict | None) -> tuple[str, str]:
+    """Downgrade a complete-sounding verdict the residual does not support.
+
+    ``missing_physics`` and ``parameters_only`` stand only when every signal's residual after the
+    winner is within ``RESIDUAL_LIMIT`` times its noise floor; otherwise the verdict is
+    ``partially_explained`` and the reason names the signals left and how far above their floors.
+    """
+    if verdict_name not in ("missing_physics", "parameters_only"):
+        return verdict_name, reason
+    left = signals_left(objective_after)
+    if not left:
+        return verdict_name, reason
+    words = ", ".join(f"{s} {v:.1f} x its floor" for s, v in sorted(left.items(), key=lambda kv: -kv[1]))
+    return "partially_explained", (f"{reason}, but leaves {words} (complete only within {RESIDUAL_LIMIT:g} x the "
+                                   f"floor on every signal)")
+
+
+def same_physics(a: str, b: str) -> bool:
+    """True when two candidate names hold the same effects (``x`` and ``x+base`` are one explanation)."""
+    ea = {e for e in a.split("+") if e != "base"}
+    eb = {e for e in b.split("+") if e != "base"}
+    return ea == eb
+
+
+def nested(a: str, b: str) -> bool:
+    """True when one candidate's effects contain the other's (a set and its subset are not rivals:
+    the multi-effect search and parsimony decide between them; ``base``, the recalibration, counts
+    as one more term)."""
+    ea, eb = set(a.split("+")), set(b.split("+"))
+    return ea <= eb or eb <= ea
+
+
+def ambiguity_set(scores: dict[str, Score], winner: str | None, objectives: dict | None = None) -> list[str]:
+    """Candidates (other physics than the winner) the recording cannot tell from it.
+
+    A candidate with other, not nested, physics is indistinguishable when it explains as much of the excess as the verdict asks
+    of a winner (``EXPLAINED_ENOUGH``) and either its BIC is within ``AMBIGUOUS_BIC`` of the
+    winner's, or both it and the winner are complete (``objectives``: candidate -> signal ->
+    normalised RMS, every signal within ``RESIDUAL_LIMIT``) with chi-squares within
+    ``AMBIGUOUS_RATIO``. The winner comes first; the others by BIC.
+    """
+    if winner is None or winner not in scores:
+        return []
+    w = scores[winner]
+    objectives = objectives or {}
+
+    def complete(k):
+        return k in objectives and not signals_left(objectives[k])
+
+    def rival(k, s):
+        if k in ("nominal", winner) or nested(k, winner) or s.explained < EXPLAINED_ENOUGH:
+            return False
+        if s.bic - w.bic < AMBIGUOUS_BIC:
+            return True
+        return complete(k) and complete(winner) and s.chi2 < AMBIGUOUS_RATIO * w.chi2
+
+    rivals = [k for k, s in scores.items() if rival(k, s)]
+    # one entry per physics (keep the better of x and x+base)
+    best: dict[frozenset, str] = {}
+    for k in sorted(rivals, key=lambda k: scores[k].bic):
+        key = frozenset(e for e in k.split("+") if e != "base")
+        best.setdefault(key, k)
+    return [winner] + list(best.values()) if best else []

@@ -2,8 +2,12 @@
 
 Bounds are physical ranges cut where the pinned RK4 step (1 ms for plant A) would go unstable:
 the fastest eigenvalue of each effect times the step stays below ~2 (RK4's limit is 2.8), e.g.
-a hose node relaxes at R*T*rho0*C*w'/V, so C/V <= 3e-4 (conductance <= 3e-8 m^3/(s*Pa) with
-volume >= 1e-4 m^3); linkage damping/(M/2) and regulator refill R*T*k/V_r likewise. A load
+a hose node relaxes at R*T*rho0*C*w'/V, so C/V <= 3e-4; the hose conductance is bounded at
+1e-7 m^3/(s*Pa) (a hose is less restrictive than the 2.33e-8 valve: an independent bench's
+7e-4 m^3 hose with 4.5e-8 was outside the former 3e-8 cut), so small volumes with large
+conductances (C/V > 3e-4) are admissible but diverge at the 1 ms step: the simulator reports
+it, the diagnosis scores such a trial as a failed fit; linkage damping/(M/2) and regulator
+refill R*T*k/V_r are cut by the same rule. A load
 stiffness beyond the pneumatic spring (~1.9e5 N/m) would make the plant statically unstable;
 the steepest segment of the sheet's load curve is 1.25e5 N/m.
 """
@@ -84,7 +88,8 @@ SUPPLY_DROOP = Effect(
     meaning="supply pressure sags under flow: finite reservoir refilled through a regulator",
     short="sd",
     params=(
-        Param("reservoir_volume", "m^3", "reservoir plus supply line volume", 0.02, (1e-3, 0.5), True, slot="vol"),
+        Param("reservoir_volume", "m^3", "reservoir plus supply line volume", 0.02, (1e-3, 0.5), True, slot="vol",
+              aliases=("Vr",)),
         Param("regulator_conductance", "kg/(s*Pa)", "regulator refill flow per pressure deficit", 1e-7, (1e-10, 1e-5), True,
               slot="cond"),
     ),
@@ -114,7 +119,7 @@ VALVE_OFFSET = Effect(
     name="valve_offset",
     meaning="null shift of the servo valve: the valve sees the command plus an offset",
     short="vo",
-    params=(Param("offset", "V", "voltage added to the command at the valve", 0.0, (-1.5, 1.5), slot="off"),),
+    params=(Param("offset", "V", "voltage added to the command at the valve", 0.0, (-1.5, 1.5), slot="off", aliases=("u0",)),),
     states=(),
     signature="asymmetric response up vs down; the holding command sits off the compensated null",
     signals=("valve_command", "position"),
@@ -128,7 +133,8 @@ POSITION_DEPENDENT_LOAD = Effect(
     name="position_dependent_load",
     meaning="the load changes along the stroke (gate hydraulic torque stiffness)",
     short="pl",
-    params=(Param("stiffness", "N/m", "added closing force per metre of opening about mid-stroke", 0.0, (-1.5e5, 1.5e5), slot="k"),),
+    params=(Param("stiffness", "N/m", "added closing force per metre of opening (the core: about mid-stroke; the diagnosis: about the test's start)", 0.0, (-1.5e5, 1.5e5), slot="k",
+                  aliases=("kL",)),),
     states=(),
     signature="holding pressure difference changes with position more than the nominal load says",
     signals=("pressure_a", "pressure_b", "valve_command"),
@@ -143,8 +149,8 @@ SENSOR_LAG = Effect(
     meaning="the position transducer reports a delayed, low-passed position",
     short="sl",
     params=(
-        Param("time_constant", "s", "first-order lag of the transducer", 0.005, (0.0, 0.1), slot="tau"),
-        Param("delay", "s", "pure delay of the transducer", 0.0, (0.0, 0.05), slot="td"),
+        Param("time_constant", "s", "first-order lag of the transducer", 0.005, (0.0, 0.1), slot="tau", aliases=("tau_s",)),
+        Param("delay", "s", "pure delay of the transducer", 0.0, (0.0, 0.05), slot="td", aliases=("td_s",)),
     ),
     states=(),
     loop_states=("sensor_position",),  # the PID loop filters the sampled position exactly (compliance.simulation.pid_loop)
@@ -166,8 +172,9 @@ LINE_DYNAMICS = Effect(
     meaning="hoses between valve and cylinders add volume and a flow restriction",
     short="ld",
     params=(
-        Param("volume", "m^3", "hose volume per side", 2e-4, (1e-4, 5e-3), True, slot="vol"),
-        Param("conductance", "m^3/(s*Pa)", "sonic conductance of each hose", 3e-8, (1e-9, 3e-8), True, slot="cond"),
+        Param("volume", "m^3", "hose volume per side", 2e-4, (1e-4, 5e-3), True, slot="vol", aliases=("V_line",)),
+        Param("conductance", "m^3/(s*Pa)", "sonic conductance of each hose", 3e-8, (1e-9, 1e-7), True, slot="cond",
+              aliases=("C_line",)),
     ),
     states=(State("line_pressure_a", "PLA", 13), State("line_pressure_b", "PLB", 14)),
     signature="chamber pressures respond later and smoother than the valve command; the loop is less damped",
@@ -182,8 +189,9 @@ LINKAGE_COMPLIANCE = Effect(
     meaning="the two cylinders are coupled through a flexible linkage; the sensor sits on 2A1",
     short="lk",
     params=(
-        Param("stiffness", "N/m", "linkage stiffness between the cylinders", 2e6, (1e4, 5e7), True, slot="k"),
-        Param("damping", "N*s/m", "linkage damping", 2000.0, (0.0, 1e4), slot="c"),
+        Param("stiffness", "N/m", "linkage stiffness between the cylinders", 2e6, (1e4, 5e7), True, slot="k",
+              aliases=("k_link",)),
+        Param("damping", "N*s/m", "linkage damping", 2000.0, (0.0, 1e4), slot="c", aliases=("c_link",)),
     ),
     # without the effect 2A2 follows 2A1 and plant_rhs keeps these equal to position and velocity
     states=(State("position_2", "X2", 8), State("velocity_2", "V2", 9)),

@@ -1,0 +1,26 @@
+"""What counts as right on a recording with answers (``benchmark.run_practice``)."""
+
+from __future__ import annotations
+
+from compliance.effects import EFFECTS
+
+
+def practice_correct(d, truth: list) -> tuple[bool, bool]:
+    """(right verdict and top explanation, ambiguous with the truth among the explanations named).
+
+    A truth of declared effects needs ``missing_physics`` with exactly those effects on top; a truth
+    that is not a declared effect (a parameter error such as ``valve_conductance``) needs
+    ``parameters_only``; no truth needs ``no_mismatch`` (``parameters_only`` accepted: no physics missing).
+    """
+    winner_effects = [e for e in (d.winner or "").split("+") if e in EFFECTS]
+    declared = [e for e in truth if e in EFFECTS]
+    if declared:
+        right = d.verdict == "missing_physics" and sorted(winner_effects) == sorted(declared)
+        named = {e for k in d.ambiguous for e in k.split("+")}
+        return right, d.verdict == "ambiguous" and set(declared) <= named
+    if truth:
+        return d.verdict == "parameters_only", d.verdict == "ambiguous" and "base" in d.ambiguous
+    return d.verdict in ("no_mismatch", "parameters_only"), False
+
+
+__all__ = ["practice_correct"]
