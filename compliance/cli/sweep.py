@@ -65,13 +65,13 @@ def _yield_candidate(which: str, out: Path, spec) -> dict:
     """Settings of the candidate named on --yield."""
     if which == "base":
         return {}
-    table = out / "results.parquet"
-    if not table.exists():
-        raise InputError(f"--yield {which}: no sweep results in {out} (run 'govcheck sweep {spec.path}' first, "
-                         "or use --yield base)")
     import pandas as pd
 
-    df = pd.read_parquet(table)
+    table = next((t for t in (out / "results.parquet", out / "results.csv") if t.exists()), None)
+    if table is None:
+        raise InputError(f"--yield {which}: no sweep results in {out} (run 'govcheck sweep {spec.path}' first, "
+                         "or use --yield base)")
+    df = pd.read_parquet(table) if table.suffix == ".parquet" else pd.read_csv(table)
     if which == "best":
         import json
 
