@@ -38,12 +38,30 @@ def basis(results: dict) -> dict:
             "provenance": dict(plant.get("provenance") or {})}
 
 
+def _remedy_lines(rem) -> dict:
+    """Requirement id -> one line on what would fix it, from a ``remedies`` section (docs/results-schema.md)."""
+    if not isinstance(rem, dict):
+        return {}
+    out = {}
+    fix = rem.get("remedy")
+    if fix:
+        changes = ", ".join(f"{c['path']} {c['from']:.4g} -> {c['to']:.4g} {c['unit']}" for c in fix.get("changes", []))
+        for rid in rem.get("failed", []):
+            out[rid] = f"passes with {changes} (verified by a full campaign: {fix.get('verified', {}).get('status', 'not run')})"
+        return out
+    for rid in rem.get("out_of_reach", []):
+        out[rid] = "out of reach of every adjustable setting searched; needs a hardware or design change"
+    for s in rem.get("sensitivities", []):
+        best = next((b for b in s.get("by_parameter", []) if b.get("delta_margin_pct", 0) > 0), None)
+        if s["requirement"] not in out and best:
+            out[s["requirement"]] = (f"no passing setting found; {best['path']} helps most "
+                                     f"({best['delta_margin_pct']:+.1f} points per {best['step']:.3g} {best['unit']})")
+    return out
+
+
 def failures(results: dict) -> list[dict]:
     """One line per failed requirement: the failing number against its limit, where, and the remedy if computed."""
-    remedies = {}
-    for r in (results.get("remedies") or {}).get("items", []) if isinstance(results.get("remedies"), dict) else []:
-        if isinstance(r, dict) and r.get("requirement"):
-            remedies.setdefault(r["requirement"], r.get("text") or r.get("summary"))
+    remedies = _remedy_lines(results.get("remedies"))
     out = []
     for e in results["requirements"]:
         if e["status"] != "fail":

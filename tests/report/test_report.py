@@ -469,3 +469,17 @@ def test_reproducible_html_is_byte_identical_and_dated_by_the_results(tmp_path, 
     render_report(copy.deepcopy(res), b, workers=1, appendix="none")
     assert a.read_bytes() == b.read_bytes()
     assert "2023-11-14" in a.read_text()  # the rendering date is the results' fixed date, not today
+
+
+def test_page_one_fix_lines_come_from_the_remedies_section():
+    from compliance.report.signoff import failures
+
+    res = _results()
+    failed = [e["id"] for e in res["requirements"] if e["status"] == "fail"]
+    assert failed, "the fixture has failures"
+    res["remedies"] = {"failed": failed, "out_of_reach": [failed[0]], "remedy": None, "sensitivities": []}
+    lines = {f["id"]: f["remedy"] for f in failures(res)}
+    assert "hardware" in lines[failed[0]]
+    res["remedies"] = {"failed": failed, "remedy": {"changes": [{"path": "controller.kp", "from": 280.0, "to": 400.0, "unit": "V/m"}],
+                                                     "verified": {"status": "pass"}}}
+    assert all("280 -> 400 V/m" in f["remedy"] and "pass" in f["remedy"] for f in failures(res))
