@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 from compliance.cli.common import (add_parser, add_outputs, add_quiet, add_reproducible, check_args_outputs, check_sidecar_conditions,
                                    parse_param_overrides, sidecar_plant, split_config)
@@ -74,7 +73,7 @@ def format_summary(result: dict, max_windows: int = 30) -> str:
     rec, plant, cond = result["recording"], result["plant"], result["conditions"] or {}
     lines.append(f"recording {rec['path']}: {rec['samples']} samples, {rec['duration']:.3f} s, "
                  f"step {rec['sample_time_median']*1e3:.3g} ms{'' if rec['uniform'] else ' (non-uniform)'}")
-    lines.append(f"model {plant['name']} ({plant['path'] or 'in memory'})" + (f"; overrides: " + ", ".join(f"{k}={v:g}" for k, v in plant["overrides"].items()) if plant["overrides"] else ""))
+    lines.append(f"model {plant['name']} ({plant['path'] or 'in memory'})" + ("; overrides: " + ", ".join(f"{k}={v:g}" for k, v in plant["overrides"].items()) if plant["overrides"] else ""))
     if cond:
         ip = cond.get("initial_pressures")
         lines.append(

@@ -24,7 +24,9 @@ import math
 
 import numpy as np
 
-from compliance.model.assembly import _pneumatic_forces, load_curve_arrays, load_force, parameter_vector
+from compliance.model.plant_vector import load_curve_arrays, parameter_vector
+
+from compliance.model.rest_state import load_force, pneumatic_forces
 from compliance.diagnosis.operating_point import load_at_start
 from compliance.model.vector_slots import P_BV, P_FC, P_FS, P_MASS, P_NFR, P_PATM, P_PF_COEF, P_PF_ON, P_VS
 from compliance.physics.friction import pressure_friction_increment, stribeck_map
@@ -130,7 +132,7 @@ def implied_force(cfg, setup) -> tuple[np.ndarray, dict, np.ndarray]:
     patm = P[P_PATM]
     df = np.empty(t.size)
     for k in range(t.size):
-        f1, f2 = _pneumatic_forces(P, pa[k], pb[k])
+        f1, f2 = pneumatic_forces(P, pa[k], pb[k])
         fs, fc = P[P_FS], P[P_FC]
         if P[P_PF_ON] != 0.0:
             inc = pressure_friction_increment(P[P_PF_COEF], 0.5 * (pa[k] + pb[k]), patm)

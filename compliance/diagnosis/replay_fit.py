@@ -36,7 +36,8 @@ from scipy.signal import savgol_filter
 from compliance.model.config import PlantConfig
 from compliance.errors import InputError, SimulationError
 from compliance.model.vector_slots import P_KI, P_KP, P_SD_ON, P_STROKE, S_PSUP, S_TA, S_TB, S_V, S_V2
-from compliance.model.assembly import initial_state, load_curve_arrays, parameter_vector, set_rest_internal_states
+from compliance.model.plant_vector import load_curve_arrays, parameter_vector
+from compliance.model.rest_state import initial_state, set_rest_internal_states
 from compliance.diagnosis.operating_point import load_at_start
 from compliance.simulation.rk4 import N_OUT, OUTPUT_COLUMNS
 from compliance.simulation.pid_loop import simulate_core

@@ -12,7 +12,6 @@ import tempfile
 from pathlib import Path
 from typing import Callable
 
-from compliance.errors import InputError
 from compliance.files.jsonable import json_text
 
 __all__ = ["write_atomic_with", "write_bytes_atomic", "write_json_atomic", "write_text_atomic"]

@@ -19,7 +19,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from compliance.model.assembly import initial_state, load_curve_arrays, parameter_vector, plant_rhs
+from compliance.model.assembly import plant_rhs
+
+from compliance.model.plant_vector import load_curve_arrays, parameter_vector
+
+from compliance.model.rest_state import initial_state
 from compliance.model.config import PlantConfig
 from compliance.model.vector_slots import AUX_NAMES, N_AUX, N_STATES, STATE_NAMES
 

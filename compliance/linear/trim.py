@@ -25,7 +25,9 @@ from compliance.model.config import PlantConfig
 from compliance.errors import InputError
 from compliance.model.vector_slots import *  # noqa: F403 - index constants
 from compliance.model.vector_slots import EFFECT_SLOTS, N_AUX, N_STATES, STATE_NAMES
-from compliance.model.assembly import initial_state, load_curve_arrays, load_force, parameter_vector, plant_rhs
+from compliance.model.assembly import plant_rhs
+from compliance.model.plant_vector import load_curve_arrays, parameter_vector
+from compliance.model.rest_state import initial_state, load_force
 
 GAIN_CHOICES = ("mean", "opening", "closing")
 REL_STEP = 1e-6  # central-difference step relative to each state's scale (truncation ~1e-12, rounding ~1e-10)

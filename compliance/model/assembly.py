@@ -3,25 +3,21 @@
 This is the one place where the physics functions are composed. ``plant_rhs`` is the single
 source of truth used by the simulator, the linearisation (trim + Jacobian) and the
 diagnosis (through the simulator). Its parameter vector comes from
-``compliance.model.plant_vector.parameter_vector`` (re-exported here).
+``compliance.model.plant_vector.parameter_vector``; the states of a servo at rest from
+``compliance.model.rest_state``.
 """
 
 from __future__ import annotations
 
-import numpy as np
 from numba import njit
 
-from compliance.model.config import PlantConfig
-from compliance.model.plant_vector import load_curve_arrays, parameter_vector  # noqa: F401 - public here too
 from compliance.model.vector_slots import *  # noqa: F403 - index constants are the core's vocabulary
-from compliance.model.vector_slots import N_STATES
 from compliance.physics.chamber import chamber_pressure_rate, chamber_temperature_rate, wall_heat_flow
 from compliance.physics.friction import (
     lugre_bristle_rate,
     lugre_force,
     piecewise_stribeck_friction,
     pressure_friction_increment,
-    stribeck_magnitude,
     variable_viscous_friction,
 )
 from compliance.physics.leakage import laminar_leak, reservoir_pressure_rate
@@ -294,109 +290,3 @@ def plant_rhs(y, P, u_valve, load_xs, load_ys, dy, aux):
     aux[A_OPEN] = a_pa - a_pb
     aux[A_FP] = fp
     aux[A_QS] = q_pa + q_pb
-
-
-def load_force(P: np.ndarray, x: float, lx: np.ndarray, ly: np.ndarray) -> float:
-    """Closing force on the gate at position ``x`` [N]: constant or load curve, plus load stiffness.
-
-    The same law as ``plant_rhs`` (where it acts on body 2, the gate-ring side).
-    """
-    f = float(np.interp(x, lx, ly)) if P[P_LOADMODE] == 1.0 else float(P[P_LOAD])
-    if P[P_PL_ON]:
-        f += P[P_PL_K] * (x - 0.5 * P[P_STROKE])  # load stiffness about mid-stroke
-    return f
-
-
-def _pneumatic_forces(P: np.ndarray, pa: float, pb: float) -> tuple[float, float]:
-    """Piston forces (f1, f2) [N] of the two bodies, as in ``plant_rhs``."""
-    if P[P_ARR] == 0.0:
-        return pa * P[P_AREA_CAP] - pb * P[P_AREA_ROD], pa * P[P_AREA_ROD] - pb * P[P_AREA_CAP]  # decoded seed 000 eq. (6)
-    return single_force(pa, pb, P[P_AREA_CAP], P[P_AREA_ROD], P[P_PATM]), 0.0  # seed 001 eq. (9)
-
-
-def set_rest_internal_states(P: np.ndarray, y: np.ndarray, lx: np.ndarray, ly: np.ndarray, v: float = 0.0) -> None:
-    """Set the unmeasured mechanical states consistent with position, speed and pressures (in place).
-
-    A servo found at rest with given pressures is held there: the net force sits in the
-    static friction (LuGre bristles deflected, Canudas de Wit et al. 1995) and a compliant
-    linkage carries its share of the load. Without this a recording that starts from measured
-    pressures would slip at t = 0 and a relaxed linkage under load would jump.
-
-    Parameters
-    ----------
-    P : ndarray
-        Parameter vector.
-    y : ndarray
-        State; reads x, p_A, p_B; writes x2 (linkage compliance) and z1, z2 (LuGre).
-    lx, ly : ndarray
-        Load curve (``load_curve_arrays``).
-    v : float
-        Speed [m/s]; sliding bristles sit at the steady deflection g(v)/sigma0.
-    """
-    x = y[S_X]
-    f1, f2 = _pneumatic_forces(P, y[S_PA], y[S_PB])
-    linkage = P[P_LK_ON] != 0.0 and P[P_ARR] == 0.0
-    x2 = x
-    if linkage:
-        # both bodies rest with equal friction shares: f1 + f_link = f2 - f_link - F_load(x2),
-        # f_link = K (x2 - x); fixed point in x2 (contracts while K exceeds the load stiffness)
-        for _ in range(50):
-            x2_new = x + 0.5 * (f2 - f1 - load_force(P, x2, lx, ly)) / P[P_LK_K]
-            x2_new = min(max(x2_new, 0.0), P[P_STROKE])  # a link too soft to carry it leaves 2A2 on its end stop
-            if abs(x2_new - x2) < 1e-12:
-                x2 = x2_new
-                break
-            x2 = x2_new
-        y[S_X2] = x2
-    if not (P[P_FRM] == 0.0 and P[P_SIG0] > 0.0):
-        return
-    fs, fc = P[P_FS], P[P_FC]
-    if P[P_PF_ON]:
-        d = pressure_friction_increment(P[P_PF_COEF], 0.5 * (y[S_PA] + y[S_PB]), P[P_PATM])
-        fs, fc = fs + d, fc + d
-    net = f1 + f2 - load_force(P, x2, lx, ly) + end_stop_force(x, 0.0, P[P_STROKE], P[P_KSTOP], P[P_CSTOP])
-    n = P[P_NFR] if not linkage else 2.0
-    g = stribeck_magnitude(v, fs, fc, P[P_VS])  # LuGre g(v), Canudas de Wit et al. 1995
-    z = (net / n - P[P_BV] * v) / P[P_SIG0]
-    zmax = g / P[P_SIG0]
-    z = min(max(z, -zmax), zmax)
-    y[S_Z1] = z
-    y[S_Z2] = z
-
-
-def initial_state(cfg: PlantConfig, P: np.ndarray, x0: float, pressures: tuple[float, float] | None = None) -> np.ndarray:
-    """State at rest at ``x0``: pressures balance the load with mean (p_s + p_atm)/2, T = T_s.
-
-    This is the practice emulator's convention (ANSWERS.md) and the trim a test bench
-    reaches after holding a position. Given ``pressures`` (p_A, p_B) [Pa abs] replace the
-    balance; either way the bristles and a compliant linkage start deflected so that the
-    servo is held where it is (``set_rest_internal_states``).
-    """
-    y = np.zeros(N_STATES)
-    y[S_X] = x0
-    y[S_X2] = x0
-    lx, ly = load_curve_arrays(cfg)
-    f_load = load_force(P, x0, lx, ly)
-    ps, patm = P[P_PS], P[P_PATM]
-    if pressures is not None:
-        pa, pb = pressures
-    elif P[P_ARR] == 0.0:
-        at = P[P_AREA_CAP] + P[P_AREA_ROD]
-        pa = 0.5 * (ps + patm) + 0.5 * f_load / at
-        pb = 0.5 * (ps + patm) - 0.5 * f_load / at
-    else:
-        ac, ar = P[P_AREA_CAP], P[P_AREA_ROD]
-        pa = (f_load + patm * (ac - ar) + (ps + patm) * ar) / (ac + ar)
-        pb = ps + patm - pa
-    lo = patm * 1.0001
-    pa = min(max(pa, lo), ps)
-    pb = min(max(pb, lo), ps)
-    y[S_PA] = pa
-    y[S_PB] = pb
-    y[S_TA] = P[P_TS]
-    y[S_TB] = P[P_TS]
-    y[S_PSUP] = ps
-    y[S_PLA] = pa
-    y[S_PLB] = pb
-    set_rest_internal_states(P, y, lx, ly)  # held at rest: bristles carry the net force, the link its share
-    return y

@@ -33,7 +33,9 @@ import numpy as np
 from compliance.model.config import PlantConfig
 from compliance.errors import InputError
 from compliance.model.vector_slots import N_AUX, N_STATES, P_AREA_CAP, P_AREA_ROD, P_BV, P_FC, P_FRM, P_FS, P_UCEN, P_VLIM, P_VS, S_PA, S_PB, S_V, S_X
-from compliance.model.assembly import initial_state, load_curve_arrays, parameter_vector, plant_rhs
+from compliance.model.assembly import plant_rhs
+from compliance.model.plant_vector import load_curve_arrays, parameter_vector
+from compliance.model.rest_state import initial_state
 
 _STATES = (S_X, S_V, S_PA, S_PB)
 _STEPS = (1e-6, 1e-6, 10.0, 10.0)  # central-difference steps: m, m/s, Pa, Pa (well inside the linear range)

@@ -121,7 +121,22 @@ def trace_figure(trace: dict, marks: list, kind: str, prefix: str, *, tolerance=
     closed_loop = kind not in OPEN_LOOP_KINDS and r is not None and speed_limit is None
     t_span = (float(t[0]), float(t[-1]))
 
-    # ---- panel 1: reference and position [mm]
+    _position_panel(ax_x, ax_e, t, x, r, mk, closed_loop)
+    _error_or_speed_panel(ax_e, t, x, r, closed_loop, tolerance, speed_limit)
+    _command_panel(ax_u, t, _arr(trace, "valve_command"), valve)
+    last = ax_u if ax_p is None else ax_p
+    if ax_p is not None:
+        _pressure_panel(ax_p, t, trace)
+    last.set_xlabel("time [s]")
+    last.set_xlim(*t_span)
+    for ax in axes:
+        ax.yaxis.set_label_coords(-0.075, 0.5)  # aligned labels whatever the tick widths
+    fig.subplots_adjust(left=0.1, right=0.985, top=0.94 if compact else 0.955, bottom=0.1 if compact else 0.075)
+    return to_svg(fig, prefix)
+
+
+def _position_panel(ax_x, ax_e, t, x, r, mk, closed_loop):
+    """Panel 1: set-point and position [mm], the judged windows shaded on panels 1 and 2."""
     for m in mk:
         if m["type"] in ("final_window", "tracking_window", "hold_window"):
             for ax in (ax_x, ax_e):
@@ -134,7 +149,9 @@ def trace_figure(trace: dict, marks: list, kind: str, prefix: str, *, tolerance=
     ax_x.set_ylabel("position [mm]")
     _legend(ax_x, top=True)
 
-    # ---- panel 2: error with the tolerance band [mm] (closed loop) or speed [mm/s]
+
+def _error_or_speed_panel(ax_e, t, x, r, closed_loop, tolerance, speed_limit):
+    """Panel 2: error with the tolerance band [mm] (closed loop), else the speed [mm/s] with its limit."""
     if closed_loop and x is not None:
         e = (r - x) * MM
         if tolerance is not None and math.isfinite(tolerance):
@@ -160,50 +177,44 @@ def trace_figure(trace: dict, marks: list, kind: str, prefix: str, *, tolerance=
     else:
         message_axes(ax_e, "position not recorded")
 
-    # ---- panel 3: valve command [V]
-    u = _arr(trace, "valve_command")
-    if u is not None:
-        _plot(ax_u, t, u, color=COLORS["command"], lw=0.9, label="valve command")
-        if valve:
-            c0 = valve.get("centre_voltage") or 0.0  # the valve null: 0 V for a +/-10 V valve, 5 V for a 0-10 V one
-            sat = valve.get("saturation_voltage")
-            if sat:
-                for s in (-1, 1):
-                    ax_u.axhline(c0 + s * sat, color=COLORS["limit"], lw=0.6, ls=(0, (3, 2)))
-                where = f"{c0:.3g} \u00b1 {sat:.3g} V" if c0 else f"\u00b1{sat:.3g} V"
-                ax_u.plot([], [], color=COLORS["limit"], lw=0.6, ls=(0, (3, 2)), label=f"full opening {where}")
-            if c0:
-                ax_u.axhline(c0, color="#999999", lw=0.6, ls=(0, (1, 1)), zorder=0.5, label=f"valve null {c0:.3g} V")
-            dz = valve.get("dead_zone")
-            if dz:
-                ax_u.axhspan(c0 - dz[1], c0 + dz[0], color="#999999", alpha=0.15, lw=0, label="valve dead zone")
-        ax_u.set_ylabel("command [V]")
-        _legend(ax_u)
-    else:
-        message_axes(ax_u, "valve command not recorded")
 
-    # ---- panel 4: chamber pressures [bar abs]
+def _command_panel(ax_u, t, u, valve):
+    """Panel 3: valve command [V] with the full-opening lines, the null and the dead zone about it."""
+    if u is None:
+        message_axes(ax_u, "valve command not recorded")
+        return
+    _plot(ax_u, t, u, color=COLORS["command"], lw=0.9, label="valve command")
+    if valve:
+        c0 = valve.get("centre_voltage") or 0.0  # the valve null: 0 V for a +/-10 V valve, 5 V for a 0-10 V one
+        sat = valve.get("saturation_voltage")
+        if sat:
+            for s in (-1, 1):
+                ax_u.axhline(c0 + s * sat, color=COLORS["limit"], lw=0.6, ls=(0, (3, 2)))
+            where = f"{c0:.3g} \u00b1 {sat:.3g} V" if c0 else f"\u00b1{sat:.3g} V"
+            ax_u.plot([], [], color=COLORS["limit"], lw=0.6, ls=(0, (3, 2)), label=f"full opening {where}")
+        if c0:
+            ax_u.axhline(c0, color="#999999", lw=0.6, ls=(0, (1, 1)), zorder=0.5, label=f"valve null {c0:.3g} V")
+        dz = valve.get("dead_zone")
+        if dz:
+            ax_u.axhspan(c0 - dz[1], c0 + dz[0], color="#999999", alpha=0.15, lw=0, label="valve dead zone")
+    ax_u.set_ylabel("command [V]")
+    _legend(ax_u)
+
+
+def _pressure_panel(ax_p, t, trace):
+    """Panel 4: chamber pressures and supply [bar abs]."""
     pa, pb, ps = _arr(trace, "pressure_a"), _arr(trace, "pressure_b"), _arr(trace, "supply_pressure")
-    last = ax_p if ax_p is not None else ax_u
-    if ax_p is None:
-        pass
-    elif pa is not None or pb is not None:
-        if pa is not None:
-            _plot(ax_p, t, pa * BAR, color=COLORS["pressure_a"], lw=0.9, label="chamber A")
-        if pb is not None:
-            _plot(ax_p, t, pb * BAR, color=COLORS["pressure_b"], lw=0.9, label="chamber B")
-        if ps is not None:
-            _plot(ax_p, t, ps * BAR, color=COLORS["supply"], lw=0.7, ls=":", label="supply")
-        ax_p.set_ylabel("pressure [bar abs]")
-        _legend(ax_p)
-    else:
+    if pa is None and pb is None:
         message_axes(ax_p, "chamber pressures not recorded")
-    last.set_xlabel("time [s]")
-    last.set_xlim(*t_span)
-    for ax in axes:
-        ax.yaxis.set_label_coords(-0.075, 0.5)  # aligned labels whatever the tick widths
-    fig.subplots_adjust(left=0.1, right=0.985, top=0.94 if compact else 0.955, bottom=0.1 if compact else 0.075)
-    return to_svg(fig, prefix)
+        return
+    if pa is not None:
+        _plot(ax_p, t, pa * BAR, color=COLORS["pressure_a"], lw=0.9, label="chamber A")
+    if pb is not None:
+        _plot(ax_p, t, pb * BAR, color=COLORS["pressure_b"], lw=0.9, label="chamber B")
+    if ps is not None:
+        _plot(ax_p, t, ps * BAR, color=COLORS["supply"], lw=0.7, ls=":", label="supply")
+    ax_p.set_ylabel("pressure [bar abs]")
+    _legend(ax_p)
 
 
 def _legend(ax, top=False):

@@ -13,7 +13,9 @@ import pandas as pd
 from numba import njit
 
 from compliance.errors import SimulationError
-from compliance.model.assembly import initial_state, load_curve_arrays, parameter_vector, plant_rhs, valve_lag_input
+from compliance.model.assembly import plant_rhs, valve_lag_input
+from compliance.model.plant_vector import load_curve_arrays, parameter_vector
+from compliance.model.rest_state import initial_state
 from compliance.model.config import PlantConfig
 from compliance.model.pid_controller import first_order_filter_gain, pid_sample, saturate
 from compliance.model.vector_slots import P_FILT, P_KD, P_KI, P_KP, P_SL_ON, P_SL_TD, P_TSAMP, P_UCEN, P_ULIM, P_VD_ON, P_VD_TD, S_SP, S_X

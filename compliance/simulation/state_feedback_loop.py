@@ -20,7 +20,9 @@ from compliance.model.config import PlantConfig
 from compliance.model.pid_controller import pid_sample, saturate
 from compliance.errors import InputError, SimulationError
 from compliance.model.vector_slots import N_STATES, P_UCEN, P_ULIM, P_VD_ON, S_PA, S_PB, S_SP, S_V, S_X
-from compliance.model.assembly import initial_state, load_curve_arrays, parameter_vector, plant_rhs, valve_lag_input
+from compliance.model.assembly import plant_rhs, valve_lag_input
+from compliance.model.plant_vector import load_curve_arrays, parameter_vector
+from compliance.model.rest_state import initial_state
 from compliance.simulation.rk4 import OUTPUT_COLUMNS, measured_position, non_physical, record_sample, rk4_step, rk4_workspace
 from compliance.simulation.scenario import Scenario, SensorNoise, sample_profile
 from compliance.model.state_feedback import (

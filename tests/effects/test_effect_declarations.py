@@ -8,7 +8,7 @@ import pytest
 from compliance.model.config import load_plant
 from compliance.effects import EFFECTS
 from compliance.model.vector_slots import EFFECT_SLOTS, STATE_NAMES
-from compliance.model.assembly import parameter_vector
+from compliance.model.plant_vector import parameter_vector
 
 REQUIRED = {
     "heat_transfer", "internal_leakage", "external_leakage", "valve_dynamics", "supply_droop",

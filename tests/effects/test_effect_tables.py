@@ -14,7 +14,7 @@ from compliance.effects import EFFECTS
 from compliance.errors import InputError
 from compliance.linear.analysis import PADE_ORDER, _augment
 from compliance.linear.trim import kept_states
-from compliance.model.assembly import parameter_vector
+from compliance.model.plant_vector import parameter_vector
 from compliance.model.config import load_plant
 from compliance.model.parameters import BASE_PARAMS
 from compliance.model.state_feedback import controller_vector

@@ -16,7 +16,9 @@ import pytest
 
 from compliance.model.config import load_plant
 from compliance.model.vector_slots import A_FRIC, A_LOAD, N_AUX, N_STATES, S_V, S_X2
-from compliance.model.assembly import initial_state, load_curve_arrays, parameter_vector, plant_rhs
+from compliance.model.assembly import plant_rhs
+from compliance.model.plant_vector import load_curve_arrays, parameter_vector
+from compliance.model.rest_state import initial_state
 from compliance.simulation.profiles import Profile, steps
 from compliance.simulation import Scenario, simulate
 

@@ -398,7 +398,8 @@ def regenerate(path: Path = FIXTURE) -> None:  # pragma: no cover - run by hand
     subprocess.run(py + ["check", "plant-a", "--requirements", "requirements/shpp-400kw.toml", "--json", str(tmp / "r.json"), "-q"])
     subprocess.run(py + ["linear", "plant-a", "--map", "--crosscheck", "--governor", "--json", str(tmp / "lin.json")],
                    check=True, stdout=subprocess.DEVNULL)
-    subprocess.run(py + ["validate", str(ROOT / "tests/data/practice/practice_internal_leakage.csv.gz"), "--plant", "plant-a",
+    root = FIXTURE.parents[2]
+    subprocess.run(py + ["validate", "plant-a", str(root / "tests/data/practice/practice_internal_leakage.csv.gz"),
                         "--json", str(tmp / "val.json")], stdout=subprocess.DEVNULL)
     res = json.loads((tmp / "r.json").read_text())
     keep = ("steps-5@mid-no-load", "steps-10@region2-80", "full-stroke@governor-setup", "sine-8mm@region2-80",

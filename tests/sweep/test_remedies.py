@@ -9,7 +9,6 @@ from compliance.cli import main
 from compliance.model.config import load_plant
 from compliance.requirements.loading import load_requirements
 from compliance.sweep.check_remedies import remedies_for_check
-from compliance.sweep.parameter_paths import apply_values
 
 from tests.sweep.conftest import SMALL_TC, sweep_text
 

@@ -14,7 +14,9 @@ from compliance.errors import InputError
 from compliance.model.vector_slots import A_QA, N_AUX, N_STATES, P_FJ, P_FRM, P_KV1, P_KV2, P_VD, S_PA, S_PB, S_V
 from compliance.physics.friction import piecewise_stribeck_friction
 from compliance.physics.valve_flow import bobrow_mass_flow, iso6358_mass_flow, power_law_mass_flow, sanville_mass_flow
-from compliance.model.assembly import initial_state, load_curve_arrays, parameter_vector, plant_rhs
+from compliance.model.assembly import plant_rhs
+from compliance.model.plant_vector import load_curve_arrays, parameter_vector
+from compliance.model.rest_state import initial_state
 from compliance.model import axis_design as design
 from compliance.characterise import flow_rating
 from compliance.characterise.flow_trend import flow_claim

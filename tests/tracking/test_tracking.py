@@ -14,7 +14,8 @@ from compliance import procedures
 from compliance.model.config import load_plant
 from compliance.errors import InputError
 from compliance.model.vector_slots import S_PA, S_PB
-from compliance.model.assembly import initial_state, parameter_vector
+from compliance.model.plant_vector import parameter_vector
+from compliance.model.rest_state import initial_state
 from compliance.simulation import Scenario, simulate
 from compliance.simulation.profiles import sine
 from compliance.procedures import path_tracking as tracking
