@@ -6,13 +6,12 @@ so a CI job never reads half a file.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from xml.sax.saxutils import escape, quoteattr
 
 from compliance.errors import InputError
 from compliance.files.atomic import write_text_atomic
-from compliance.files.jsonable import json_text
+from compliance.files.jsonable import json_text, read_json
 from compliance.units.formatting import STATUS_WORD as _STATUS_WORD  # the one status-word table
 
 RESULTS_SCHEMA = "govcheck-results/1"
@@ -38,15 +37,8 @@ def read_results(path) -> dict:
         Not JSON, or not a govcheck results file of a supported schema.
     """
     p = Path(path)
-    try:
-        data = json.loads(p.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise InputError(f"{p}: results file not found") from None
-    except IsADirectoryError:
-        raise InputError(f"{p}: is a folder; expected a results JSON file written by 'govcheck check --json'") from None
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise InputError(f"{p}: not a JSON results file ({exc.__class__.__name__}: {exc})") from None
-    if not isinstance(data, dict) or "schema" not in data:
+    data = read_json(p, "results")
+    if "schema" not in data:
         raise InputError(f"{p}: schema: missing; expected a govcheck results file ('{RESULTS_SCHEMA}')")
     if data["schema"] != RESULTS_SCHEMA:
         raise InputError(f"{p}: schema: '{data['schema']}' is not supported (expected '{RESULTS_SCHEMA}')")

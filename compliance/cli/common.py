@@ -85,6 +85,15 @@ def add_outputs(parser, *names: str, help: dict | None = None) -> None:
         parser.add_argument(f"--{name}", metavar=_METAVAR[name], default=None, help=text)
 
 
+def add_recording_inputs(parser, recordings: str) -> None:
+    """``[CONFIG] RECORDING``, the hidden old ``--plant`` and ``--column-map`` (validate, diagnose)."""
+    parser.add_argument("inputs", nargs="+", metavar="[CONFIG] RECORDING",
+                        help="plant configuration (TOML file or reference name; default: the sidecar's 'plant') and "
+                             + recordings)
+    parser.add_argument("--plant", help=argparse.SUPPRESS)
+    parser.add_argument("--column-map", help="column map (TOML path or shipped name) for a logger's own names and units")
+
+
 def add_jobs(parser, what: str = "worker processes") -> None:
     """``--jobs/-j N``."""
     parser.add_argument("--jobs", "-j", type=int, default=None, metavar="N", help=f"{what} (default: the available cores)")

@@ -13,10 +13,9 @@ found), 2 on bad input.
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
-from compliance.cli.common import (add_parser, add_jobs, add_outputs, add_quiet, add_reproducible, check_args_outputs,
+from compliance.cli.common import (add_recording_inputs, add_parser, add_jobs, add_outputs, add_quiet, add_reproducible, check_args_outputs,
                                    check_sidecar_conditions, sidecar_plant, split_config)
 from compliance.errors import InputError
 from compliance.files.atomic import write_json_atomic
@@ -45,11 +44,7 @@ def register(sub):
         ],
         usage="govcheck diagnose [options] [CONFIG] RECORDING [RECORDING ...]",
     )
-    p.add_argument("inputs", nargs="+", metavar="[CONFIG] RECORDING",
-                   help="plant configuration (TOML file or reference name; default: the sidecar's 'plant') and the "
-                        "recording file(s); several only for friction runs")
-    p.add_argument("--plant", help=argparse.SUPPRESS)
-    p.add_argument("--column-map", help="column map (TOML path or shipped name) for a logger's own names and units")
+    add_recording_inputs(p, "the recording file(s); several only for friction runs")
     p.add_argument("--effects", help="comma-separated candidate effects (default: every declared effect)")
     p.add_argument("--no-recalibration", action="store_true", help="do not consider recalibrating base parameters")
     add_jobs(p)

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 from compliance.cli.common import add_jobs, add_parser, check_args_outputs
 from compliance.errors import InputError
+from compliance.files.jsonable import read_json
 
 
 def register(subparsers):
@@ -39,22 +39,6 @@ def register(subparsers):
                    help="compliance report appendix: none, summary (configuration, requirement file, versions; default) "
                         "or full (+ every run with its figures)")
     return p
-
-
-def read_json(path, what: str) -> dict:
-    """Read a JSON object from ``path``; InputError naming the file otherwise."""
-    p = Path(path)
-    try:
-        data = json.loads(p.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise InputError(f"{p}: {what} file not found") from None
-    except IsADirectoryError:
-        raise InputError(f"{p}: is a folder; expected a {what} JSON file") from None
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise InputError(f"{p}: not a JSON {what} file ({exc})") from None
-    if not isinstance(data, dict):
-        raise InputError(f"{p}: expected a JSON object ({what}), got {type(data).__name__}")
-    return data
 
 
 def merge_linear(docs) -> dict:

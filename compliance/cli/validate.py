@@ -2,9 +2,8 @@
 
 from __future__ import annotations
 
-import argparse
 
-from compliance.cli.common import (add_parser, add_outputs, add_quiet, add_reproducible, check_args_outputs, check_sidecar_conditions,
+from compliance.cli.common import (add_recording_inputs, add_parser, add_outputs, add_quiet, add_reproducible, check_args_outputs, check_sidecar_conditions,
                                    parse_param_overrides, sidecar_plant, split_config)
 from compliance.errors import InputError
 from compliance.files.atomic import write_json_atomic
@@ -37,11 +36,7 @@ def register(sub):
         ],
         usage="govcheck validate [options] [CONFIG] RECORDING",
     )
-    p.add_argument("inputs", nargs="+", metavar="[CONFIG] RECORDING",
-                   help="plant configuration (TOML file or reference name; default: the sidecar's 'plant') and the "
-                        "recording (canonical CSV/CSV.GZ with NAME.toml sidecar, or any format a column map reads)")
-    p.add_argument("--plant", help=argparse.SUPPRESS)
-    p.add_argument("--column-map", help="column map (TOML path or shipped name) for a logger's own names and units")
+    add_recording_inputs(p, "the recording (canonical CSV/CSV.GZ with NAME.toml sidecar, or any format a column map reads)")
     p.add_argument("--mode", default="both", help="closed_loop, plant_only or both (default both)")
     p.add_argument("--noise", default=None, help="closed-loop position-noise replay: auto (default), recorded, none")
     p.add_argument("--settings", help="validation settings TOML (limits, locate parameters, windows); see docs/validation.md")

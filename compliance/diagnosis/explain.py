@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from compliance.effects import EFFECTS
 from compliance.diagnosis.candidates import FRICTION_LEVEL
+from compliance.units.formatting import format_value
 
 # how each effect reads in words, with its main fitted value ({v} is filled in): ``Effect.explanation``
 PHYSICS = {name: eff.explanation for name, eff in EFFECTS.items()}
@@ -12,30 +13,6 @@ SIGNAL_WORDS = {"position": "position", "pressure_a": "side-A pressure", "pressu
 ALMOST_AS_WELL = 1.5  # a runner-up within this chi-square ratio of the winner is named as an alternative
 REGIME_WORDS = {"step": "after the set-point steps", "hold": "while the position holds", "tracking": "during the sinusoidal tracking",
                 "open_loop": "over the run"}
-
-
-def format_value(value: float, unit: str) -> str:
-    """A value with the unit an engineer would use ("12 ms", "1.5e-10 kg/(s*Pa)", "6.1 W/K")."""
-    v = float(value)
-    if unit == "s":
-        return f"{v*1e3:.3g} ms" if abs(v) < 1 else f"{v:.3g} s"
-    if unit == "m^3":
-        return f"{v*1e3:.3g} L"
-    if unit == "m":
-        return f"{v*1e3:.3g} mm"
-    if unit == "Pa":
-        return f"{v/1e3:.3g} kPa"
-    if unit == "N/m":
-        return f"{v/1e3:.3g} kN/m"
-    if unit == "N/Pa":
-        return f"{v*1e5:.3g} N/bar"
-    if unit == "m^3/(s*Pa)":
-        return f"{v*1e8:.3g} dm^3/(s*bar)"
-    if unit in ("kg/(s*Pa)",):
-        return f"{v:.2g} {unit}"
-    if unit == "":
-        return f"{v:.3g}"
-    return f"{v:.3g} {unit}"
 
 
 def _pm(value, err, unit) -> str:

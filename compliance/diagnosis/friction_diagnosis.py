@@ -30,6 +30,7 @@ import numpy as np
 from scipy.signal import savgol_filter
 
 from compliance.errors import InputError
+from compliance.files.jsonable import json_number
 from compliance.units import ATMOSPHERE_PA
 from compliance.diagnosis.friction_fit import LAWS, PRESLIDING, PRESSURE_EFFECT, LawFit, fit_law
 from compliance.diagnosis.friction_runs import Run
@@ -194,32 +195,27 @@ class SealDiagnosis:
             cands.append({
                 "rank": rank, "name": name,
                 "effects": [e for e in name.split("+") if e != "baseline"],
-                "parameters": [{"name": k, "value": _num(v), "stderr": _num(f.stderr.get(k)), "unit": UNITS[k], "meaning": MEANING[k]}
+                "parameters": [{"name": k, "value": json_number(v), "stderr": json_number(f.stderr.get(k)), "unit": UNITS[k], "meaning": MEANING[k]}
                                for k, v in f.params.items()],
-                "k": f.k, "chi2": _num(s.chi2), "chi2_per_residual": _num(s.chi2 / f.n), "bic": _num(s.bic),
-                "delta_bic": _num(s.delta_bic), "score": _num(-s.delta_bic), "explained_fraction": _num(s.explained),
-                "rms_per_run": {r.name: _num(x) for r, x in zip(self.runs, f.rms_per_run())},
+                "k": f.k, "chi2": json_number(s.chi2), "chi2_per_residual": json_number(s.chi2 / f.n), "bic": json_number(s.bic),
+                "delta_bic": json_number(s.delta_bic), "score": json_number(-s.delta_bic), "explained_fraction": json_number(s.explained),
+                "rms_per_run": {r.name: json_number(x) for r, x in zip(self.runs, f.rms_per_run())},
             })
         base = self.fits["baseline"]
         win = self.fits.get(self.winner) if self.winner else None
         return {
             "seal": self.seal, "verdict": self.verdict, "winner": self.winner, "runner_up": self.runner_up,
             "explanation": self.explanation, "effects": cands,
-            "fit_before": {r.name: {"pressure_gauge": _num(r.pressure), "rms": _num(b), "unit": "N"}
+            "fit_before": {r.name: {"pressure_gauge": json_number(r.pressure), "rms": json_number(b), "unit": "N"}
                            for r, b in zip(self.runs, base.rms_per_run())},
-            "fit_after": ({r.name: {"pressure_gauge": _num(r.pressure), "rms": _num(a), "unit": "N"}
+            "fit_after": ({r.name: {"pressure_gauge": json_number(r.pressure), "rms": json_number(a), "unit": "N"}
                            for r, a in zip(self.runs, win.rms_per_run())} if win else None),
             "windows": self.located, "windows_after": self.located_after,
-            "noise_floor": {"value": _num(self.noise_floor), "unit": "N"},
+            "noise_floor": {"value": json_number(self.noise_floor), "unit": "N"},
             "structure_left": self.structure,
         }
 
 
-def _num(x):
-    if x is None:
-        return None
-    x = float(x)
-    return x if math.isfinite(x) else None
 
 
 def diagnose_seal(runs: list[Run]) -> SealDiagnosis:

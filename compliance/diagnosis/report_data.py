@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-import math
 
 from compliance.effects import EFFECTS
+from compliance.files.jsonable import json_number
 from compliance.model.parameters import BASE_BY_KEY
 from compliance.diagnosis.candidates import FRICTION_LEVEL
 from compliance.diagnosis.residuals import UNITS
@@ -13,27 +13,22 @@ from compliance.diagnosis.select import RESIDUAL_LIMIT
 SCHEMA = "govcheck-diagnosis/1"  # docs/diagnosis-schema.md
 
 
-def _num(x):
-    if x is None:
-        return None
-    x = float(x)
-    return x if math.isfinite(x) else None
 
 
 def _param_rows(cfg, fit) -> list[dict]:
     rows = []
     for fp, v, e in zip(fit.params, fit.values, fit.stderr):
         if fp.kind == "effect":
-            rows.append({"name": fp.key, "kind": "effect", "value": _num(v), "stderr": _num(e), "unit": fp.unit,
-                         "meaning": EFFECTS[fp.effect].param(fp.name).meaning, "default": _num(fp.nominal)})
+            rows.append({"name": fp.key, "kind": "effect", "value": json_number(v), "stderr": json_number(e), "unit": fp.unit,
+                         "meaning": EFFECTS[fp.effect].param(fp.name).meaning, "default": json_number(fp.nominal)})
         elif fp.key == FRICTION_LEVEL:
             for key in ("friction.static_force", "friction.coulomb_force"):
                 a = cfg.p(key)
-                rows.append({"name": key, "kind": "base", "value": _num(a * v), "stderr": _num(a * e), "unit": "N",
-                             "meaning": BASE_BY_KEY[key].meaning, "nominal": _num(a)})
+                rows.append({"name": key, "kind": "base", "value": json_number(a * v), "stderr": json_number(a * e), "unit": "N",
+                             "meaning": BASE_BY_KEY[key].meaning, "nominal": json_number(a)})
         else:
-            rows.append({"name": fp.key, "kind": "base", "value": _num(v), "stderr": _num(e), "unit": fp.unit,
-                         "meaning": BASE_BY_KEY[fp.key].meaning, "nominal": _num(fp.nominal)})
+            rows.append({"name": fp.key, "kind": "base", "value": json_number(v), "stderr": json_number(e), "unit": fp.unit,
+                         "meaning": BASE_BY_KEY[fp.key].meaning, "nominal": json_number(fp.nominal)})
     return rows
 
 
@@ -44,7 +39,7 @@ def _lumped_rows(fit, name: str) -> list[dict]:
         got = fit.lumped(e) if e in EFFECTS else None
         if got is not None:
             decl = EFFECTS[e].lumped
-            rows.append({"name": f"{e}.{decl.name}", "value": _num(got[0]), "stderr": _num(got[1]), "unit": decl.unit,
+            rows.append({"name": f"{e}.{decl.name}", "value": json_number(got[0]), "stderr": json_number(got[1]), "unit": decl.unit,
                          "meaning": decl.meaning})
     return rows
 
@@ -52,8 +47,8 @@ def _lumped_rows(fit, name: str) -> list[dict]:
 def _fit_table(fit: dict | None) -> dict | None:
     if fit is None:
         return None
-    return {s: {"rms": _num(v["rms"]), "unit": UNITS[s], "rms_normalised": _num(v["rms_normalised"]),
-                "nrmse": _num(v["nrmse"]), "fit_percent": _num(v["fit_percent"])} for s, v in fit.items()}
+    return {s: {"rms": json_number(v["rms"]), "unit": UNITS[s], "rms_normalised": json_number(v["rms_normalised"]),
+                "nrmse": json_number(v["nrmse"]), "fit_percent": json_number(v["fit_percent"])} for s, v in fit.items()}
 
 
 def _clean(obj):
@@ -63,7 +58,7 @@ def _clean(obj):
     if isinstance(obj, (list, tuple)):
         return [_clean(v) for v in obj]
     if isinstance(obj, (float, int)) and not isinstance(obj, bool):
-        return _num(obj) if isinstance(obj, float) else obj
+        return json_number(obj) if isinstance(obj, float) else obj
     return obj
 
 
@@ -72,7 +67,7 @@ def _ambiguity(d) -> dict | None:
     if not d.ambiguous:
         return None
     return {"explanations": list(d.ambiguous),
-            "delta_bic": {k: _num(d.scores[k].bic - d.scores[d.ambiguous[0]].bic) for k in d.ambiguous},
+            "delta_bic": {k: json_number(d.scores[k].bic - d.scores[d.ambiguous[0]].bic) for k in d.ambiguous},
             "suggested_test": _clean(d.suggested_test)}
 
 
@@ -93,16 +88,16 @@ def diagnosis_to_dict(d) -> dict:
             "parameters": _param_rows(d.cfg, f),
             "lumped": _lumped_rows(f, name),
             "k": f.k,
-            "chi2": _num(s.chi2),
-            "chi2_per_residual": _num(s.chi2 / f.n) if f.n else None,
-            "aic": _num(s.aic),
-            "bic": _num(s.bic),
-            "delta_bic": _num(s.delta_bic),
-            "score": _num(-s.delta_bic),
-            "explained_fraction": _num(s.explained),
-            "window_agreement": _num(agreement.get(name)) if name != "nominal" else None,
+            "chi2": json_number(s.chi2),
+            "chi2_per_residual": json_number(s.chi2 / f.n) if f.n else None,
+            "aic": json_number(s.aic),
+            "bic": json_number(s.bic),
+            "delta_bic": json_number(s.delta_bic),
+            "score": json_number(-s.delta_bic),
+            "explained_fraction": json_number(s.explained),
+            "window_agreement": json_number(agreement.get(name)) if name != "nominal" else None,
             "simulations": f.sims,
-            "seconds": _num(f.seconds),
+            "seconds": json_number(f.seconds),
         })
     return {
         "schema": SCHEMA,
@@ -117,22 +112,22 @@ def diagnosis_to_dict(d) -> dict:
         "effects": effects,
         "fit_before": _fit_table(d.fit_before),
         "fit_after": _fit_table(d.fit_after),
-        "objective_before": {s: _num(v) for s, v in d.objective_before.items()},
-        "objective_after": {s: _num(v) for s, v in d.objective_after.items()} if d.objective_after else None,
-        "noise_floor": {s: {"value": _num(v), "unit": UNITS[s]} for s, v in d.floors.items()},
+        "objective_before": {s: json_number(v) for s, v in d.objective_before.items()},
+        "objective_after": {s: json_number(v) for s, v in d.objective_after.items()} if d.objective_after else None,
+        "noise_floor": {s: {"value": json_number(v), "unit": UNITS[s]} for s, v in d.floors.items()},
         "windows": [
-            {k: (_num(v) if isinstance(v, float) else ({s: _num(x) for s, x in v.items()} if isinstance(v, dict) else v))
+            {k: (json_number(v) if isinstance(v, float) else ({s: json_number(x) for s, x in v.items()} if isinstance(v, dict) else v))
              for k, v in w.items()}
             for w in d.windows
         ],
         "located_regimes": list(d.located_regimes),
         "ambiguity": _ambiguity(d),
-        "signals_left": {s: _num(v) for s, v in d.signals_left.items()},
+        "signals_left": {s: json_number(v) for s, v in d.signals_left.items()},
         "residual_limit": RESIDUAL_LIMIT,
-        "contributions": {e: {k: _num(v) for k, v in c.items()} for e, c in d.contributions.items()},
+        "contributions": {e: {k: json_number(v) for k, v in c.items()} for e, c in d.contributions.items()},
         "effect_search": _clean(d.search),
         "empirical": _clean(d.empirical),
         "saved_model": d.saved_model,
         "notes": list(d.notes),
-        "timing": {"seconds": _num(d.seconds), "simulations": d.simulations, "jobs": d.jobs},
+        "timing": {"seconds": json_number(d.seconds), "simulations": d.simulations, "jobs": d.jobs},
     }

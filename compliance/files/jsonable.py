@@ -10,11 +10,13 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
-from pathlib import PurePath
+from pathlib import Path, PurePath
 
 import numpy as np
 
-__all__ = ["json_number", "json_text", "jsonable"]
+from compliance.errors import InputError
+
+__all__ = ["json_number", "json_text", "jsonable", "read_json"]
 
 
 def jsonable(obj):
@@ -67,3 +69,19 @@ def json_text(data, *, indent: int | None = 1, compact: bool = False) -> str:
     if compact:
         return json.dumps(clean, separators=(",", ":"), allow_nan=False) + "\n"
     return json.dumps(clean, indent=indent, allow_nan=False) + "\n"
+
+
+def read_json(path, what: str) -> dict:
+    """Read a JSON object from ``path``; InputError naming the file otherwise."""
+    p = Path(path)
+    try:
+        data = json.loads(p.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise InputError(f"{p}: {what} file not found") from None
+    except IsADirectoryError:
+        raise InputError(f"{p}: is a folder; expected a {what} JSON file") from None
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise InputError(f"{p}: not a JSON {what} file ({exc})") from None
+    if not isinstance(data, dict):
+        raise InputError(f"{p}: expected a JSON object ({what}), got {type(data).__name__}")
+    return data

@@ -133,3 +133,27 @@ def fmt_date(iso: str | None) -> str:
     if d.tzinfo is not None:
         return d.astimezone(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     return d.strftime("%Y-%m-%d %H:%M")
+
+
+def format_value(value: float, unit: str) -> str:
+    """An SI value in the unit an engineer would use for it (fitted parameters, explanations) ("12 ms", "1.5e-10 kg/(s*Pa)", "6.1 W/K")."""
+    v = float(value)
+    if unit == "s":
+        return f"{v*1e3:.3g} ms" if abs(v) < 1 else f"{v:.3g} s"
+    if unit == "m^3":
+        return f"{v*1e3:.3g} L"
+    if unit == "m":
+        return f"{v*1e3:.3g} mm"
+    if unit == "Pa":
+        return f"{v/1e3:.3g} kPa"
+    if unit == "N/m":
+        return f"{v/1e3:.3g} kN/m"
+    if unit == "N/Pa":
+        return f"{v*1e5:.3g} N/bar"
+    if unit == "m^3/(s*Pa)":
+        return f"{v*1e8:.3g} dm^3/(s*bar)"
+    if unit in ("kg/(s*Pa)",):
+        return f"{v:.2g} {unit}"
+    if unit == "":
+        return f"{v:.3g}"
+    return f"{v:.3g} {unit}"
