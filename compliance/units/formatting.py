@@ -135,25 +135,19 @@ def fmt_date(iso: str | None) -> str:
     return d.strftime("%Y-%m-%d %H:%M")
 
 
+# SI unit -> (factor, unit an engineer reads) for fitted parameters and explanations
+_ENGINEERING = {"m^3": (1e3, "L"), "m": (1e3, "mm"), "Pa": (1e-3, "kPa"), "N/m": (1e-3, "kN/m"),
+                "N/Pa": (1e5, "N/bar"), "m^3/(s*Pa)": (1e8, "dm^3/(s*bar)")}
+
+
 def format_value(value: float, unit: str) -> str:
-    """An SI value in the unit an engineer would use for it (fitted parameters, explanations) ("12 ms", "1.5e-10 kg/(s*Pa)", "6.1 W/K")."""
+    """An SI value in the unit an engineer reads it in: "12 ms", "50 kN/m", "1.5e-10 kg/(s*Pa)", "6.1 W/K"."""
     v = float(value)
     if unit == "s":
         return f"{v*1e3:.3g} ms" if abs(v) < 1 else f"{v:.3g} s"
-    if unit == "m^3":
-        return f"{v*1e3:.3g} L"
-    if unit == "m":
-        return f"{v*1e3:.3g} mm"
-    if unit == "Pa":
-        return f"{v/1e3:.3g} kPa"
-    if unit == "N/m":
-        return f"{v/1e3:.3g} kN/m"
-    if unit == "N/Pa":
-        return f"{v*1e5:.3g} N/bar"
-    if unit == "m^3/(s*Pa)":
-        return f"{v*1e8:.3g} dm^3/(s*bar)"
-    if unit in ("kg/(s*Pa)",):
+    if unit in _ENGINEERING:
+        factor, shown = _ENGINEERING[unit]
+        return f"{v * factor:.3g} {shown}"
+    if unit == "kg/(s*Pa)":
         return f"{v:.2g} {unit}"
-    if unit == "":
-        return f"{v:.3g}"
-    return f"{v:.3g} {unit}"
+    return f"{v:.3g} {unit}" if unit else f"{v:.3g}"
