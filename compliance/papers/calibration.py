@@ -16,7 +16,11 @@ Search in the unit cube of the declared plausible ranges (``calibration_table``)
 
 The test conditions are separable blocks of the objective (fig. 9's sequence touches only
 fig. 9, the stroke start only the strokes), so each point is scored under every condition set
-with its runs shared, and keeps the best.
+with its runs shared, and keeps the best. Switching a condition can pay only after several
+parameters move together (starting the full strokes from the end stop needs both throttles
+opened at once), which an axis-by-axis compass on the best-over-conditions objective never
+tries; so after the compass starts, the compass is run again under each other condition set held
+fixed, from the optimum (condition-set restarts).
 
 Deterministic: fixed Sobol seed, fixed polling order, ties broken by index.
 """
@@ -98,22 +102,26 @@ class Calibration:
 
 
 def _point_cost(task):
-    """Worker: a unit-cube point (or ("cfg", index) into a list of configurations) -> (cost, condition index)."""
+    """Worker: a unit-cube point (or ("cfg", index) into a list of configurations) -> (cost, condition index,
+    cost under each condition set)."""
     if isinstance(task, tuple):
         cfg = _CTX["cfgs"][task[1]]
     else:
         cfg = _configure(_CTX["cfg"], _CTX["params"], task)
     try:
+        if "score" in _CTX:  # another objective of the same search (calibration_reach: one figure alone)
+            c = _CTX["score"](cfg)
+            return c, 0, (c,)
         return best_conditions(cfg, _CTX["conds"], _CTX.get("targets"))
     except InputError:  # a point the loader's cross-checks refuse is outside the plant
-        return math.inf, 0
+        return math.inf, 0, (math.inf,) * len(_CTX["conds"])
 
 
 def _configure(cfg: PlantConfig, params, u) -> PlantConfig:
     return apply_values(cfg, {fp.key: fp.from_unit(x) for fp, x in zip(params, u)})
 
 
-def _map(tasks: list, workers: int) -> list[tuple[float, int]]:
+def _map(tasks: list, workers: int) -> list[tuple[float, int, tuple[float, ...]]]:
     """Score tasks on a forked pool (workers read the configuration from ``_CTX``, nothing large pickled)."""
     if workers <= 1 or len(tasks) < 4:
         return [_point_cost(t) for t in tasks]
@@ -123,8 +131,8 @@ def _map(tasks: list, workers: int) -> list[tuple[float, int]]:
         return list(pool.map(_point_cost, tasks, chunksize=max(1, len(tasks) // (4 * workers))))
 
 
-def map_configs(cfgs: list[PlantConfig], conds: list[dict], workers: int) -> list[tuple[float, int]]:
-    """(cost, condition index) of each configuration, on the same pool as the search."""
+def map_configs(cfgs: list[PlantConfig], conds: list[dict], workers: int) -> list[tuple[float, int, tuple]]:
+    """(cost, condition index, cost per set) of each configuration, on the same pool as the search."""
     _CTX.update(cfgs=cfgs, conds=conds, targets=None)
     return _map([("cfg", i) for i in range(len(cfgs))], workers)
 
@@ -136,11 +144,14 @@ def _condition_sets(fixed: dict | None = None) -> list[dict]:
 
 
 def _compass(u0: np.ndarray, best: tuple[float, int], workers: int, iterations: int = COMPASS_ITERATIONS,
-             start: float = COMPASS_START):
-    """Parallel compass search in the unit cube from ``u0`` (its (cost, condition) ``best``)."""
+             start: float = COMPASS_START, good_enough: float = -math.inf):
+    """Parallel compass search in the unit cube from ``u0`` (its (cost, condition) ``best``).
+
+    Stops early once the cost is at most ``good_enough``.
+    """
     u, step, n_eval = u0.copy(), start, 0
     for _ in range(iterations):
-        if step < COMPASS_MIN:
+        if step < COMPASS_MIN or best[0] <= good_enough:
             break
         trials = []
         for i in range(u.size):
@@ -157,6 +168,31 @@ def _compass(u0: np.ndarray, best: tuple[float, int], workers: int, iterations: 
         else:
             step *= 0.5
     return u, best, n_eval
+
+
+def _condition_restarts(u_best: np.ndarray, best: tuple, workers: int, iterations: int):
+    """The compass again from the optimum under each other condition set, held fixed.
+
+    Under a fixed set the moves that make that set pay (both throttles opening for a stroke
+    from the end stop) improve one axis at a time, so the compass follows them; restarting from
+    the best sample point of each set instead missed that basin (docs/calibration.md).
+    Returns the best (point, (cost, condition index)) and the evaluations spent.
+    """
+    conds, n_eval = _CTX["conds"], 0
+    u_start, best_j = u_best, best[1]
+    for j, cond in enumerate(conds):
+        if j == best_j:
+            continue
+        _CTX["conds"] = [cond]  # the forked workers read it
+        try:
+            r0 = _point_cost(u_start)
+            u, b, n = _compass(np.asarray(u_start), r0, workers, iterations)
+        finally:
+            _CTX["conds"] = conds
+        n_eval += n + 1
+        if b[0] < best[0] - 1e-9:
+            u_best, best = u, (b[0], j)
+    return u_best, best, n_eval
 
 
 def _profiles(params, u_best: np.ndarray, c_best: float, workers: int):
@@ -193,7 +229,7 @@ def calibrate(cfg: PlantConfig, *, workers: int | None = None, sobol_points: int
               table: tuple[Unstated, ...] | None = None, conditions: dict | None = None,
               profiles: bool = True, targets: dict | None = None,
               compass_iterations: int = COMPASS_ITERATIONS, seeds: tuple[PlantConfig, ...] = (),
-              starts: int = STARTS) -> Calibration:
+              starts: int = STARTS, restarts: bool = True) -> Calibration:
     """Fit the unstated parameters and test conditions of ``cfg`` to the paper's figures.
 
     Parameters
@@ -218,6 +254,8 @@ def calibrate(cfg: PlantConfig, *, workers: int | None = None, sobol_points: int
         Further starting points for the global sample (e.g. an earlier stage's optimum).
     starts : int
         Compass searches from that many best points of the sample.
+    restarts : bool
+        Condition-set restarts: the compass again from the optimum under each other set of test conditions.
     """
     workers = max(1, workers or available_cores())
     table = table if table is not None else unstated_for(cfg)
@@ -240,6 +278,9 @@ def calibrate(cfg: PlantConfig, *, workers: int | None = None, sobol_points: int
         n_eval += n
         if b[0] < best[0]:
             u_best, best = u, b
+    if restarts and len(conds) > 1:
+        u_best, best, n = _condition_restarts(u_best, best, workers, compass_iterations)
+        n_eval += n
     prof = []
     for _ in range(POLISH_ROUNDS + 1 if profiles else 0):
         prof, better = _profiles(params, u_best, best[0], workers)

@@ -85,7 +85,7 @@ def effect_search(cfg: PlantConfig, conditions: dict, base_rows: list[Row], work
     costs = map_configs(cfgs, [conditions], workers)
     best: dict[str, tuple[float, int]] = {}
     tried: dict[str, list[tuple[float, dict]]] = {}
-    for i, ((name, point), (c, _)) in enumerate(zip(owners, costs)):
+    for i, ((name, point), (c, *_)) in enumerate(zip(owners, costs)):
         tried.setdefault(name, []).append((c, point))
         if name not in best or c < best[name][0]:
             best[name] = (c, i)

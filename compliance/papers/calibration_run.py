@@ -77,6 +77,7 @@ def run_calibration(cfg: PlantConfig, out: str, json_path: str | None = None) ->
     """
     from compliance.model.config import load_plant
     from compliance.papers.calibration_effects import format_effect_search
+    from compliance.papers.calibration_reach import format_reach, reach_json, reach_search
     from compliance.papers.calibration_report import calibration_table, save_calibrated
     from compliance.papers.plant_a import compare, format_table
 
@@ -86,14 +87,19 @@ def run_calibration(cfg: PlantConfig, out: str, json_path: str | None = None) ->
     t0, c0 = time.perf_counter(), _cpu_seconds()
     final, first, found = calibrate_in_stages(cfg)
     wall, cpu = time.perf_counter() - t0, _cpu_seconds() - c0
+    # serial: one figure's test is a few ms, less than a process pool costs per poll
+    reach = reach_search(final.best, final.conditions, final.rows_after, workers=1)
+    reach_wall, reach_cpu = time.perf_counter() - t0 - wall, _cpu_seconds() - c0 - cpu
     columns = [("published", final.rows_before), ("parameters", first.rows_after)]
     if found:
         columns.append(("+ null flow", final.rows_after))
     print(calibration_table(final, columns))
     if found:
         print("\n" + format_effect_search(found, first.cost_after))
+    print("\n" + format_reach(reach))
     print(f"\ncalibration: {wall:.1f} s wall, {cpu:.1f} s CPU over all processes "
-          f"(= {cpu / max(final.workers, 1):.1f} s on {final.workers} idle cores)")
+          f"(= {cpu / max(final.workers, 1):.1f} s on {final.workers} idle cores); reach search: {reach_wall:.1f} s wall, "
+          f"{reach_cpu:.1f} s CPU")
     saved = save_calibrated(final, out)
     print(f"saved {saved}: every changed value has source = \"calibrated to seed 000 figures ...\"\n")
     best = load_plant(saved)
@@ -105,10 +111,11 @@ def run_calibration(cfg: PlantConfig, out: str, json_path: str | None = None) ->
             "plant": best.name, "calibrated_file": saved, "conditions": final.conditions,
             "cost_published": final.cost_before, "cost_parameters_only": first.cost_after,
             "cost_final": final.cost_after, "values": final.values, "evaluations": final.evaluations,
-            "wall_s": wall, "cpu_s": cpu,
+            "wall_s": wall, "cpu_s": cpu, "reach_wall_s": reach_wall, "reach_cpu_s": reach_cpu,
             "columns": {label: [r.__dict__ for r in rows] for label, rows in columns},
             "profiles": [p.__dict__ for p in final.profiles],
             "effect_search": [{"name": r.name, "cost": r.cost, "params": r.params, "closes": r.closes,
                                "opens": r.opens} for r in found],
+            "reach": reach_json(reach),
         })
     return 0

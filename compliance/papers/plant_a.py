@@ -42,6 +42,7 @@ TOLERANCES = {
 # test conditions the lost figures leave open (choices; the calibration picks, docs/calibration.md)
 FIG9_SEQUENCES = {"alternating": "2%@4s,-2%@9s,2%@14s", "staircase": "2%@4s,2%@9s,2%@14s"}
 DEFAULT_CONDITIONS = {"fig9_sequence": "alternating", "full_stroke_start": "balanced"}
+STROKE_TEST = "speed-governor set-up (5.7 kN)"  # the full strokes of section 5.2
 SENSITIVITY_STEP = 0.2  # relative perturbation of assumed parameters
 SENSITIVITY_PARAMS = (
     "friction.static_force",
@@ -133,6 +134,14 @@ def _case_rows(cfg: PlantConfig, case: StepCase, memo: dict | None = None) -> li
         rows.append(Row(label, "settling time", m.settling_time, p_settle, "s", note=case.note))
         rows.append(Row(label, "steady error", m.steady_state_error, p_err, "mm"))
     return rows
+
+
+def case_test(row_test: str) -> str:
+    """The test (``StepCase.test``, or ``STROKE_TEST``) a row belongs to (a multi-step case adds " (step k)")."""
+    for c in CASES:
+        if row_test == c.test or row_test.startswith(c.test + " (step"):
+            return c.test
+    return row_test
 
 
 def scaled_miss(row: Row) -> float | None:
@@ -232,28 +241,32 @@ def full_stroke(cfg: PlantConfig, load: float = 5700.0, start: str = "balanced")
     return out
 
 
-def figure_rows(cfg: PlantConfig, conditions: dict | None = None,
-                memo: dict | None = None) -> list[tuple[StepCase | None, int, Row]]:
+def figure_rows(cfg: PlantConfig, conditions: dict | None = None, memo: dict | None = None,
+                tests: frozenset | None = None) -> list[tuple[StepCase | None, int, Row]]:
     """The paper's figures (figs. 9-12, section 5.2) simulated: (case, step index, row), flags set.
 
     ``memo``: a dict kept for one configuration, so that several condition sets share the runs.
+    ``tests``: only the rows of these tests (``Row.test`` names; the others are not simulated).
     """
     cond = dict(DEFAULT_CONDITIONS, **(conditions or {}))
     memo = {} if memo is None else memo
     out = []
     for case in cases(cond):
+        if tests is not None and case.test not in tests:
+            continue
         rows = _case_rows(cfg, case, memo)
         idxs = [i for i in case.paper for _ in (0, 1)]
         out.extend((case, idx, row) for idx, row in zip(idxs, rows))
-    key = ("full_stroke", cond["full_stroke_start"])
-    if key not in memo:
-        memo[key] = full_stroke(cfg, start=cond["full_stroke_start"])
-    fs = memo[key]
-    for name, key in (("opening time t_a", "opening"), ("closing time t_f", "closing")):
-        out.append((None, 0, Row("speed-governor set-up (5.7 kN)", name, fs[key], 5.0, "s")))
-    vmax = max(fs["opening_speed"], fs["closing_speed"])
-    out.append((None, 0, Row("speed-governor set-up (5.7 kN)", "max speed", vmax, 0.09, "m/s",
-                             note=f"full strokes start {cond['full_stroke_start']}")))
+    if tests is None or STROKE_TEST in tests:
+        key = ("full_stroke", cond["full_stroke_start"])
+        if key not in memo:
+            memo[key] = full_stroke(cfg, start=cond["full_stroke_start"])
+        fs = memo[key]
+        for name, k in (("opening time t_a", "opening"), ("closing time t_f", "closing")):
+            out.append((None, 0, Row(STROKE_TEST, name, fs[k], 5.0, "s")))
+        vmax = max(fs["opening_speed"], fs["closing_speed"])
+        out.append((None, 0, Row(STROKE_TEST, "max speed", vmax, 0.09, "m/s",
+                                 note=f"full strokes start {cond['full_stroke_start']}")))
     for _, _, row in out:
         row.flagged = _flag(row)
     return out
