@@ -149,7 +149,7 @@ def plant_rhs(y, P, u_valve, load_xs, load_ys, dy, aux):
     if P[P_NF_ON] != 0.0:
         # the lands leak near null (Merritt 1967 sec. 5.4), driven by the command the spool sees
         u_null = (u if not lag_opening else u_valve + (P[P_VO_OFF] if P[P_VO_ON] != 0.0 else 0.0)) - P[P_UCEN]
-        l_pa, l_at, l_pb, l_bt = land_leak_openings(u_null, P[P_NF_A0], P[P_NF_W])
+        l_pa, l_at, l_pb, l_bt = land_leak_openings(u_null, P[P_NF_A0], P[P_NF_W], P[P_DZP], P[P_DZN])
         a_pa = min(a_pa + l_pa, 1.0)
         a_at = min(a_at + l_at, 1.0)
         a_pb = min(a_pb + l_pb, 1.0)

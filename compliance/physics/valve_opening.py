@@ -75,16 +75,19 @@ def openings_from_signed(o):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def land_leak_openings(u, null_opening, null_width):
+def land_leak_openings(u, null_opening, null_width, dz_pos, dz_neg):
     """Relative openings through which the four lands leak near null (a_pa, a_at, a_pb, a_bt) [-].
 
     A real spool passes flow inside its nominal dead zone: air leaks through the radial
     clearance of every land, more the less of the land is covered (Merritt 1967, sec. 5.4: null
-    leakage and the pressure sensitivity of a practical critical-centre valve). Taken linear in
-    the command: each land leaks ``null_opening`` at null; the lands a command of |u| =
-    ``null_width`` uncovers leak twice that, the ones it covers no longer leak. With both lands
-    of a port leaking, the port pressure follows the command inside the dead zone (a finite
-    pressure gain at null) instead of staying where the valve shut.
+    leakage and the pressure sensitivity of a practical critical-centre valve; near null the
+    clearance acts as a small underlap). Taken linear in the spool travel, as for an underlap of
+    ``null_width``: each land leaks ``null_opening`` at null; a land the command covers leaks
+    a0*(1 - |u|/w) and is shut from |u| = w; a land the command uncovers leaks a0*(1 + |u|/w)
+    and keeps opening with the travel until its metering edge is reached at the nominal dead
+    zone (beyond it the nominal opening adds and the leak stays at its edge value). With both
+    lands of a port leaking the port pressure follows the command inside the dead zone (a finite
+    pressure gain at null), and the flow keeps a finite gain across the whole dead zone.
 
     Parameters
     ----------
@@ -93,13 +96,17 @@ def land_leak_openings(u, null_opening, null_width):
     null_opening : float
         Relative opening of each land at null [-] (>= 0).
     null_width : float
-        Command over which a land goes from half to fully covered [V] (> 0).
+        Command over which a covered land closes (the equivalent underlap) [V] (> 0).
+    dz_pos, dz_neg : float
+        Nominal dead zone for positive / negative commands [V] (where the uncovering land's edge opens).
     """
     s = u / null_width
-    if s > 1.0:
-        s = 1.0
-    elif s < -1.0:
-        s = -1.0
-    uncovering = null_opening * (1.0 + s)  # P->A and B->T for u > 0
-    covering = null_opening * (1.0 - s)  # P->B and A->T for u > 0
-    return uncovering, covering, covering, uncovering
+    # an uncovering land opens until its edge (at least over the width, where a critically lapped valve opens anyway)
+    edge = (dz_pos if u >= 0.0 else dz_neg) / null_width
+    up = min(abs(s), max(edge, 1.0))
+    down = max(1.0 - abs(s), 0.0)
+    uncovering = null_opening * (1.0 + up)
+    covering = null_opening * down
+    if u >= 0.0:
+        return uncovering, covering, covering, uncovering  # P->A and B->T uncovered
+    return covering, uncovering, uncovering, covering

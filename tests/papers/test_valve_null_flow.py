@@ -47,7 +47,7 @@ def test_finite_null_flow_shrinks_the_steady_error_monotonically():
 def _port_pressure(u, opening, width, ps=8.0e5, patm=1.013e5, c=2.33e-8):
     """Steady pressure of a blocked port A: inflow P->A equals outflow A->T (ISO 6358, seed 000 eq. 1)."""
     dz_pa, dz_at, _, _ = valve_openings(u, 0.61, 0.69, 1.0, 1.0, 4.0)
-    l_pa, l_at, _, _ = land_leak_openings(u, opening, width)
+    l_pa, l_at, _, _ = land_leak_openings(u, opening, width, 0.61, 0.69)
 
     def net(p):
         q_in = iso6358_mass_flow(1.0, c * (dz_pa + l_pa), ps, p, 293.15, 0.528, 1.204, 293.15)
@@ -72,3 +72,27 @@ def test_null_flow_gives_a_pressure_gain_at_null():
     assert gain > 1e5  # Pa/V: over 1 bar per volt near null
     # the swing is set by the width: a covered land stops leaking at |u| = width
     assert _port_pressure(0.3, 0.005, 0.3) == 8.0e5 and _port_pressure(-0.3, 0.005, 0.3) < 1.1e5
+
+
+def test_an_uncovering_land_keeps_opening_up_to_its_metering_edge():
+    """Underlap-like leak (w = 0.1 V, inside the 0.61/0.69 V dead zone): the land the command covers is shut from
+    |u| = w, the one it uncovers keeps opening with the travel (slope a0/w) until its edge, where the nominal
+    opening takes over: the total opening of the path is continuous and strictly rising through the dead zone
+    and its edge, so the loop keeps a flow gain everywhere (no flat band between w and the dead zone)."""
+    a0, w = 0.004, 0.1
+    for sign, dz in ((+1.0, 0.61), (-1.0, 0.69)):
+        def path(u):  # P->A for u > 0, A->T for u < 0: the uncovering path
+            nominal = valve_openings(sign * u, 0.61, 0.69, 1.0, 1.0, 4.0)
+            leak = land_leak_openings(sign * u, a0, w, 0.61, 0.69)
+            k = 0 if sign > 0 else 1
+            return nominal[k] + leak[k], leak[2 if sign > 0 else 3]
+
+        us = [0.0, 0.05, 0.2, 0.4, dz - 1e-6, dz + 1e-6, dz + 0.2]
+        opened = [path(u)[0] for u in us]
+        assert all(b > a for a, b in zip(opened, opened[1:]))
+        assert opened[1] - opened[0] == pytest.approx(a0 * 0.05 / w, rel=1e-9)  # slope a0/w near null
+        assert opened[3] - opened[2] == pytest.approx(a0 * 0.2 / w, rel=1e-9)  # still a0/w beyond w
+        assert opened[5] - opened[4] == pytest.approx(0.0, abs=1e-5)  # continuous at the metering edge
+        assert path(0.2)[1] == 0.0  # the covered land is shut beyond w
+    # the equivalent underlap wider than the dead zone (a critically lapped valve, plant B): leak capped at 2 a0
+    assert land_leak_openings(1.0, a0, 0.3, 0.0, 0.0)[0] == pytest.approx(2 * a0)
