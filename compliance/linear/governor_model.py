@@ -28,6 +28,7 @@ from compliance.linear.analysis import analyse
 from compliance.linear.maps import nonlinear_step
 from compliance.simulation.profiles import Profile
 from compliance.simulation import Scenario, simulate
+from compliance.simulation.scenario import stroke_start_pressures
 
 
 def nominal_point(cfg: PlantConfig) -> tuple[float, float | str | None]:
@@ -55,7 +56,7 @@ def stroke_average_load(cfg: PlantConfig) -> float | None:
 
 
 def stroke_speed(cfg: PlantConfig, direction: str, load, *, flow_control: bool = True, timeout: float = 30.0) -> dict:
-    """Full-stroke closed-loop run: a reference step from one end to the other, speed from 25-75 % of stroke.
+    """Full-stroke closed-loop run: a reference step from one end stop to the other, speed from 25-75 % of stroke.
 
     Returns
     -------
@@ -66,7 +67,9 @@ def stroke_speed(cfg: PlantConfig, direction: str, load, *, flow_control: bool =
     L = cfg.p("cylinder.stroke")
     x0, x1 = (0.0, L) if direction == "opening" else (L, 0.0)
     ref = Profile(np.array([0.0, 0.1, 0.1]), np.array([x0, x0, x1]))
-    df = simulate(cfg, Scenario(timeout, x0, reference=ref, load=load, flow_control=flow_control))
+    # from the end stop as the hold there leaves the chambers, like the full_stroke procedure
+    df = simulate(cfg, Scenario(timeout, x0, reference=ref, load=load, flow_control=flow_control,
+                                initial_pressures=stroke_start_pressures(cfg, direction)))
     t, x = M.frame_columns(df, "time", "position")
     T, t1, t2, why = M.stroke_time(t, x, L, direction)
     if T is None:

@@ -25,6 +25,7 @@ from compliance.model.config import PlantConfig
 from compliance.model.dead_zone_stall import stall_error
 from compliance.papers.plant_a_fig8 import fig8, format_fig8
 from compliance.metrics import find_steps, speed_extremes, step_response, stroke_time
+from compliance.simulation.scenario import stroke_start_pressures
 from compliance.simulation.profiles import Profile, steps
 from compliance.simulation import Scenario, simulate
 
@@ -223,15 +224,12 @@ def full_stroke(cfg: PlantConfig, load: float = 5700.0, start: str = "balanced")
     supply pressure and the other exhausted to atmosphere (the paper does not say which).
     """
     stroke = cfg.p("cylinder.stroke")
-    ps, patm = cfg.p("air.supply_pressure"), cfg.p("air.atmospheric_pressure")
     out = {}
     for name, direction in (("opening", +1), ("closing", -1)):
         x0 = 0.0 if direction > 0 else stroke
         u = cfg.p("valve.centre_voltage") + direction * cfg.p("valve.command_limit")
         cmd = Profile(np.array([0.0, 0.2, 0.2]), np.array([cfg.p("valve.centre_voltage")] * 2 + [u]))
-        pressures = None
-        if start == "end_stop":  # closing ended at x = 0 with B at supply; opening ended at L with A at supply
-            pressures = (1.001 * patm, ps) if direction > 0 else (ps, 1.001 * patm)
+        pressures = stroke_start_pressures(cfg, name, "rest" if start == "balanced" else start)
         df = simulate(cfg, Scenario(duration=12.0, initial_position=x0, command=cmd, load=load, flow_control=True,
                                     initial_pressures=pressures))
         t = df.time.to_numpy()

@@ -13,13 +13,13 @@ from dataclasses import dataclass
 from compliance.units.amounts import parse_amount
 from compliance.errors import InputError
 
-__all__ = ["KINDS", "ROBOT_TRACKING", "TRACKING", "Kind", "Setting", "parse_setting"]
+__all__ = ["KINDS", "STROKE_STARTS", "ROBOT_TRACKING", "TRACKING", "Kind", "Setting", "parse_setting"]
 
 
 @dataclass(frozen=True)
 class Setting:
     """A procedure setting: type (``length``, ``time``, ``frequency``, ``speed``, ``voltage``,
-    ``number``, ``count``, ``bool``, ``directions``, ``pattern``), default text (None = required)."""
+    ``number``, ``count``, ``bool``, ``directions``, ``pattern``, ``start``), default text (None = required)."""
 
     type: str
     default: object
@@ -37,6 +37,12 @@ class Kind:
 
 _SI = {"length": "m", "time": "s", "frequency": "Hz", "speed": "m/s", "voltage": "V"}
 _CMD = Setting("voltage", "full", "valve command magnitude about the valve centre; 'full' = valve.command_limit")
+
+# How a full stroke starts: as the hold at the end left the chambers, or at rest with the pressures
+# balancing the load about their mean (the idealised start); simulation.scenario.stroke_start_pressures.
+STROKE_STARTS = ("end_stop", "rest")
+_START = Setting("start", "end_stop", "initial chamber pressures: 'end_stop' = as the hold at the end left them (the side "
+                 "about to drive exhausted, the other at supply); 'rest' = at rest balancing the load about their mean")
 
 KINDS: dict[str, Kind] = {
     k.name: k
@@ -58,12 +64,14 @@ KINDS: dict[str, Kind] = {
             "command": _CMD,
             "flow_control": Setting("bool", True, "flow-control valves 2V2/2V3 in the circuit"),
             "timeout": Setting("time", "30 s", "simulated time per stroke"),
+            "start": _START,
         }),
         Kind("independent_adjustment", "change one flow-control valve; the other direction's time must not change", {
             "adjust": Setting("directions", ["opening", "closing"], "which valve(s) to change, one at a time"),
             "factor": Setting("number", 0.5, "factor applied to the adjusted valve's conductance"),
             "command": _CMD,
             "timeout": Setting("time", "30 s", "simulated time per stroke"),
+            "start": _START,
         }),
         Kind("hold", "reach the operating point's position from below, then hold it under its load in closed loop", {
             "duration": Setting("time", "10 s", "simulated time"),
@@ -160,6 +168,10 @@ def parse_setting(setting: Setting, value, where: str):
     if t == "bool":
         if not isinstance(value, bool):
             raise InputError(f"{where}: expected true or false, got {value!r}")
+        return value
+    if t == "start":
+        if value not in STROKE_STARTS:
+            raise InputError(f"{where}: expected one of {', '.join(repr(v) for v in STROKE_STARTS)}, got {value!r}")
         return value
     allowed = ("opening", "closing") if t == "directions" else ("up", "down")
     if not isinstance(value, list) or not value or any(v not in allowed for v in value):

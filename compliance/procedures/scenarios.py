@@ -12,7 +12,7 @@ import numpy as np
 
 from compliance import metrics as M
 from compliance.errors import InputError
-from compliance.simulation.scenario import scenario_load
+from compliance.simulation.scenario import scenario_load, stroke_start_pressures
 from compliance.procedures.outcomes import Sample, downsample
 
 __all__ = [
@@ -58,14 +58,18 @@ def full_command(cfg, setting) -> tuple[float, float]:
     return centre + mag, centre - mag
 
 
-def simulate_run(cfg, duration, x0, *, reference=None, command=None, load=None, flow_control=None):
-    """Simulate one scenario (``compliance.simulation``, looked up at call time) -> DataFrame."""
+def simulate_run(cfg, duration, x0, *, reference=None, command=None, load=None, flow_control=None, pressures=None):
+    """Simulate one scenario (``compliance.simulation``, looked up at call time) -> DataFrame.
+
+    ``pressures``: initial chamber pressures (p_A, p_B) [Pa]; None = at rest balancing the load.
+    """
     from compliance.simulation import Scenario, simulate
 
-    return simulate(cfg, Scenario(duration, x0, reference=reference, command=command, load=load, flow_control=flow_control))
+    return simulate(cfg, Scenario(duration, x0, reference=reference, command=command, load=load, flow_control=flow_control,
+                                  initial_pressures=pressures))
 
 
-def full_command_stroke(cfg, op, direction, command, duration, flow_control):
+def full_command_stroke(cfg, op, direction, command, duration, flow_control, start="end_stop"):
     """Open-loop run at full valve command from the end of the stroke a ``direction`` starts at.
 
     Parameters
@@ -81,6 +85,8 @@ def full_command_stroke(cfg, op, direction, command, duration, flow_control):
         Simulated time [s].
     flow_control : bool or None
         Flow-control valves in the circuit (None = as configured).
+    start : {"end_stop", "rest"}
+        Initial chamber pressures (:func:`stroke_start_pressures`).
 
     Returns
     -------
@@ -90,7 +96,8 @@ def full_command_stroke(cfg, op, direction, command, duration, flow_control):
 
     u_open, u_close = full_command(cfg, command)
     x0, u = (0.0, u_open) if direction == "opening" else (stroke(cfg), u_close)
-    return simulate_run(cfg, duration, x0, command=Profile.constant(u), load=scenario_load(cfg, op), flow_control=flow_control)
+    return simulate_run(cfg, duration, x0, command=Profile.constant(u), load=scenario_load(cfg, op), flow_control=flow_control,
+                        pressures=stroke_start_pressures(cfg, direction, start))
 
 
 def swing(cfg, proc, op) -> tuple[float, float]:

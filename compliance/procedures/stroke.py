@@ -21,7 +21,7 @@ __all__ = ["run_full_stroke", "run_independent_adjustment", "stroke_runs"]
 _VALVE_KEY = {"opening": "flow_control.opening_conductance", "closing": "flow_control.closing_conductance"}
 
 
-def stroke_runs(cfg, op, command, flow_control, timeout, label, out, directions=("opening", "closing")):
+def stroke_runs(cfg, op, command, flow_control, timeout, label, out, directions=("opening", "closing"), start="end_stop"):
     """Full-command strokes from each end, simulated long enough to pass 25-75 % and reach the end.
 
     Parameters
@@ -39,6 +39,8 @@ def stroke_runs(cfg, op, command, flow_control, timeout, label, out, directions=
         Trace label prefix; empty = keep no traces or marks in ``out``.
     out : RunOutcome
     directions : iterable of {"opening", "closing"}
+    start : {"end_stop", "rest"}
+        Initial chamber pressures (``simulation.scenario.stroke_start_pressures``).
 
     Returns
     -------
@@ -52,7 +54,7 @@ def stroke_runs(cfg, op, command, flow_control, timeout, label, out, directions=
         # simulate 8 s, then double up to the timeout until the stroke passes 75 % (25 %) and ends
         dur = min(8.0, timeout)
         while True:
-            df = full_command_stroke(cfg, op, d, command, dur, flow_control)
+            df = full_command_stroke(cfg, op, d, command, dur, flow_control, start)
             tt, x = M.frame_columns(df, "time", "position")
             T, t1, t2, why = M.stroke_time(tt, x, L, d)
             done = abs(x[-1] - x_end) <= 0.01 * L
@@ -72,7 +74,7 @@ def run_full_stroke(cfg, proc, op, requests, out):
     """Run a ``full_stroke`` procedure at ``op`` and add its samples to ``out`` (see ``procedures.run``)."""
     s = proc.settings
     label = f"{proc.name}@{op.name}"
-    times = stroke_runs(cfg, op, s["command"], s["flow_control"], s["timeout"].value, label, out, s["directions"])
+    times = stroke_runs(cfg, op, s["command"], s["flow_control"], s["timeout"].value, label, out, s["directions"], s["start"])
     for d, (T, why, df, t1, t2) in times.items():
         tt, x = M.frame_columns(df, "time", "position")
         L = stroke(cfg)
@@ -90,7 +92,7 @@ def run_independent_adjustment(cfg, proc, op, requests, out):
     """Run an ``independent_adjustment`` procedure at ``op`` and add its samples to ``out``."""
     s = proc.settings
     timeout = s["timeout"].value
-    base = stroke_runs(cfg, op, s["command"], True, timeout, f"{proc.name}@{op.name} base", out)
+    base = stroke_runs(cfg, op, s["command"], True, timeout, f"{proc.name}@{op.name} base", out, start=s["start"])
     base_t = {d: v[0] for d, v in base.items()}
     for d, v in base.items():
         if v[0] is None:
@@ -103,7 +105,8 @@ def run_independent_adjustment(cfg, proc, op, requests, out):
             _not_measured(out, adj, f"{key} = 0 (no throttle in the circuit): there is nothing to adjust")
             continue
         mod_cfg = cfg.replace(params={key: c0 * s["factor"]})
-        mod = stroke_runs(mod_cfg, op, s["command"], True, timeout, f"{proc.name}@{op.name} {adj} x{s['factor']:g}", out)
+        mod = stroke_runs(mod_cfg, op, s["command"], True, timeout, f"{proc.name}@{op.name} {adj} x{s['factor']:g}", out,
+                          start=s["start"])
         mod_t = {d: v[0] for d, v in mod.items()}
         if any(v is None for v in mod_t.values()):
             _not_measured(out, adj, "; ".join(v[1] for v in mod.values() if v[0] is None))

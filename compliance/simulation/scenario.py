@@ -83,3 +83,17 @@ def scenario_load(cfg, op):
     if op.load == "nominal":
         return cfg.p("load.nominal_force")
     return op.load
+
+
+def stroke_start_pressures(cfg, direction: str, start: str = "end_stop"):
+    """Initial chamber pressures (p_A, p_B) [Pa] of a full stroke, or None for the rest state.
+
+    ``"end_stop"``: the servo sits at the end it starts from, held there by the side that drove it
+    (at supply); the side about to drive is exhausted to atmosphere (A drives opening, B closing).
+    ``"rest"``: None (the simulator's rest state balancing the load, mean (p_s + p_atm)/2).
+    """
+    if start == "rest":
+        return None
+    ps, patm = cfg.p("air.supply_pressure"), cfg.p("air.atmospheric_pressure")
+    exhausted = 1.001 * patm  # just above atmosphere: an exhausted chamber still holds its residual air
+    return (exhausted, ps) if direction == "opening" else (ps, exhausted)

@@ -105,7 +105,7 @@ file_cases(CHECK, "bad.toml", [
     ("config-negative-gain", plant('"280 V/m"', '"-280 V/m"'), "kp"),
     ("config-zero-sample-time", plant('sample_time = { value = "1 ms"', 'sample_time = { value = "0 ms"'), "sample_time"),
     ("config-step-too-large", plant('step = { value = "1 ms"', 'step = { value = "1 s"'), "step"),
-    ("config-conductance-unit", plant('"0.440 dm^3/(s*bar)"', '"0.440 bar"'), "opening_conductance"),
+    ("config-conductance-unit", plant('"0.794 dm^3/(s*bar)"', '"0.794 bar"'), "opening_conductance"),
     ("config-critical-ratio-above-1", plant("critical_pressure_ratio = { value = 0.528", "critical_pressure_ratio = { value = 1.5"), "critical_pressure_ratio"),
 ])
 case("config-missing-file", "check nothere.toml -r req.toml -q", "nothere.toml")
