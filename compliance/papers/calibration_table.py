@@ -16,6 +16,9 @@ from compliance.effects import EFFECTS
 from compliance.model.config import PlantConfig
 from compliance.model.parameters import BASE_BY_KEY
 
+# breakaway over Coulomb friction of lip seals (the static force's plausible range, as a ratio)
+BREAKAWAY_RATIO = (1.0, 1.6)
+
 CALIBRATED_SOURCE = "calibrated to seed 000 figures 9-12 and section 5.2 (govcheck reproduce plant-a --calibrate)"
 
 
@@ -67,7 +70,7 @@ UNSTATED: tuple[Unstated, ...] = (
              "fig. 3 (friction maps) is lost; 125 mm piston + 32 mm rod seals: 1-6 % of the 16 kN theoretical "
              "force at 7 bar"),
     Unstated("friction.static_force", 100.0, 1400.0, True,
-             "fig. 3 is lost; breakaway 1.0-1.6 x Coulomb for lip seals (set to at least the Coulomb force)"),
+             "fig. 3 is lost; breakaway 1.0-1.6 x Coulomb for lip seals (held within that ratio of the Coulomb force)"),
     Unstated("friction.stribeck_velocity", 0.001, 0.03, True,
              "fig. 3 is lost; pneumatic seal maps fall from static to Coulomb within 1-30 mm/s"),
     Unstated("friction.viscous_coefficient", 100.0, 3000.0, True,
@@ -123,8 +126,8 @@ def value_of(cfg: PlantConfig, path: str) -> float:
 def apply_values(cfg: PlantConfig, values: dict[str, float], source: str = CALIBRATED_SOURCE) -> PlantConfig:
     """``cfg`` with ``values`` (path -> SI) set, every changed base value's source = ``source``.
 
-    The static friction is raised to the Coulomb force when a point asks for less (a static
-    force below the sliding force is not physical; the loader refuses it).
+    The static friction is held within ``BREAKAWAY_RATIO`` times the Coulomb force: below it is not
+    physical (the loader refuses it), above it is outside what the range's reason allows.
     """
     base: dict[str, float] = {}
     effects: dict[str, dict[str, float]] = {}
@@ -136,5 +139,7 @@ def apply_values(cfg: PlantConfig, values: dict[str, float], source: str = CALIB
             base[path] = float(v)
     if "friction.coulomb_force" in base or "friction.static_force" in base:
         fc = base.get("friction.coulomb_force", cfg.p("friction.coulomb_force"))
-        base["friction.static_force"] = max(base.get("friction.static_force", cfg.p("friction.static_force")), fc)
+        fs = base.get("friction.static_force", cfg.p("friction.static_force"))
+        lo, hi = BREAKAWAY_RATIO
+        base["friction.static_force"] = min(max(fs, lo * fc), hi * fc)
     return cfg.replace(params=base or None, effects=effects or None, sources={k: source for k in base})
