@@ -341,7 +341,7 @@ def run_practice(directory, cfg: PlantConfig, *, library=None, jobs: int = 1) ->
     from compliance.errors import InputError
     from compliance.recordings.reader import read_recording
     from compliance.diagnosis.engine import diagnose
-    from compliance.diagnosis.practice_score import practice_correct
+    from compliance.diagnosis.practice_score import answer_in_si, practice_correct
 
     folder = Path(directory)
     answers_path = folder / "ANSWERS.json"
@@ -368,6 +368,7 @@ def run_practice(directory, cfg: PlantConfig, *, library=None, jobs: int = 1) ->
         for alias, value in (ans.get("parameters") or {}).items():
             key = ANSWER_ALIASES.get(alias, alias)
             got = fitted.get(key)
+            value = answer_in_si(alias, value)
             params[alias] = {"true": value, "fitted": got, "error": None if got is None else abs(got - value) / abs(value)}
         rows.append({"name": name, "truth": ", ".join(truth) or "none", "verdict": d.verdict, "winner": d.winner,
                      "correct": bool(correct), "ambiguous_with_truth": ambiguous_ok, "ambiguity": list(d.ambiguous),

@@ -4,6 +4,15 @@ from __future__ import annotations
 
 from compliance.effects import EFFECTS
 
+# answers given in a unit other than the SI unit of the declared parameter: name -> factor to SI
+# (the practice emulator states its pressure-dependent friction per bar; ours is per Pa)
+ANSWER_TO_SI = {"kp_fric": 1e-5}
+
+
+def answer_in_si(name: str, value: float) -> float:
+    """A true parameter value of ANSWERS.json in the SI unit of the parameter it names."""
+    return value * ANSWER_TO_SI.get(name, 1.0)
+
 
 def practice_correct(d, truth: list) -> tuple[bool, bool]:
     """(right verdict and top explanation, ambiguous with the truth among the explanations named).
@@ -23,4 +32,4 @@ def practice_correct(d, truth: list) -> tuple[bool, bool]:
     return d.verdict in ("no_mismatch", "parameters_only"), False
 
 
-__all__ = ["practice_correct"]
+__all__ = ["answer_in_si", "practice_correct"]
