@@ -341,7 +341,7 @@ def run_practice(directory, cfg: PlantConfig, *, library=None, jobs: int = 1) ->
     from compliance.errors import InputError
     from compliance.recordings.reader import read_recording
     from compliance.diagnosis.engine import diagnose
-    from compliance.diagnosis.practice_score import answer_in_si, practice_correct
+    from compliance.diagnosis.practice_score import answer_in_si, main_parameter, practice_correct
 
     folder = Path(directory)
     answers_path = folder / "ANSWERS.json"
@@ -373,5 +373,9 @@ def run_practice(directory, cfg: PlantConfig, *, library=None, jobs: int = 1) ->
         rows.append({"name": name, "truth": ", ".join(truth) or "none", "verdict": d.verdict, "winner": d.winner,
                      "correct": bool(correct), "ambiguous_with_truth": ambiguous_ok, "ambiguity": list(d.ambiguous),
                      "signals_left": dict(d.signals_left), "parameters": params, "seconds": d.seconds, "explanation": d.explanation,
-                     "fit_before": d.fit_before, "fit_after": d.fit_after})
-    return {"recordings": rows, "correct": sum(r["correct"] for r in rows)}
+                     "fit_before": d.fit_before, "fit_after": d.fit_after, "main": main_parameter(d, truth, params)})
+    mains = [r["main"] for r in rows if r["main"]]
+    return {"recordings": rows, "correct": sum(r["correct"] for r in rows), "main_scored": len(mains),
+            "main_within_25": sum(m["within_25"] for m in mains),
+            "main_split_open_interval_contains_truth": sum(not m["within_25"] and m.get("split_pinned") is False
+                                                           and m.get("interval_contains_truth", False) for m in mains)}
