@@ -334,15 +334,21 @@ def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | N
     pair = dec["ambiguous"] or ([winner, runner] if suggest_test and winner and runner else [])
     diag.suggested_test = _suggest(st, pair)
     diag.empirical = _empirical(st, dec)
-    lag = next((e for e in (winner or "").split("+") if e in EFFECTS and EFFECTS[e].lumped is not None), None)
-    if lag is not None and verdict_name != "unexplained":  # does the recording pin the lag's split, or its total only?
-        diag.split = split_scan(FitContext(st.rc, st.setup, st.model), st.fits[winner], lag)
-        diag.simulations += len(diag.split["points"]) - 1 if diag.split else 0
+    diag.split = _split(st, winner, verdict_name)
+    diag.simulations += len(diag.split["points"]) - 1 if diag.split else 0
     from compliance.diagnosis.explain import explain
 
     diag.explanation = explain(diag)
     diag.seconds = time.perf_counter() - t0
     return diag
+
+
+def _split(st: _Stage, winner: str | None, verdict_name: str) -> dict | None:
+    """Does the recording pin the split of the winner's lag, or its total only (``split.split_scan``)?"""
+    lag = next((e for e in (winner or "").split("+") if e in EFFECTS and EFFECTS[e].lumped is not None), None)
+    if lag is None or verdict_name == "unexplained":
+        return None
+    return split_scan(FitContext(st.rc, st.setup, st.model), st.fits[winner], lag)
 
 
 def _contributions(st: _Stage, winner: str | None) -> dict:

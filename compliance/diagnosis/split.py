@@ -16,8 +16,8 @@ the interval instead of presenting the fitted split as measured.
 Why this rule and not a statistical interval: the replay's chi-square has wrinkles along the
 valley (a stall point or breakaway moves when the lag shifts by a millisecond), measured on the
 independent sensor-lag recording at 10-20 % of chi2/N between neighbouring points of one
-valley, far above any Gaussian profile threshold (the sandwich standard errors are 0.3 % of
-the value); two splits whose chi-squares differ by less than those wrinkles are not told apart
+valley, far above any Gaussian profile threshold (the sandwich standard error of the independent
+valve recording's spool frequency is 0.25 % of it); two splits whose chi-squares differ by less than those wrinkles are not told apart
 by the recording, which is the same judgement the verdict makes between two explanations.
 """
 
