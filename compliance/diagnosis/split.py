@@ -4,34 +4,41 @@ A spool or a transducer below the loop's bandwidth shows the loop its total lag 
 its main parameter (spool natural frequency, transducer time constant) and its pure delay trade
 along a valley of the fit. After the winner is fitted, its main parameter is moved over
 ``SPLIT_FACTORS`` of the fitted value while the delay is re-solved to keep the total lag at its
-fitted value (the other parameters stay at the fit), and each point is replayed. The values whose
+fitted value; the nuisance parameters are profiled coarsely - the total lag at ``TOTAL_FACTORS``
+of its fit, a third parameter (the spool's damping) at ``OTHER_FACTORS`` of its fit - and the best
+replay of each main value kept. The values whose
 replay is as good an explanation as the fit by the verdict's own rule for indistinguishable
 explanations - chi-square within ``AMBIGUOUS_RATIO`` of the fit's, and no signal above
 ``RESIDUAL_LIMIT`` times its floor or, when the fit itself sits near that limit, above the fit's
 worst signal by more than the same ratio in chi-square - form the *split interval* (the connected
-run of such values around the fit). When it spans more than a factor
-``PINNED_SPAN`` the recording pins the total, not the split, and the diagnosis says so with
+run of such values around the fit). When it spans more than a factor ``PINNED_SPAN`` the recording pins the total, not the split, and the diagnosis says so with
 the interval instead of presenting the fitted split as measured.
 
 Why this rule and not a statistical interval: the replay's chi-square has wrinkles along the
 valley (a stall point or breakaway moves when the lag shifts by a millisecond), measured on the
 independent sensor-lag recording at 10-20 % of chi2/N between neighbouring points of one
 valley, far above any Gaussian profile threshold (the sandwich standard error of the independent
-valve recording's spool frequency is 0.25 % of it); two splits whose chi-squares differ by less than those wrinkles are not told apart
-by the recording, which is the same judgement the verdict makes between two explanations.
+valve recording's spool frequency is 0.25 % of it); two splits whose chi-squares differ by less
+than those wrinkles are not told apart by the recording, which is the same judgement the verdict makes between two explanations.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
+from scipy.optimize import minimize
 
 from compliance.effects import EFFECTS
 from compliance.diagnosis.select import AMBIGUOUS_RATIO, RESIDUAL_LIMIT
 
-SPLIT_FACTORS = (0.5, 0.6, 0.7, 0.8, 0.9, 1.12, 1.25, 1.5, 2.0)  # main parameter / fitted value
+SPLIT_FACTORS = (0.5, 0.67, 0.8, 0.9, 1.12, 1.25, 1.5, 2.0)  # main parameter / fitted value
 PINNED_SPAN = 1.25  # an interval wider than this factor (max / min) leaves the split undetermined
+OTHER_FACTORS = (0.8, 1.0, 1.25)  # a third parameter (the spool's damping) is tried at these multiples of its fit
+TOTAL_FACTORS = (0.96, 1.0, 1.04)  # ... and the total lag at these (independent recordings: fitted totals within 2-5 %)
+REFINE = 1.25  # a grid profile within this factor above the limit is refined by a short simplex ...
+REFINE_FEV = 12  # ... of this many replays
 
 
 def _delay_param(effect: str) -> str | None:
@@ -54,6 +61,71 @@ def _valley_point(effect: str, vals: dict, main: str, delay: str, value: float, 
     return p
 
 
+def _replay_point(ctx, fit, values) -> tuple[float, float] | None:
+    """(chi2 per residual, largest normalised RMS of a signal) of the candidate at ``values``."""
+    vec, sim = ctx.residual(fit.params, values)
+    if sim is None:
+        return None
+    parts = {s: float(np.dot(r, r)) for s, r in ctx.model.split(vec).items()}
+    m = ctx.model.index.size
+    return sum(parts.values()) / ctx.model.size, max(math.sqrt(c / m) for c in parts.values())
+
+
+def _best_on_valley(ctx, fit, effect, idx, vals, main, delay, value, total, limit) -> tuple[float, float] | None:
+    """The best replay with ``main`` at ``value``, the nuisance parameters profiled (delay re-solved).
+
+    A coarse grid (total lag x ``TOTAL_FACTORS``, a third parameter x ``OTHER_FACTORS``); where the
+    decision hinges on it - the grid's best within ``REFINE`` times the ``limit`` above it - a short
+    simplex from the grid's best refines the profile (a coarse grid only bounds it from above).
+    """
+    others = [q for q in idx if q not in (main, delay)]
+    fd = fit.params[idx[delay]]
+
+    def at(factors):
+        trial = dict(vals)
+        for q, f in zip(others, factors[1:]):
+            fp = fit.params[idx[q]]
+            trial[q] = min(max(vals[q] * f, fp.low), fp.high)
+        p = _valley_point(effect, trial, main, delay, value, total * factors[0])
+        if p is None or not fd.low <= p[delay] <= fd.high:
+            return None
+        values = list(fit.values)
+        for q in idx:
+            values[idx[q]] = p[q]
+        return _replay_point(ctx, fit, values)
+
+    grid = [(f, at(f)) for f in itertools.product(TOTAL_FACTORS, *([OTHER_FACTORS] * len(others)))]
+    grid = [(f, g) for f, g in grid if g is not None]
+    if not grid:
+        return None
+    f0, best = min(grid, key=lambda fg: fg[1][0])
+    if limit < best[0] <= REFINE * limit:
+        seen = {}
+
+        def cost(logf):
+            got = at(tuple(np.exp(logf)))
+            seen[tuple(logf)] = got
+            return math.inf if got is None else got[0]
+
+        x0 = np.log(np.asarray(f0, dtype=float))
+        steps = np.diag([0.02] + [0.12] * len(others))  # half the grid's spacing in log factor
+        minimize(cost, x0, method="Nelder-Mead", options={"maxfev": REFINE_FEV, "initial_simplex": np.vstack([x0, x0 + steps])})
+        best = min((g for g in seen.values() if g is not None), key=lambda g: g[0], default=best)
+    return best
+
+
+def _connected(points: list, fitted: float, ok) -> list[float]:
+    """[low, high] of the run of values around ``fitted`` that ``ok`` accepts (points sorted by value)."""
+    values = [v for v, _, _ in points]
+    k = values.index(fitted)
+    lo = hi = k
+    while lo > 0 and ok(points[lo - 1]):
+        lo -= 1
+    while hi < len(values) - 1 and ok(points[hi + 1]):
+        hi += 1
+    return [values[lo], values[hi]]
+
+
 def split_scan(ctx, fit, effect: str) -> dict | None:
     """Scan the lumped valley of ``effect`` in the fitted candidate ``fit`` (``fit.FitContext`` ``ctx``).
 
@@ -73,42 +145,27 @@ def split_scan(ctx, fit, effect: str) -> dict | None:
     if len(idx) != len(decl.params):
         return None
     main = decl.params[0].name
-    vals = {n: fit.values[i] for n, i in idx.items()}
+    vals = {q: fit.values[i] for q, i in idx.items()}
     total = float(decl.lumped.of(vals))
-    lo_b, hi_b = fit.params[idx[main]].low, fit.params[idx[main]].high
-    d_lo, d_hi = fit.params[idx[delay]].low, fit.params[idx[delay]].high
+    fm = fit.params[idx[main]]
     m = ctx.model.index.size
-    n = ctx.model.size
-    best = fit.chi2
-    points = [(vals[main], fit.chi2 / n, max(math.sqrt(c / m) for c in fit.chi2_signal.values()))]
+    fit_worst = max(math.sqrt(c / m) for c in fit.chi2_signal.values())
+    points = [(vals[main], fit.chi2 / ctx.model.size, fit_worst)]
+    limit = AMBIGUOUS_RATIO * fit.chi2 / ctx.model.size
     for f in SPLIT_FACTORS:
         value = vals[main] * f
-        p = _valley_point(effect, vals, main, delay, value, total) if lo_b <= value <= hi_b else None
-        if p is None or not d_lo <= p[delay] <= d_hi:
-            continue
-        values = list(fit.values)
-        values[idx[main]], values[idx[delay]] = value, p[delay]
-        vec, sim = ctx.residual(fit.params, values)
-        if sim is None:
-            continue
-        parts = {s: float(np.dot(r, r)) for s, r in ctx.model.split(vec).items()}
-        points.append((value, sum(parts.values()) / n, max(math.sqrt(c / m) for c in parts.values())))
+        got = (_best_on_valley(ctx, fit, effect, idx, vals, main, delay, value, total, limit)
+               if fm.low <= value <= fm.high else None)
+        if got is not None:
+            points.append((value, *got))
     points.sort()
-    # no signal may be worse than the limit, or than the fit's own worst signal by the same ratio
-    worst_ok = max(RESIDUAL_LIMIT, points[0][2] * math.sqrt(AMBIGUOUS_RATIO))
-    ok = [v for v, c, worst in points if c * n <= AMBIGUOUS_RATIO * best and worst <= worst_ok]
-    # the interval is the connected run of indistinguishable values around the fit
-    values = [v for v, _, _ in points]
-    k = values.index(vals[main])
-    lo = hi = k
-    while lo > 0 and values[lo - 1] in ok:
-        lo -= 1
-    while hi < len(values) - 1 and values[hi + 1] in ok:
-        hi += 1
-    interval = [values[lo], values[hi]]
+    # as good as the fit: chi-square within the ratio, no signal beyond the limit or (when the fit itself
+    # sits near it) beyond the fit's own worst signal by the same ratio
+    worst_ok = max(RESIDUAL_LIMIT, fit_worst * math.sqrt(AMBIGUOUS_RATIO))
+    interval = _connected(points, vals[main], lambda p: p[1] <= limit and p[2] <= worst_ok)
     return {"parameter": f"{effect}.{main}", "fitted": vals[main], "lumped": total, "delay": f"{effect}.{delay}",
             "points": [[v, c, w] for v, c, w in points], "interval": interval,
-            "pinned": interval[1] / interval[0] < PINNED_SPAN, "scanned": [values[0], values[-1]]}
+            "pinned": interval[1] / interval[0] < PINNED_SPAN, "scanned": [points[0][0], points[-1][0]]}
 
 
 def contains(scan: dict | None, value: float) -> bool | None:
