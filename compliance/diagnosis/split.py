@@ -168,11 +168,4 @@ def split_scan(ctx, fit, effect: str) -> dict | None:
             "pinned": interval[1] / interval[0] < PINNED_SPAN, "scanned": [points[0][0], points[-1][0]]}
 
 
-def contains(scan: dict | None, value: float) -> bool | None:
-    """True when ``value`` lies in the split interval of ``scan`` (None without a scan)."""
-    if not scan:
-        return None
-    return scan["interval"][0] <= value <= scan["interval"][1]
-
-
-__all__ = ["split_scan", "contains", "SPLIT_FACTORS", "PINNED_SPAN"]
+__all__ = ["split_scan", "SPLIT_FACTORS", "PINNED_SPAN"]
