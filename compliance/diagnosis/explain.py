@@ -126,7 +126,9 @@ def _split_words(d, fp) -> str:
         return ""
     lo, hi = (format_value(v, fp.unit) for v in sp["interval"])
     if sp["pinned"]:
-        return f" Along that valley the recording pins {fp.name.replace('_', ' ')} to {lo} - {hi}."
+        out = [format_value(v, fp.unit) for v in sp.get("bracket", []) if v is not None]
+        return (f" Along that valley the recording pins {fp.name.replace('_', ' ')} near {lo if lo == hi else f'{lo} - {hi}'}"
+                + (f" (the scan's {' and '.join(out)} fit worse)." if out else "."))
     return (f" Along that valley every {fp.name.replace('_', ' ')} from {lo} to {hi} explains the recording as well as the "
             f"fit (total held): this test does not determine the split, only the total.")
 

@@ -134,7 +134,8 @@ def split_scan(ctx, fit, effect: str) -> dict | None:
     dict or None
         ``parameter`` (key of the main parameter), ``fitted``, ``points`` [(value, chi2/N, largest
         normalised RMS)], ``interval`` [low, high] of the values indistinguishable from the fit,
-        ``pinned`` (interval narrower than ``PINNED_SPAN``), ``lumped`` (total held) - or None when
+        ``bracket`` (the nearest values tried outside it, None at the scan's end), ``pinned``
+        (interval narrower than ``PINNED_SPAN``), ``lumped`` (total held) - or None when
         the effect declares no lumped combination with a delay.
     """
     decl = EFFECTS.get(effect)
@@ -163,8 +164,12 @@ def split_scan(ctx, fit, effect: str) -> dict | None:
     # sits near it) beyond the fit's own worst signal by the same ratio
     worst_ok = max(RESIDUAL_LIMIT, fit_worst * math.sqrt(AMBIGUOUS_RATIO))
     interval = _connected(points, vals[main], lambda p: p[1] <= limit and p[2] <= worst_ok)
+    values = [v for v, _, _ in points]
+    lo, hi = values.index(interval[0]), values.index(interval[1])
+    # the scan's resolution: the nearest values tried outside the interval (None: the scan's end)
+    bracket = [values[lo - 1] if lo > 0 else None, values[hi + 1] if hi < len(values) - 1 else None]
     return {"parameter": f"{effect}.{main}", "fitted": vals[main], "lumped": total, "delay": f"{effect}.{delay}",
-            "points": [[v, c, w] for v, c, w in points], "interval": interval,
+            "points": [[v, c, w] for v, c, w in points], "interval": interval, "bracket": bracket,
             "pinned": interval[1] / interval[0] < PINNED_SPAN, "scanned": [points[0][0], points[-1][0]]}
 
 

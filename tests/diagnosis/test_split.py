@@ -75,3 +75,9 @@ def test_practice_scoring_keeps_an_open_split_apart_from_a_hit():
     assert m["interval_contains_truth"] and not m["split_pinned"]
     d.split["interval"] = [0.0178, 0.0249]
     assert not main_parameter(d, ["sensor_lag"], params)["interval_contains_truth"]
+
+
+def test_a_pinned_split_is_bracketed_by_the_values_that_fit_worse():
+    ctx = _Valley(lambda tau, td: 200.0 * (1.0 + 100.0 * ((tau - 0.02) / 0.02) ** 2))
+    sp = split_scan(ctx, _fit(ctx, 0.02, 0.004), "sensor_lag")
+    assert sp["bracket"] == [pytest.approx(0.018), pytest.approx(0.0224)]  # the scan's 0.9 and 1.12 x the fit
