@@ -60,6 +60,8 @@ def predicted_label(diag) -> str:
         return "parameters_only"
     if diag.verdict == "no_mismatch":
         return "none"
+    if diag.verdict == "ambiguous":
+        return "ambiguous"  # its own column: not a hit, not "unexplained" either
     return "unexplained"
 
 
@@ -245,7 +247,7 @@ def summarise(results: list[CaseResult], effects) -> dict:
     eff = [r for r in results if r.kind == "effect" and r.visible]
     nul = [r for r in results if r.kind == "null"]
     mis = [r for r in results if r.kind == "miscalibration" and r.visible]
-    labels = list(effects) + ["none", "parameters_only", "unexplained", "error"]
+    labels = list(effects) + ["none", "parameters_only", "ambiguous", "unexplained", "error"]
     truths = list(effects) + (["none"] if nul else []) + sorted({r.truth for r in mis})
     confusion = {t: {} for t in truths}
     for r in results:
