@@ -130,7 +130,7 @@ def _split_words(d, fp) -> str:
         return (f" Along that valley the recording pins {fp.name.replace('_', ' ')} near {lo if lo == hi else f'{lo} - {hi}'}"
                 + (f" (the scan's {' and '.join(out)} fit worse)." if out else "."))
     return (f" Along that valley every {fp.name.replace('_', ' ')} from {lo} to {hi} explains the recording as well as the "
-            f"fit (total held): this test does not determine the split, only the total.")
+            f"fit (total lag within 4 % of its fit): this test does not determine the split, only the total.")
 
 
 def explain(d) -> str:
