@@ -96,6 +96,9 @@ def run(args) -> int:
         amb = sum(bool(r.get("ambiguous_with_truth")) for r in rep["recordings"])
         print(f"\n{rep['correct']}/{len(rep['recordings'])} practice recordings diagnosed correctly"
               + (f"; {amb} more called ambiguous with the truth among the explanations named" if amb else ""))
+        print(f"main parameter within 25 %: {rep['main_within_25']} of {rep['main_scored']}"
+              + (f"; not a hit but not identifiable by the test (split interval contains the truth): "
+                 f"{rep['main_split_open_interval_contains_truth']}" if rep["main_split_open_interval_contains_truth"] else ""))
         if args.json:
             _write(args, rep)
         return 0 if rep["correct"] == len(rep["recordings"]) else 1

@@ -14,10 +14,11 @@ Modules, one job each: ``replay_fit`` (fast re-synchronised replay with matched 
 ``residuals`` (normalised residuals), ``candidates`` (what may be fitted), ``fit`` (scan,
 simplex, least squares), ``recalibration`` (base parameters), ``multi`` (several effects),
 ``workers`` (parallel fits), ``select`` (information criteria, honest verdicts, ambiguity),
-``discriminate`` (the test that tells two explanations apart), ``empirical`` (the missing force
+``discriminate`` (the test that tells two explanations apart), ``split`` (does the recording
+pin a lag's split or only its total), ``empirical`` (the missing force
 outside the library), ``located`` (where the model misses), ``explain`` (the paragraph),
 ``fitted_model`` (the fitted plant), ``engine`` (the chain),
-``concealed`` / ``benchmark`` (the proof), ``friction_models`` / ``friction_diagnosis`` /
+``concealed`` / ``benchmark`` / ``practice_score`` (the proof), ``friction_models`` / ``friction_diagnosis`` /
 (the friction bench; its report is compliance/report/friction.py).
 """
 

@@ -60,6 +60,8 @@ def predicted_label(diag) -> str:
         return "parameters_only"
     if diag.verdict == "no_mismatch":
         return "none"
+    if diag.verdict == "ambiguous":
+        return "ambiguous"  # its own column: not a hit, not "unexplained" either
     return "unexplained"
 
 
@@ -245,7 +247,7 @@ def summarise(results: list[CaseResult], effects) -> dict:
     eff = [r for r in results if r.kind == "effect" and r.visible]
     nul = [r for r in results if r.kind == "null"]
     mis = [r for r in results if r.kind == "miscalibration" and r.visible]
-    labels = list(effects) + ["none", "parameters_only", "unexplained", "error"]
+    labels = list(effects) + ["none", "parameters_only", "ambiguous", "unexplained", "error"]
     truths = list(effects) + (["none"] if nul else []) + sorted({r.truth for r in mis})
     confusion = {t: {} for t in truths}
     for r in results:
@@ -341,7 +343,7 @@ def run_practice(directory, cfg: PlantConfig, *, library=None, jobs: int = 1) ->
     from compliance.errors import InputError
     from compliance.recordings.reader import read_recording
     from compliance.diagnosis.engine import diagnose
-    from compliance.diagnosis.practice_score import practice_correct
+    from compliance.diagnosis.practice_score import answer_in_si, main_parameter, practice_correct
 
     folder = Path(directory)
     answers_path = folder / "ANSWERS.json"
@@ -368,9 +370,14 @@ def run_practice(directory, cfg: PlantConfig, *, library=None, jobs: int = 1) ->
         for alias, value in (ans.get("parameters") or {}).items():
             key = ANSWER_ALIASES.get(alias, alias)
             got = fitted.get(key)
+            value = answer_in_si(alias, value)
             params[alias] = {"true": value, "fitted": got, "error": None if got is None else abs(got - value) / abs(value)}
         rows.append({"name": name, "truth": ", ".join(truth) or "none", "verdict": d.verdict, "winner": d.winner,
                      "correct": bool(correct), "ambiguous_with_truth": ambiguous_ok, "ambiguity": list(d.ambiguous),
                      "signals_left": dict(d.signals_left), "parameters": params, "seconds": d.seconds, "explanation": d.explanation,
-                     "fit_before": d.fit_before, "fit_after": d.fit_after})
-    return {"recordings": rows, "correct": sum(r["correct"] for r in rows)}
+                     "fit_before": d.fit_before, "fit_after": d.fit_after, "main": main_parameter(d, truth, params)})
+    mains = [r["main"] for r in rows if r["main"]]
+    return {"recordings": rows, "correct": sum(r["correct"] for r in rows), "main_scored": len(mains),
+            "main_within_25": sum(m["within_25"] for m in mains),
+            "main_split_open_interval_contains_truth": sum(not m["within_25"] and m.get("split_pinned") is False
+                                                           and m.get("interval_contains_truth", False) for m in mains)}

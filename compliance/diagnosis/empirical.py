@@ -29,7 +29,7 @@ from compliance.model.plant_vector import load_curve_arrays, parameter_vector
 from compliance.model.rest_state import load_force, pneumatic_forces
 from compliance.diagnosis.operating_point import load_at_start
 from compliance.model.vector_slots import P_BV, P_FC, P_FS, P_MASS, P_NFR, P_PATM, P_PF_COEF, P_PF_ON, P_VS
-from compliance.physics.friction import pressure_friction_increment, stribeck_map
+from compliance.physics.friction import pressure_friction_factor, stribeck_map
 
 MOVING_SPEED = 2e-3  # m/s; below it static friction absorbs any force
 REVERSAL_TIME = 0.1  # s; decay time of the after-reversal feature (pre-sliding, breakaway transients)
@@ -133,10 +133,8 @@ def implied_force(cfg, setup) -> tuple[np.ndarray, dict, np.ndarray]:
     df = np.empty(t.size)
     for k in range(t.size):
         f1, f2 = pneumatic_forces(P, pa[k], pb[k])
-        fs, fc = P[P_FS], P[P_FC]
-        if P[P_PF_ON] != 0.0:
-            inc = pressure_friction_increment(P[P_PF_COEF], 0.5 * (pa[k] + pb[k]), patm)
-            fs, fc = fs + inc, fc + inc
+        rise = pressure_friction_factor(P[P_PF_COEF], 0.5 * (pa[k] + pb[k]), patm) if P[P_PF_ON] != 0.0 else 1.0
+        fs, fc = P[P_FS] * rise, P[P_FC] * rise
         ff = P[P_NFR] * stribeck_map(v[k], fs, fc, P[P_VS], P[P_BV])
         df[k] = P[P_MASS] * acc[k] - (f1 + f2) + load_force(P, x[k], lx, ly) + ff
     moving = np.abs(v) > MOVING_SPEED

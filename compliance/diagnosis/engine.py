@@ -33,6 +33,7 @@ from compliance.diagnosis.multi import (CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_
                                         set_effects, set_name)
 from compliance.diagnosis.discriminate import design_test
 from compliance.diagnosis.empirical import empirical_term
+from compliance.diagnosis.split import split_scan
 from compliance.diagnosis.replay_fit import ReplaySetup, prepare_replay, replay_config, run_replay
 from compliance.diagnosis.residuals import UNITS, build_residual_model, null_recording, signal_fit, with_fail_level
 from compliance.diagnosis.select import (AMBIGUOUS_BIC, EXPLAINED_ENOUGH, NOISE_TOLERANCE, RESIDUAL_LIMIT, ambiguity_set, honest, same_physics,
@@ -79,6 +80,7 @@ class Diagnosis:
     contributions: dict = field(default_factory=dict)  # effect -> its own contribution in the winning set
     suggested_test: dict | None = None  # discriminate.design_test for an ambiguous recording
     empirical: dict | None = None  # empirical.empirical_term when the library leaves residual
+    split: dict | None = None  # split.split_scan: does the recording pin a lag's split or only its total
 
     def ranked(self) -> list[str]:
         """Candidate names by BIC, best first (nominal included)."""
@@ -332,11 +334,21 @@ def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | N
     pair = dec["ambiguous"] or ([winner, runner] if suggest_test and winner and runner else [])
     diag.suggested_test = _suggest(st, pair)
     diag.empirical = _empirical(st, dec)
+    diag.split = _split(st, winner, verdict_name)
+    diag.simulations += len(diag.split["points"]) - 1 if diag.split else 0
     from compliance.diagnosis.explain import explain
 
     diag.explanation = explain(diag)
     diag.seconds = time.perf_counter() - t0
     return diag
+
+
+def _split(st: _Stage, winner: str | None, verdict_name: str) -> dict | None:
+    """Does the recording pin the split of the winner's lag, or its total only (``split.split_scan``)?"""
+    lag = next((e for e in (winner or "").split("+") if e in EFFECTS and EFFECTS[e].lumped is not None), None)
+    if lag is None or verdict_name == "unexplained":
+        return None
+    return split_scan(FitContext(st.rc, st.setup, st.model), st.fits[winner], lag)
 
 
 def _contributions(st: _Stage, winner: str | None) -> dict:

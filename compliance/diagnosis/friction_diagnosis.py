@@ -32,6 +32,7 @@ from scipy.signal import savgol_filter
 from compliance.errors import InputError
 from compliance.files.jsonable import json_number
 from compliance.units import ATMOSPHERE_PA
+from compliance.diagnosis.friction_models import core_equivalent
 from compliance.diagnosis.friction_fit import LAWS, PRESLIDING, PRESSURE_EFFECT, LawFit, fit_law
 from compliance.diagnosis.friction_runs import Run
 from compliance.diagnosis.noise_floor import sensor_noise_std
@@ -317,8 +318,7 @@ def explain_friction(d: SealDiagnosis) -> str:
     parts = []
     if "pressure_coefficient" in p:
         parts.append(f"seal friction that rises with the chamber pressure (k_p = {p['pressure_coefficient']*1e5:.2f} N/bar "
-                     f"on F_C and F_S; the core's pressure_dependent_friction coefficient for this single-acting cylinder, "
-                     f"per Pa of mean chamber gauge pressure, is {2*p['pressure_coefficient']:.3g} N/Pa)")
+                     f"on F_C and F_S{core_equivalent(p)})")
     if "bristle_stiffness" in p:
         pm = float(np.mean([r.pressure for r in runs]))
         fc = p["coulomb"] + p.get("pressure_coefficient", 0.0) * pm

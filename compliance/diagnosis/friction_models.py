@@ -102,3 +102,17 @@ def friction_force(velocity, pressure_gauge, time, params: dict, *, presliding: 
 def bias_force(pressure_gauge, params: dict) -> np.ndarray:
     """Direction-independent force of the bench [N]: sensor zero c0 plus area error c1 * p_g."""
     return params.get("bias", 0.0) + params.get("bias_per_pressure", 0.0) * np.asarray(pressure_gauge, dtype=float)
+
+
+def core_equivalent(p: dict) -> str:
+    """The bench's additive k_p (``pressure_coefficient`` [N/Pa]) in the core's multiplicative ``pressure_dependent_friction`` terms.
+
+    The core scales both levels by 1 + k p_mean (p_mean the mean chamber gauge pressure; this
+    single-acting cylinder has its rod side vented, so p_mean = p_g / 2): k = 2 k_p / F_0 per level.
+    """
+    rel = [f"{2e5 * p['pressure_coefficient'] / p[level]:.3g} per bar on {name}"
+           for level, name in (("coulomb", "F_C"), ("static", "F_S")) if p[level] > 1e-3]
+    if not rel:
+        return ""
+    return ("; the core's pressure_dependent_friction, which scales both levels by 1 + k x the mean chamber gauge "
+            f"pressure, would need k = {' and '.join(rel)}")

@@ -4,6 +4,15 @@ from __future__ import annotations
 
 from compliance.effects import EFFECTS
 
+# answers given in a unit other than the SI unit of the declared parameter: name -> factor to SI
+# (the practice emulator states its pressure-dependent friction per bar; ours is per Pa)
+ANSWER_TO_SI = {"kp_fric": 1e-5}
+
+
+def answer_in_si(name: str, value: float) -> float:
+    """A true parameter value of ANSWERS.json in the SI unit of the parameter it names."""
+    return value * ANSWER_TO_SI.get(name, 1.0)
+
 
 def practice_correct(d, truth: list) -> tuple[bool, bool]:
     """(right verdict and top explanation, ambiguous with the truth among the explanations named).
@@ -23,4 +32,31 @@ def practice_correct(d, truth: list) -> tuple[bool, bool]:
     return d.verdict in ("no_mismatch", "parameters_only"), False
 
 
-__all__ = ["practice_correct"]
+def main_parameter(d, truth: list, params: dict) -> dict | None:
+    """How the main parameter of the (first) true effect came out, scored two ways kept apart.
+
+    ``params``: answer name -> {"true" [SI], "fitted", "error"} (``benchmark.run_practice``).
+    ``within_25`` is the hit (fitted within 25 % of the truth). A lag whose split the recording does
+    not determine (``split.split_scan``: not pinned) is also checked against its split interval:
+    ``interval_contains_truth`` says the honest output (the interval) holds the truth - reported
+    next to the hit, never counted as one.
+    """
+    declared = [e for e in truth if e in EFFECTS]
+    if not declared:
+        return None
+    main = EFFECTS[declared[0]].params[0]
+    name = next((a for a in main.aliases if a in params), None)
+    if name is None:
+        return None
+    row = params[name]
+    err = row["error"]
+    out = {"parameter": name, "error": err, "within_25": err is not None and err <= 0.25}
+    sp = getattr(d, "split", None)
+    if sp and sp["parameter"] == f"{declared[0]}.{main.name}":
+        lo, hi = sp["interval"]
+        out.update(split_interval=[lo, hi], split_pinned=bool(sp["pinned"]),
+                   interval_contains_truth=bool(lo <= row["true"] <= hi))
+    return out
+
+
+__all__ = ["answer_in_si", "main_parameter", "practice_correct"]

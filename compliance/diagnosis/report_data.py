@@ -127,6 +127,7 @@ def diagnosis_to_dict(d) -> dict:
         "contributions": {e: {k: json_number(v) for k, v in c.items()} for e, c in d.contributions.items()},
         "effect_search": _clean(d.search),
         "empirical": _clean(d.empirical),
+        "split": _clean(getattr(d, "split", None)),
         "saved_model": d.saved_model,
         "notes": list(d.notes),
         "timing": {"seconds": json_number(d.seconds), "simulations": d.simulations, "jobs": d.jobs},

@@ -117,11 +117,13 @@ def trim(cfg: PlantConfig, position: float, load: float | str | None = None, *, 
     P[P_VD_STAGE] = 0.0
     linkage = bool(P[P_LK_ON]) and P[P_ARR] == 0.0
     x2 = position
+    f_here = load_force_at(cfg, P, position)
     for _ in range(50 if linkage else 1):  # fixed point; contracts while the linkage is stiffer than the load curve
-        f = load_force_at(cfg, P, x2)  # the load acts on the gate-ring side (body 2 with linkage compliance)
+        # with linkage compliance each cylinder carries half the gate-ring load at its own position
+        f = 0.5 * (f_here + load_force_at(cfg, P, x2)) if linkage else f_here
         pa, pb, cap_closing, cap_opening = _rest_pressures(P, f)
-        if linkage:
-            x2 = position - (pa * P[P_AREA_CAP] - pb * P[P_AREA_ROD]) / P[P_LK_K]  # spring carries 2A1's force f1
+        if linkage:  # 2A1 at rest without friction: f1 + K (x2 - x) = F(x)/2
+            x2 = position + (0.5 * f_here - (pa * P[P_AREA_CAP] - pb * P[P_AREA_ROD])) / P[P_LK_K]
     ps, patm = P[P_PS], P[P_PATM]
     if not (patm <= pa <= ps and patm <= pb <= ps):
         raise InputError(

@@ -17,7 +17,7 @@ from compliance.physics.friction import (
     lugre_bristle_rate,
     lugre_force,
     piecewise_stribeck_friction,
-    pressure_friction_increment,
+    pressure_friction_factor,
     variable_viscous_friction,
 )
 from compliance.physics.leakage import laminar_leak, reservoir_pressure_rate
@@ -59,19 +59,29 @@ def _path_flow(P, opening, throttle, p_up, p_down, t_up):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _body_friction(P, v, z, applied, fs, fc, n):
-    """Friction force on one body [N] and bristle rate; ``applied`` is the net non-friction force."""
+def _body_friction(P, v, z, applied, fs, fc, rise, n):
+    """Friction force on one body [N] and bristle rate; ``applied`` is the net non-friction force,
+    ``rise`` the pressure factor already applied to ``fs`` and ``fc``."""
     if P[P_FRM] == 0.0:
         dz = lugre_bristle_rate(v, z, P[P_SIG0], fs, fc, P[P_VS])  # LuGre (Canudas de Wit 1995)
         return n * lugre_force(v, z, dz, P[P_SIG0], P[P_SIG1], P[P_BV]), dz, False
     if P[P_FRM] == 2.0:
-        fj = P[P_FJ] + (fs - P[P_FS])  # pressure-dependent friction raises F_j by the same increment
+        fj = P[P_FJ] * rise  # pressure-dependent friction scales F_j like F_S and F_C
         f = n * piecewise_stribeck_friction(v, applied / n, fj, P[P_KV1], P[P_VD], P[P_KV2], P[P_VLIM])  # seed 001 eq. (8)
         stuck = abs(v) < P[P_VLIM] and abs(applied) <= n * fj
         return f, 0.0, stuck
     f = n * variable_viscous_friction(v, applied / n, fs, fc, P[P_VS], P[P_BV], P[P_VLIM])  # seed 000 eq. (7)
     stuck = abs(v) < P[P_VLIM] and abs(applied) <= n * fs
     return f, 0.0, stuck
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _gate_load(P, x, load_xs, load_ys):
+    """Closing force of the gate ring at position ``x`` [N]: constant or load curve, plus load stiffness."""
+    f = interp_curve(x, load_xs, load_ys) if P[P_LOADMODE] == 1.0 else P[P_LOAD]
+    if P[P_PL_ON] != 0.0:
+        f += P[P_PL_K] * (x - 0.5 * P[P_STROKE])  # load stiffness about mid-stroke
+    return f
 
 
 @njit(cache=True, error_model="numpy")
@@ -237,18 +247,10 @@ def plant_rhs(y, P, u_valve, load_xs, load_ys, dy, aux):
     if P[P_SD_ON] != 0.0:
         dy[S_PSUP] = reservoir_pressure_rate(P[P_SD_COND], P[P_PS], ps, q_pa + q_pb, P[P_SD_VOL], rg, ts)
     # --- forces
-    fs = P[P_FS]
-    fc = P[P_FC]
-    if P[P_PF_ON] != 0.0:
-        dfp = pressure_friction_increment(P[P_PF_COEF], 0.5 * (pa + pb), patm)
-        fs += dfp
-        fc += dfp
-    if P[P_LOADMODE] == 1.0:
-        f_load = interp_curve(x2, load_xs, load_ys)
-    else:
-        f_load = P[P_LOAD]
-    if P[P_PL_ON] != 0.0:
-        f_load += P[P_PL_K] * (x2 - 0.5 * P[P_STROKE])  # load stiffness about mid-stroke
+    rise = pressure_friction_factor(P[P_PF_COEF], 0.5 * (pa + pb), patm) if P[P_PF_ON] != 0.0 else 1.0
+    fs = P[P_FS] * rise
+    fc = P[P_FC] * rise
+    f_load = _gate_load(P, x, load_xs, load_ys)
     if P[P_ARR] == 0.0:
         f1 = pa * a_cap - pb * a_rod  # cylinder 2A1 (decoded seed 000 eq. 6)
         f2 = pa * a_rod - pb * a_cap  # cylinder 2A2, mounted opposite
@@ -259,7 +261,7 @@ def plant_rhs(y, P, u_valve, load_xs, load_ys, dy, aux):
     if not linkage:
         fp = f1 + f2
         applied = fp - f_load + end_stop_force(x, v, P[P_STROKE], P[P_KSTOP], P[P_CSTOP])
-        ff, dz, stuck = _body_friction(P, v, y[S_Z1], applied, fs, fc, P[P_NFR])
+        ff, dz, stuck = _body_friction(P, v, y[S_Z1], applied, fs, fc, rise, P[P_NFR])
         acc = -v / STICK_TIME_CONSTANT if stuck else (applied - ff) / mass  # seed 000 eq. (6)
         dy[S_X] = v
         dy[S_V] = acc
@@ -268,14 +270,18 @@ def plant_rhs(y, P, u_valve, load_xs, load_ys, dy, aux):
         dy[S_X2] = v
         dy[S_V2] = acc
     else:
-        # two bodies (2A1 with the sensor; 2A2 with the gate ring and load) joined by a spring-damper
+        # two cylinders (2A1 with the sensor, 2A2) joined by a spring-damper, each with half the moving
+        # mass, its own piston force and friction and its half of the gate-ring load at its own position
         fp = f1 + f2
         f_link = P[P_LK_K] * (x2 - x) + P[P_LK_C] * (v2 - v)
         m1 = 0.5 * mass
-        app1 = f1 + f_link + end_stop_force(x, v, P[P_STROKE], P[P_KSTOP], P[P_CSTOP])
-        app2 = f2 - f_link - f_load + end_stop_force(x2, v2, P[P_STROKE], P[P_KSTOP], P[P_CSTOP])
-        ff1, dz1, st1 = _body_friction(P, v, y[S_Z1], app1, fs, fc, 1.0)
-        ff2, dz2, st2 = _body_friction(P, v2, y[S_Z2], app2, fs, fc, 1.0)
+        load1 = 0.5 * f_load
+        load2 = 0.5 * _gate_load(P, x2, load_xs, load_ys)
+        f_load = load1 + load2
+        app1 = f1 + f_link - load1 + end_stop_force(x, v, P[P_STROKE], P[P_KSTOP], P[P_CSTOP])
+        app2 = f2 - f_link - load2 + end_stop_force(x2, v2, P[P_STROKE], P[P_KSTOP], P[P_CSTOP])
+        ff1, dz1, st1 = _body_friction(P, v, y[S_Z1], app1, fs, fc, rise, 1.0)
+        ff2, dz2, st2 = _body_friction(P, v2, y[S_Z2], app2, fs, fc, rise, 1.0)
         dy[S_X] = v
         dy[S_V] = -v / STICK_TIME_CONSTANT if st1 else (app1 - ff1) / m1
         dy[S_X2] = v2

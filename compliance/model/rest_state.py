@@ -12,14 +12,15 @@ import numpy as np
 from compliance.model.config import PlantConfig
 from compliance.model.plant_vector import load_curve_arrays
 from compliance.model.vector_slots import *  # noqa: F403 - index constants are the core's vocabulary
-from compliance.physics.friction import pressure_friction_increment, stribeck_magnitude
+from compliance.physics.friction import pressure_friction_factor, stribeck_magnitude
 from compliance.physics.mechanics import end_stop_force, single_force
 
 
 def load_force(P: np.ndarray, x: float, lx: np.ndarray, ly: np.ndarray) -> float:
     """Closing force on the gate at position ``x`` [N]: constant or load curve, plus load stiffness.
 
-    The same law as ``plant_rhs`` (where it acts on body 2, the gate-ring side).
+    The same law as ``plant_rhs`` (``_gate_load``; with linkage compliance each cylinder carries half
+    of it, at its own position).
     """
     f = float(np.interp(x, lx, ly)) if P[P_LOADMODE] == 1.0 else float(P[P_LOAD])
     if P[P_PL_ON]:
@@ -57,11 +58,12 @@ def set_rest_internal_states(P: np.ndarray, y: np.ndarray, lx: np.ndarray, ly: n
     f1, f2 = pneumatic_forces(P, y[S_PA], y[S_PB])
     linkage = P[P_LK_ON] != 0.0 and P[P_ARR] == 0.0
     x2 = x
+    load1 = 0.5 * load_force(P, x, lx, ly)  # each cylinder carries half the gate-ring load (plant_rhs)
     if linkage:
-        # both bodies rest with equal friction shares: f1 + f_link = f2 - f_link - F_load(x2),
+        # both bodies rest with equal friction shares: f1 + f_link - F(x)/2 = f2 - f_link - F(x2)/2,
         # f_link = K (x2 - x); fixed point in x2 (contracts while K exceeds the load stiffness)
         for _ in range(50):
-            x2_new = x + 0.5 * (f2 - f1 - load_force(P, x2, lx, ly)) / P[P_LK_K]
+            x2_new = x + 0.5 * (f2 - f1 + load1 - 0.5 * load_force(P, x2, lx, ly)) / P[P_LK_K]
             x2_new = min(max(x2_new, 0.0), P[P_STROKE])  # a link too soft to carry it leaves 2A2 on its end stop
             if abs(x2_new - x2) < 1e-12:
                 x2 = x2_new
@@ -70,11 +72,10 @@ def set_rest_internal_states(P: np.ndarray, y: np.ndarray, lx: np.ndarray, ly: n
         y[S_X2] = x2
     if not (P[P_FRM] == 0.0 and P[P_SIG0] > 0.0):
         return
-    fs, fc = P[P_FS], P[P_FC]
-    if P[P_PF_ON]:
-        d = pressure_friction_increment(P[P_PF_COEF], 0.5 * (y[S_PA] + y[S_PB]), P[P_PATM])
-        fs, fc = fs + d, fc + d
-    net = f1 + f2 - load_force(P, x2, lx, ly) + end_stop_force(x, 0.0, P[P_STROKE], P[P_KSTOP], P[P_CSTOP])
+    rise = pressure_friction_factor(P[P_PF_COEF], 0.5 * (y[S_PA] + y[S_PB]), P[P_PATM]) if P[P_PF_ON] else 1.0
+    fs, fc = P[P_FS] * rise, P[P_FC] * rise
+    f_load = load1 + 0.5 * load_force(P, x2, lx, ly) if linkage else load_force(P, x, lx, ly)
+    net = f1 + f2 - f_load + end_stop_force(x, 0.0, P[P_STROKE], P[P_KSTOP], P[P_CSTOP])
     n = P[P_NFR] if not linkage else 2.0
     g = stribeck_magnitude(v, fs, fc, P[P_VS])  # LuGre g(v), Canudas de Wit et al. 1995
     z = (net / n - P[P_BV] * v) / P[P_SIG0]

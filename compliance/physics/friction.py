@@ -80,13 +80,15 @@ def lugre_force(velocity, bristle, bristle_rate, stiffness, damping, viscous):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def pressure_friction_increment(coefficient, mean_chamber_pressure, atmosphere):
-    """Rise of seal friction with chamber pressure, dF = k_p*(p_mean - p_atm) [N].
+def pressure_friction_factor(coefficient, mean_chamber_pressure, atmosphere):
+    """Factor on the seal friction levels from the chamber pressure, 1 + k_p*(p_mean - p_atm) [-].
 
-    Seal friction grows roughly linearly with the pressure behind the seal lip
-    (Belforte et al. 2003, "Pneumatic cylinder seal friction"; Zillen data in real-data/).
+    A lip seal's friction is the contact pressure times the contact area, and the pressure
+    behind the lip adds to the contact pressure, so both friction levels scale with it
+    (Belforte et al. 2003, "Pneumatic cylinder seal friction"); scaling F_C and F_S alike keeps
+    the Stribeck shape. ``coefficient`` is the relative rise per Pa of mean gauge pressure [1/Pa].
     """
-    return coefficient * max(mean_chamber_pressure - atmosphere, 0.0)
+    return 1.0 + coefficient * max(mean_chamber_pressure - atmosphere, 0.0)
 
 
 @njit(cache=True, error_model="numpy", inline="always")

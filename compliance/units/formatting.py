@@ -137,7 +137,7 @@ def fmt_date(iso: str | None) -> str:
 
 # SI unit -> (factor, unit an engineer reads) for fitted parameters and explanations
 _ENGINEERING = {"m^3": (1e3, "L"), "m": (1e3, "mm"), "Pa": (1e-3, "kPa"), "N/m": (1e-3, "kN/m"),
-                "N/Pa": (1e5, "N/bar"), "m^3/(s*Pa)": (1e8, "dm^3/(s*bar)")}
+                "N/Pa": (1e5, "N/bar"), "1/Pa": (1e5, "per bar"), "m^3/(s*Pa)": (1e8, "dm^3/(s*bar)")}
 
 
 def format_value(value: float, unit: str) -> str:

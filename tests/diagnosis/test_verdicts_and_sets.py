@@ -126,11 +126,11 @@ def test_indistinguishable_explanations_get_a_test_that_separates_them(cfg):
     """Friction raised by a fixed amount, or friction rising with chamber pressure by the same amount at
     this test's mean pressure: the same test predicts nearly the same signals; a test at another supply
     pressure moves the mean pressure and separates them by several noise floors."""
-    coef = 5e-4  # N/Pa per cylinder
+    coef = 1.5e-6  # relative rise per Pa of mean gauge pressure (0.15 per bar)
     p_mean = 0.5 * (cfg.p("air.supply_pressure") + cfg.p("air.atmospheric_pressure")) - cfg.p("air.atmospheric_pressure")
-    inc = coef * p_mean
-    a = cfg.replace(params={"friction.static_force": cfg.p("friction.static_force") + inc,
-                            "friction.coulomb_force": cfg.p("friction.coulomb_force") + inc})
+    scale = 1.0 + coef * p_mean
+    a = cfg.replace(params={"friction.static_force": cfg.p("friction.static_force") * scale,
+                            "friction.coulomb_force": cfg.p("friction.coulomb_force") * scale})
     b = cfg.replace(effects={"pressure_dependent_friction": {"coefficient": coef}})
     floors = {"position": 2e-5, "pressure_a": 300.0, "pressure_b": 300.0, "valve_command": 0.01}  # the practice sensors
     out = design_test(a, b, floors, x0=0.06, load=7000.0, names=("friction level", "pressure-dependent friction"))
@@ -138,8 +138,11 @@ def test_indistinguishable_explanations_get_a_test_that_separates_them(cfg):
     rec = out["recommended"]
     assert out["separates"]
     assert rec["key"] != "same"
-    assert rec["key"] == "supply"  # the mean chamber pressure follows the supply; the fixed friction does not
-    assert rec["difference"] > 2.0 * same["difference"]
+    supply = next(r for r in out["tests"] if r["key"] == "supply")
+    # the mean chamber pressure follows the supply; the fixed friction does not (a slow ramp, along which the
+    # mean pressure drifts with the chamber volumes, may separate them more on the command)
+    assert supply["difference"] > 2.0 * same["difference"]
+    assert rec["difference"] >= supply["difference"]
     assert set(rec["traces"][rec["signal"]]) == {"friction level", "pressure-dependent friction"}
 
 

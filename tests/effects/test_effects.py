@@ -236,18 +236,26 @@ def _rhs(cfg, y, u=0.0, load=0.0):
     return dy, aux, P
 
 
-def test_pressure_dependent_friction_adds_coefficient_times_mean_gauge_pressure(cfg):
-    """Sliding friction rises by n * k_p * (mean(p_A, p_B) - p_atm) (variable-viscous map: no bristle state)."""
+def test_pressure_dependent_friction_scales_both_levels_by_one_plus_k_times_mean_gauge_pressure(cfg):
+    """Sliding friction F = n (g(v) (1 + k (mean(p_A, p_B) - p_atm)) + b v): both levels scale, the
+    Stribeck shape and the viscous term do not (variable-viscous map: no bristle state)."""
     c0 = cfg.replace(options={"friction.model": "variable_viscous"})
-    k = 3e-4
+    k = 1e-6  # 0.1 per bar
     c1 = c0.replace(effects={"pressure_dependent_friction": {"coefficient": k}})
     P = parameter_vector(c0, load=0.0)
-    y = initial_state(c0, P, 0.08, (6e5, 4e5))
-    y[S_V] = 0.02
-    _, a0, _ = _rhs(c0, y)
-    _, a1, _ = _rhs(c1, y)
-    gauge = 0.5 * (6e5 + 4e5) - cfg.p("air.atmospheric_pressure")
-    assert a1[A_FRIC] - a0[A_FRIC] == pytest.approx(2 * k * gauge, rel=1e-9)  # two cylinders (tandem)
+    v = 0.02
+    for pa, pb in ((6e5, 4e5), (3e5, 2e5)):
+        y = initial_state(c0, P, 0.08, (pa, pb))
+        y[S_V] = v
+        _, a0, _ = _rhs(c0, y)
+        _, a1, _ = _rhs(c1, y)
+        gauge = 0.5 * (pa + pb) - cfg.p("air.atmospheric_pressure")
+        b = cfg.p("friction.viscous_coefficient")
+        g0 = a0[A_FRIC] / 2 - b * v  # per cylinder, without the viscous part (two cylinders, tandem)
+        rs = math.exp(-v / cfg.p("friction.stribeck_velocity"))
+        assert g0 == pytest.approx(cfg.p("friction.coulomb_force") + (cfg.p("friction.static_force")
+                                                                      - cfg.p("friction.coulomb_force")) * rs, rel=1e-9)
+        assert a1[A_FRIC] == pytest.approx(2 * (g0 * (1 + k * gauge) + b * v), rel=1e-9)
 
 
 def test_position_dependent_load_adds_stiffness_times_offset_from_mid_stroke(cfg):

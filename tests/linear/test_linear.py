@@ -242,3 +242,20 @@ def test_governor_rates_recover_the_flow_control_setting(cfg):
     assert g.VELM == min(g.UO, -g.UC)
     assert 0.05 < g.Tg < 1.0 and (g.GMAX, g.GMIN) == (1.0, 0.0)
     assert json.loads(g.to_json())["parameters"]["Tg"] == pytest.approx(g.Tg)
+
+
+def test_trim_with_a_compliant_linkage_shares_the_load_like_the_rest_state(cfg):
+    """Each cylinder carries half the gate-ring load: 2A1 at rest has f1 + K d = F/2 (no friction in
+    the trim), the same deflection the simulator's rest state gives."""
+    from compliance.model.plant_vector import parameter_vector
+    from compliance.model.rest_state import initial_state
+    from compliance.model.vector_slots import S_X, S_X2
+
+    k, load = 7e4, 3000.0
+    lc = cfg.replace(effects={"linkage_compliance": {"stiffness": k, "damping": 500.0}})
+    op = trim(lc, 0.02, load)
+    f1 = op.pressure_a * lc.piston_area - op.pressure_b * lc.rod_side_area
+    d = op.state[S_X2] - op.state[S_X]
+    assert f1 + k * d == pytest.approx(0.5 * load, rel=1e-9)
+    y = initial_state(lc, parameter_vector(lc, load=load), 0.02, (op.pressure_a, op.pressure_b))
+    assert y[S_X2] - y[S_X] == pytest.approx(d, rel=1e-9)

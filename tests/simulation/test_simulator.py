@@ -114,13 +114,20 @@ def test_given_pressures_beyond_stiction_slip(cfg):
 
 
 def test_compliant_linkage_starts_deflected_and_at_rest(cfg):
-    """With linkage compliance the link carries 2A1's force to the loaded 2A2 from t = 0."""
+    """With linkage compliance each cylinder carries half the gate-ring load from t = 0: at rest
+    2A1 balances f1 + K d = F/2 and 2A2 f2 - K d = F/2, so the link is deflected by
+    d = (f2 - f1) / (2 K) = (F/2 - f1) / K, and neither body accelerates."""
     k = 3e5
+    load = 9000.0
     lc = cfg.replace(effects={"linkage_compliance": {"stiffness": k, "damping": 500.0}})
-    P = parameter_vector(lc, load=9000.0)
+    P = parameter_vector(lc, load=load)
     y = initial_state(lc, P, 0.08)
     f1 = y[S_PA] * lc.piston_area - y[S_PB] * lc.rod_side_area  # decoded seed 000 eq. (6), cylinder 2A1
-    assert (y[S_X2] - y[S_X]) * k == pytest.approx(-f1, rel=1e-9)
+    f2 = y[S_PA] * lc.rod_side_area - y[S_PB] * lc.piston_area  # cylinder 2A2, mounted opposite
+    assert f1 + f2 == pytest.approx(load, rel=1e-9)
+    d = y[S_X2] - y[S_X]
+    assert d * k == pytest.approx(0.5 * (f2 - f1), rel=1e-9)
+    assert f1 + k * d == pytest.approx(0.5 * load, rel=1e-9)
     dy = _rhs(lc, P, y)
     assert dy[S_V] == pytest.approx(0.0, abs=1e-9)
     assert dy[S_V2] == pytest.approx(0.0, abs=1e-9)
