@@ -171,9 +171,11 @@ def _search_sets(st: _Stage, winner: str) -> list[dict]:
             break
         have = set(set_effects(current.name))
         singles = [f for f in st.fits.values() if f.name in EFFECTS and f.name not in have]
-        screen = screen_additions(FitContext(st.rc, st.setup, st.model), current, singles)
-        st.sims += 2 * len(singles)
-        tasks = [("extend", current, f) for f in sorted(singles, key=lambda f: screen[f.name])[:CANDIDATES_PER_ROUND]]
+        ctx = FitContext(st.rc, st.setup, st.model)
+        screen = screen_additions(ctx, current, singles)
+        st.sims += ctx.sims
+        order = sorted(singles, key=lambda f: screen[f.name][0])[:CANDIDATES_PER_ROUND]
+        tasks = [("extend", current, f, screen[f.name][1]) for f in order]
         if not tasks:
             break
         _run(st, tasks)

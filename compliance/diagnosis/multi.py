@@ -19,6 +19,7 @@ effect alone is switched off (the others at their fitted values): one replay per
 from __future__ import annotations
 
 from compliance.effects import EFFECTS
+from compliance.diagnosis.candidates import effect_candidate
 from compliance.diagnosis.fit import FitContext, FitResult, least_squares_fit, scan_points
 from compliance.diagnosis.select import RESIDUAL_LIMIT, SIGNIFICANCE
 
@@ -40,35 +41,54 @@ def set_effects(name: str) -> list[str]:
 
 
 def _start_points(current: FitResult, single: FitResult) -> tuple[tuple, list[list[float]]]:
-    """Parameters of ``current`` plus ``single``'s effect, and the two starts: its single optimum, its default."""
+    """Parameters of ``current`` plus ``single``'s effect, and the starts the screen tries for the added effect.
+
+    The starts: its single-effect optimum, its declared default, and each value of its main
+    parameter on its declared coarse grid (other parameters at the single optimum). An effect whose
+    single fit was dragged off by a dominant other effect (a leak fitted twice too large under a
+    valve lag) has its single optimum and its default both on the wrong side of the value the set
+    needs; the grid brackets it, as it does for the single fit.
+    """
     added = tuple(fp for fp in single.params if fp.kind == "effect")
     params = tuple(current.params) + added
-    return params, [list(current.values) + [v for fp, v in zip(single.params, single.values) if fp.kind == "effect"],
-                    list(current.values) + [fp.nominal for fp in added]]
+    opt = [v for fp, v in zip(single.params, single.values) if fp.kind == "effect"]
+    starts = [list(current.values) + opt, list(current.values) + [fp.nominal for fp in added]]
+    if added:
+        main = added[0].key.split(".", 1)[1]
+        for g in effect_candidate(single.name).grid:
+            if main in g:
+                pt = list(current.values) + [g[main]] + opt[1:]
+                if pt not in starts:
+                    starts.append(pt)
+    return params, starts
 
 
-def screen_additions(ctx: FitContext, current: FitResult, singles) -> dict[str, float]:
-    """Effect -> chi-square of the current set with that effect added, unfitted (the better of its two starts).
+def screen_additions(ctx: FitContext, current: FitResult, singles) -> dict[str, tuple[float, list[float]]]:
+    """Effect -> (chi-square of the current set with that effect added, unfitted, at its best start; that start).
 
-    Which effects a round refits: an effect whose single fit was poor because another effect
-    dominated the recording can still complete the set (two replays per effect, no fit).
+    Which effects a round refits, and where each refit starts: an effect whose single fit was
+    poor because another effect dominated the recording can still complete the set (a few
+    replays per effect over its main parameter's grid, the set held at its optimum, no fit).
     """
     out = {}
     for f in singles:
         params, starts = _start_points(current, f)
-        out[f.name] = min(scan_points(ctx, params, starts))
+        chis = scan_points(ctx, params, starts)
+        i = min(range(len(chis)), key=chis.__getitem__)
+        out[f.name] = (chis[i], starts[i])
     return out
 
 
-def extend_fit(ctx: FitContext, current: FitResult, single: FitResult) -> FitResult:
+def extend_fit(ctx: FitContext, current: FitResult, single: FitResult, start: list[float] | None = None) -> FitResult:
     """Refit ``current`` (an effect set, possibly with base parameters) with ``single``'s effect added.
 
-    The added effect starts at its single-effect optimum or its declared default, whichever
-    leaves the lower chi-square with the current set held at its optimum.
+    The whole set is refitted (the first effects move with the added one), starting at ``start``
+    (the screen's best point) or, without it, at the best of ``_start_points``.
     """
     params, starts = _start_points(current, single)
-    chis = scan_points(ctx, params, starts)
-    start = starts[0] if chis[0] <= chis[1] else starts[1]
+    if start is None:
+        chis = scan_points(ctx, params, starts)
+        start = starts[min(range(len(chis)), key=chis.__getitem__)]
     names = set_effects(current.name) + set_effects(single.name)
     name = set_name(names) + ("+base" if any(fp.kind == "base" for fp in params) else "")
     return least_squares_fit(ctx, name, params, start, simplex_fev=SET_SIMPLEX_FEV)

@@ -27,11 +27,11 @@ def _init_worker(toml_text: str, setup: ReplaySetup, model) -> None:
 
 def _run_task(task):
     """One unit of parallel work: ('base', params) | ('effect', Candidate) | ('combo', Candidate, FitResult)
-    | ('extend', FitResult of a set, FitResult of a single effect)."""
+    | ('extend', FitResult of a set, FitResult of a single effect, start values or None)."""
     ctx: FitContext = _WORKER["ctx"]
     kind = task[0]
     if kind == "extend":
-        res = extend_fit(ctx, task[1], task[2])
+        res = extend_fit(ctx, *task[1:])
     elif kind == "base":
         penalty = task[2]
         res, log = forward_select_base(ctx, task[1], penalty=penalty)
