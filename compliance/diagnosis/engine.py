@@ -29,8 +29,7 @@ from compliance.errors import InputError, SimulationError
 from compliance.diagnosis.candidates import Candidate, apply, base_params, effect_candidate, signature_order
 from compliance.diagnosis.fit import FitContext, FitResult, chi2_parts
 from compliance.diagnosis.fitted_model import fitted_plant, save_fitted
-from compliance.diagnosis.multi import (CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_enough, contributions, screen_additions,
-                                        set_effects, set_name)
+from compliance.diagnosis.multi import CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_enough, contributions, set_effects, set_name
 from compliance.diagnosis.discriminate import design_test
 from compliance.diagnosis.empirical import empirical_term
 from compliance.diagnosis.replay_fit import ReplaySetup, prepare_replay, replay_config, run_replay
@@ -171,9 +170,9 @@ def _search_sets(st: _Stage, winner: str) -> list[dict]:
             break
         have = set(set_effects(current.name))
         singles = [f for f in st.fits.values() if f.name in EFFECTS and f.name not in have]
-        ctx = FitContext(st.rc, st.setup, st.model)
-        screen = screen_additions(ctx, current, singles)
-        st.sims += ctx.sims
+        screened = [r for r, _ in map_tasks([("screen", current, f) for f in singles], st.jobs, st.payload)]
+        screen = {name: (chi, start) for name, chi, start, _ in screened}
+        st.sims += sum(r[3] for r in screened)
         order = sorted(singles, key=lambda f: screen[f.name][0])[:CANDIDATES_PER_ROUND]
         tasks = [("extend", current, f, screen[f.name][1]) for f in order]
         if not tasks:

@@ -1,10 +1,12 @@
 """Several effects at once: greedy forward selection of effect sets, with re-fitting.
 
-After the best single explanation, the diagnosis searches again on what is left: the effects
-that lower the set's chi-square most when simply switched on at their single-effect optimum or
-default (``screen_additions``, two replays each) are each added to the current set and the whole set is refitted (starting
-at the set's optimum plus the added effect at its own single-effect optimum, or at its
-declared default when that starts better). An added effect is kept only when
+After the best single explanation, the diagnosis searches again on what is left. Every other
+effect is screened by switching it on in the current set, unfitted, the set held at its optimum
+(``screen_addition``: the added effect at its single-effect optimum, its declared default, and
+each value of its main parameter's coarse grid; one worker task per effect). The
+``CANDIDATES_PER_ROUND`` effects that lower the chi-square most are each added to the current set
+and the whole set is refitted from the screen's best point (``extend_fit``: the first effects
+move with the added one). An added effect is kept only when
 
 - it pays for itself by the information criterion (``select.SIGNIFICANCE``),
 - it removes at least ``ADD_GAIN`` of the current set's excess chi-square (chi2 - N), and
@@ -54,7 +56,7 @@ def _start_points(current: FitResult, single: FitResult) -> tuple[tuple, list[li
     opt = [v for fp, v in zip(single.params, single.values) if fp.kind == "effect"]
     starts = [list(current.values) + opt, list(current.values) + [fp.nominal for fp in added]]
     if added:
-        main = added[0].key.split(".", 1)[1]
+        main = added[0].name
         for g in effect_candidate(single.name).grid:
             if main in g:
                 pt = list(current.values) + [g[main]] + opt[1:]
@@ -63,20 +65,19 @@ def _start_points(current: FitResult, single: FitResult) -> tuple[tuple, list[li
     return params, starts
 
 
-def screen_additions(ctx: FitContext, current: FitResult, singles) -> dict[str, tuple[float, list[float]]]:
-    """Effect -> (chi-square of the current set with that effect added, unfitted, at its best start; that start).
+def screen_addition(ctx: FitContext, current: FitResult, single: FitResult) -> tuple[str, float, list[float], int]:
+    """(effect, chi-square of the current set with ``single``'s effect added, unfitted, at its best start, that start,
+    replays run).
 
     Which effects a round refits, and where each refit starts: an effect whose single fit was
     poor because another effect dominated the recording can still complete the set (a few
     replays per effect over its main parameter's grid, the set held at its optimum, no fit).
+    One task of the worker pool per effect.
     """
-    out = {}
-    for f in singles:
-        params, starts = _start_points(current, f)
-        chis = scan_points(ctx, params, starts)
-        i = min(range(len(chis)), key=chis.__getitem__)
-        out[f.name] = (chis[i], starts[i])
-    return out
+    params, starts = _start_points(current, single)
+    chis = scan_points(ctx, params, starts)
+    i = min(range(len(chis)), key=chis.__getitem__)
+    return single.name, chis[i], starts[i], len(starts)
 
 
 def extend_fit(ctx: FitContext, current: FitResult, single: FitResult, start: list[float] | None = None) -> FitResult:
@@ -126,4 +127,4 @@ def contributions(ctx: FitContext, fit: FitResult) -> dict[str, float]:
 
 
 __all__ = ["extend_fit", "adds_enough", "contributions", "set_name", "set_effects", "ADD_GAIN", "NO_WORSE",
-           "CANDIDATES_PER_ROUND", "MAX_EFFECTS", "screen_additions"]
+           "CANDIDATES_PER_ROUND", "MAX_EFFECTS", "screen_addition"]

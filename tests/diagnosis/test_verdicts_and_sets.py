@@ -16,8 +16,10 @@ from compliance.model.config import load_plant
 from compliance.diagnosis.discriminate import design_test
 from compliance.diagnosis.empirical import sparse_fit
 from compliance.diagnosis.engine import diagnose
-from compliance.diagnosis.multi import NO_WORSE, adds_enough
-from compliance.diagnosis.fit import FitResult
+from compliance.diagnosis.candidates import effect_params
+from compliance.diagnosis.engine import _prepare
+from compliance.diagnosis.multi import NO_WORSE, adds_enough, screen_addition
+from compliance.diagnosis.fit import FitContext, FitResult, chi2_parts, scan_points
 from compliance.diagnosis.operating_point import load_at_start
 from compliance.diagnosis.select import RESIDUAL_LIMIT, Score, ambiguity_set, honest
 from compliance.recordings.synth import PRACTICE_NOISE, synthesise
@@ -104,6 +106,29 @@ def test_two_effects_switched_on_are_both_named(cfg):
     assert set(d.contributions) == {"valve_offset", "external_leakage"}
     assert all(c["share_of_excess"] > 0.05 for c in d.contributions.values())
     assert d.fits[d.winner].value("valve_offset.offset") == pytest.approx(0.25, rel=0.15)
+
+
+def test_the_screen_finds_a_small_leak_whose_single_fit_a_dominant_valve_lag_dragged_off(cfg):
+    """A valve lag dominates (nominal chi2/N in the hundreds) and a small external leak completes it.
+    The leak's own single fit lands about twice too large, where it makes the set worse, as does its
+    declared default; switched on over its grid the screen finds the side that helps (3e-11 against a
+    true 4.5e-11: the grid's spacing is a factor 3) and the set's chi-square falls."""
+    leak = 4.5e-11
+    frame, meta = _recording(cfg, {"valve_dynamics": {"natural_frequency": 50.7, "damping": 0.63, "delay": 0.0124},
+                                   "external_leakage": {"conductance": leak}}, x0=0.027, load=6000.0)
+    st = _prepare(cfg, frame, meta, 5, 1)
+    ctx, n = FitContext(st.rc, st.setup, st.model), st.model.size
+    pv, pl = effect_params("valve_dynamics"), effect_params("external_leakage")
+    lag = [44.4, 0.6, 0.00814]  # the lag's single fit: it absorbs part of the leak's signature
+    chi, parts = chi2_parts(st.model, ctx.residual(pv, lag)[0])
+    current = FitResult("valve_dynamics", pv, lag, [], chi, parts, n)
+    single = FitResult("external_leakage", pl, [2.1 * leak], [], math.inf, {}, n)
+    # the two starts of a screen without the grid: the single optimum and the declared default (1e-10)
+    assert min(scan_points(ctx, pv + pl, [lag + [2.1 * leak], lag + [pl[0].nominal]])) > chi
+    name, screened, start, replays = screen_addition(ctx, current, single)
+    assert name == "external_leakage" and replays >= 6
+    assert screened < 0.8 * chi
+    assert start[-1] == pytest.approx(leak, rel=0.5)
 
 
 def test_physics_outside_the_library_names_the_signal_left_and_an_empirical_force(cfg):
