@@ -131,6 +131,28 @@ def test_the_screen_finds_a_small_leak_whose_single_fit_a_dominant_valve_lag_dra
     assert start[-1] == pytest.approx(leak, rel=0.5)
 
 
+def test_a_pair_is_identifiable_on_a_model_bench_and_not_under_a_stick_band_friction(cfg):
+    """``truth_share``: the true pair replayed with the fitted model removes almost all the nominal
+    excess when the bench is the model, and less than the half a winner must remove when the bench's
+    friction is the variable-viscous stick band (seed 000 eq. 7) where the model has LuGre: that
+    case's right outcome is an honest incomplete verdict, which ``score_pair`` scores."""
+    from types import SimpleNamespace
+
+    from compliance.diagnosis.pairs import bench_config, score_pair, truth_share
+
+    params = {"valve_offset": {"offset": 0.25}, "external_leakage": {"conductance": 3e-10}}
+    shares = {}
+    for variant in ("fine_step", "friction_form"):
+        frame, meta = _recording(bench_config(cfg, variant), params, x0=0.05, load=6000.0)
+        case = {"pair": list(params), "variant": variant, "params": params, "operating_point": {}, "frame": frame, "meta": meta}
+        shares[variant] = truth_share(cfg, case)
+    assert shares["fine_step"] > 0.9
+    assert shares["friction_form"] < 0.5
+    diag = SimpleNamespace(winner=None, verdict="unexplained", seconds=1.0, ambiguous=[], signals_left={})
+    row = score_pair(case, diag, shares["friction_form"])
+    assert not row["identifiable"] and row["honest"] and not row["both_named"]
+
+
 def test_physics_outside_the_library_names_the_signal_left_and_an_empirical_force(cfg):
     """A load stiffness diagnosed with a library that lacks it: no complete verdict, the pressures named
     as what is left, and the empirical force term finds a position-proportional force of the right size."""
