@@ -182,7 +182,9 @@ def _search_sets(st: _Stage, winner: str) -> list[dict]:
         tried = sorted((_extended(st, t[1], t[2]) for t in tasks),
                        key=lambda f: f.chi2)
         best = tried[0]
-        ok, why = adds_enough(best, current, n, math.log(n), c)
+        times = np.tile(st.setup.time[st.model.index], len(st.model.signals))  # residuals are signal blocks
+        vecs = (st.vecs[current.name], st.vecs[best.name], times) if current.name in st.vecs else None
+        ok, why = adds_enough(best, current, n, math.log(n), c, vecs)
         log.append({"round": len(have) + 1, "tried": [f.name for f in tried], "best": best.name, "kept": ok, "why": why})
         if not ok:
             break

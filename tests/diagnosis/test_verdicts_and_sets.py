@@ -18,7 +18,7 @@ from compliance.diagnosis.empirical import sparse_fit
 from compliance.diagnosis.engine import diagnose
 from compliance.diagnosis.candidates import effect_params
 from compliance.diagnosis.engine import _prepare
-from compliance.diagnosis.multi import NO_WORSE, adds_enough, screen_addition
+from compliance.diagnosis.multi import ADD_GAIN, BURST_WINDOW, NO_WORSE, adds_enough, screen_addition
 from compliance.diagnosis.fit import FitContext, FitResult, chi2_parts, scan_points
 from compliance.diagnosis.operating_point import load_at_start
 from compliance.diagnosis.select import RESIDUAL_LIMIT, Score, ambiguity_set, honest
@@ -79,6 +79,34 @@ def test_an_added_effect_that_makes_a_signal_worse_is_not_kept():
     # the position 1.3 x worse but still within the limit (RMS 1.14 < 2): kept
     assert NO_WORSE < 1.3 < RESIDUAL_LIMIT ** 2
     assert adds_enough(fit("a+d", 1.3, 4.0), cur, n, math.log(n), 1.0)[0]
+
+
+def test_one_burst_neither_hides_a_second_effect_nor_is_the_only_evidence_for_one():
+    """30 s of residuals at 5 ms; the current set leaves 2.5 x the floor everywhere (above the completeness limit
+    of 2) and one 2 s burst at 30 x (a stick-slip event the replay makes and the bench did not, which
+    holds most of the excess). An addition that brings everything outside the burst to the floor is kept
+    although it removes little of the pooled excess; one that fits only the burst is not, although it
+    removes most of it."""
+    t = np.arange(0.0, 30.0, 0.005)
+    burst = (t >= 22.0) & (t < 22.0 + BURST_WINDOW)
+    cur = np.where(burst, 30.0, 2.5)
+    real, burst_fit = np.where(burst, 30.0, 1.0), np.where(burst, 1.0, 2.5)
+    n = t.size
+
+    def fit(name, vec):
+        return FitResult(name, (None,) * (name.count("+") + 1), [], [], float(vec @ vec), {"position": float(vec @ vec)}, n)
+
+    current = fit("a", cur)
+    pooled_real = (current.chi2 - fit("a+b", real).chi2) / (current.chi2 - n)
+    assert pooled_real < ADD_GAIN  # the pooled share alone would reject it
+    kept, why = adds_enough(fit("a+b", real), current, n, math.log(n), 1.0, (cur, real, t))
+    assert kept and "outside" in why
+    kept, why = adds_enough(fit("a+c", burst_fit), current, n, math.log(n), 1.0, (cur, burst_fit, t))
+    assert not kept and "outside" in why
+    # nothing left outside the burst (the floor there): the pooled excess decides, as without the residuals
+    cur_only_burst = np.where(burst, 30.0, 1.0)
+    assert adds_enough(fit("a+c", np.ones(n)), fit("a", cur_only_burst), n, math.log(n), 1.0,
+                       (cur_only_burst, np.ones(n), t))[0]
 
 
 # ----------------------------------------------------------------------------- whole diagnoses
