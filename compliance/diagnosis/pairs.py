@@ -12,7 +12,9 @@ model the diagnosis fits:
 - ``whole_stroke``: the operating point is drawn along the whole stroke (10 mm from either end).
 
 Scored: both effects named in the winning explanation (the issue-13 target, >= 80 %), the
-verdict, and each effect's main parameter against its truth.
+verdict, each effect's main parameter against its truth, and whether the case is identifiable at
+all (``truth_share``: the true pair replayed through the fitted model removes at least half the
+excess; the friction-form cases do not, and their right outcome is an incomplete verdict).
 """
 
 from __future__ import annotations
