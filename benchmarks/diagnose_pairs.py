@@ -32,7 +32,11 @@ def main() -> int:
 
     out = run_pairs(load_plant("plant-a"), cases=args.cases, seed=args.seed, jobs=args.jobs)
     print(f"\nboth effects named: {out['both_named']}/{out['cases']} ({100*out['rate']:.0f} %; target >= 80 %) "
-          f"in {out['seconds']:.0f} s")
+          f"in {out['seconds']:.0f} s, CPU {out['cpu_seconds']:.0f} s ({out['cpu_seconds']/max(out['cases'], 1):.0f} s per case)")
+    other = out["cases"] - out["identifiable"]
+    print(f"identifiable (the true pair removes >= half the excess in the fitted model): both named in "
+          f"{out['both_named_identifiable']}/{out['identifiable']}; not identifiable: honest incomplete verdict in "
+          f"{out['honest_not_identifiable']}/{other}")
     errs = [e for r in out["rows"] if r["both_named"] for e in r["main_errors"].values()]
     if errs:
         print(f"main parameters within 25 %: {sum(e <= 0.25 for e in errs)}/{len(errs)}")

@@ -29,8 +29,7 @@ from compliance.errors import InputError, SimulationError
 from compliance.diagnosis.candidates import Candidate, apply, base_params, effect_candidate, signature_order
 from compliance.diagnosis.fit import FitContext, FitResult, chi2_parts
 from compliance.diagnosis.fitted_model import fitted_plant, save_fitted
-from compliance.diagnosis.multi import (CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_enough, contributions, screen_additions,
-                                        set_effects, set_name)
+from compliance.diagnosis.multi import CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_enough, contributions, set_effects, set_name
 from compliance.diagnosis.discriminate import design_test
 from compliance.diagnosis.empirical import empirical_term
 from compliance.diagnosis.split import split_scan
@@ -173,9 +172,11 @@ def _search_sets(st: _Stage, winner: str) -> list[dict]:
             break
         have = set(set_effects(current.name))
         singles = [f for f in st.fits.values() if f.name in EFFECTS and f.name not in have]
-        screen = screen_additions(FitContext(st.rc, st.setup, st.model), current, singles)
-        st.sims += 2 * len(singles)
-        tasks = [("extend", current, f) for f in sorted(singles, key=lambda f: screen[f.name])[:CANDIDATES_PER_ROUND]]
+        screened = [r for r, _ in map_tasks([("screen", current, f) for f in singles], st.jobs, st.payload)]
+        screen = {name: (chi, start) for name, chi, start, _ in screened}
+        st.sims += sum(r[3] for r in screened)
+        order = sorted(singles, key=lambda f: screen[f.name][0])[:CANDIDATES_PER_ROUND]
+        tasks = [("extend", current, f, screen[f.name][1]) for f in order]
         if not tasks:
             break
         _run(st, tasks)
@@ -183,7 +184,9 @@ def _search_sets(st: _Stage, winner: str) -> list[dict]:
         tried = sorted((_extended(st, t[1], t[2]) for t in tasks),
                        key=lambda f: f.chi2)
         best = tried[0]
-        ok, why = adds_enough(best, current, n, math.log(n), c)
+        times = np.tile(st.setup.time[st.model.index], len(st.model.signals))  # residuals are signal blocks
+        vecs = (st.vecs[current.name], st.vecs[best.name], times) if current.name in st.vecs else None
+        ok, why = adds_enough(best, current, n, math.log(n), c, vecs)
         log.append({"round": len(have) + 1, "tried": [f.name for f in tried], "best": best.name, "kept": ok, "why": why})
         if not ok:
             break

@@ -14,7 +14,7 @@ from concurrent.futures import ProcessPoolExecutor
 from compliance.model.config import plant_from_dict
 from compliance.diagnosis.fit import FitContext, fit_candidate, least_squares_fit
 from compliance.diagnosis.recalibration import forward_select_base
-from compliance.diagnosis.multi import extend_fit
+from compliance.diagnosis.multi import extend_fit, screen_addition
 from compliance.diagnosis.replay_fit import ReplaySetup
 
 _WORKER: dict = {}
@@ -27,11 +27,14 @@ def _init_worker(toml_text: str, setup: ReplaySetup, model) -> None:
 
 def _run_task(task):
     """One unit of parallel work: ('base', params) | ('effect', Candidate) | ('combo', Candidate, FitResult)
-    | ('extend', FitResult of a set, FitResult of a single effect)."""
+    | ('extend', FitResult of a set, FitResult of a single effect, start values or None)
+    | ('screen', FitResult of a set, FitResult of a single effect)."""
     ctx: FitContext = _WORKER["ctx"]
     kind = task[0]
+    if kind == "screen":  # (effect, chi-square, start, replays) of multi.screen_addition; no fit, no residual
+        return screen_addition(ctx, task[1], task[2]), None
     if kind == "extend":
-        res = extend_fit(ctx, task[1], task[2])
+        res = extend_fit(ctx, *task[1:])
     elif kind == "base":
         penalty = task[2]
         res, log = forward_select_base(ctx, task[1], penalty=penalty)
