@@ -131,6 +131,8 @@ file_cases(CHECKR, "bad-req.toml", [
     ("req-unknown-operating-point", req('operating_points = ["mid"]', 'operating_points = ["middle"]'), "middle"),
     ("req-unknown-procedure", req('procedures = ["steps-5"]', 'procedures = ["steps-50"]'), "steps-50"),
     ("req-unknown-kind", req('kind = "steps"', 'kind = "jumps"'), "jumps"),
+    ("req-unknown-stroke-start", req('kind = "steps"\ntitle = "5 % steps"\nsize = "5 %stroke"',
+                                     'kind = "full_stroke"\ntitle = "stroke"\nstart = "middle"'), "procedures.steps-5.start"),
     ("req-metric-not-measurable", req('metric = "time_constant"', 'metric = "opening_time"'), "cannot be measured"),
     ("req-unknown-severity", req('severity = "mandatory"', 'severity = "optional"'), "optional"),
     ("req-extends-missing", req('name = "tiny"', 'name = "tiny"\nextends = "nothere.toml"'), "nothere.toml"),
