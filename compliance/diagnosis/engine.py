@@ -33,6 +33,7 @@ from compliance.diagnosis.multi import CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_e
 from compliance.diagnosis.discriminate import design_test
 from compliance.diagnosis.empirical import empirical_term
 from compliance.diagnosis.split import split_scan
+from compliance.diagnosis.friction_form import OPTION as FORM_OPTION, friction_form_check
 from compliance.diagnosis.replay_fit import ReplaySetup, prepare_replay, replay_config, run_replay
 from compliance.diagnosis.residuals import UNITS, build_residual_model, null_recording, signal_fit, with_fail_level
 from compliance.diagnosis.select import (AMBIGUOUS_BIC, EXPLAINED_ENOUGH, NOISE_TOLERANCE, RESIDUAL_LIMIT, ambiguity_set, honest, same_physics,
@@ -80,6 +81,7 @@ class Diagnosis:
     suggested_test: dict | None = None  # discriminate.design_test for an ambiguous recording
     empirical: dict | None = None  # empirical.empirical_term when the library leaves residual
     split: dict | None = None  # split.split_scan: does the recording pin a lag's split or only its total
+    friction_form: dict | None = None  # friction_form.friction_form_check: another friction law as the base
 
     def ranked(self) -> list[str]:
         """Candidate names by BIC, best first (nominal included)."""
@@ -302,6 +304,12 @@ def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | N
     jobs = default_jobs() if jobs is None else max(1, int(jobs))
     names = _check_effects(cfg, effects)
     st = _prepare(cfg, frame, meta, stride, jobs)
+    form = friction_form_check(st.rc, st.setup, st.model, st.fits["nominal"])
+    if form and form["adopted"]:  # the other friction law is the base of the whole search
+        cfg = cfg.replace(options={FORM_OPTION: form["adopted"]})
+        st = _prepare(cfg, frame, meta, stride, jobs)
+        st.sims += 2
+    st.sims += form["replays"] if form else 0
     _fit_singles(st, names, recalibrate)
     dec = _decide(st)
     winner, verdict_name = dec["winner"], dec["verdict"]
@@ -330,7 +338,7 @@ def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | N
         traces={"time": st.setup.time, "recorded": st.model.recorded, "before": full_nom, "after": full_win,
                 "objective_before": st.nominal_sim, "objective_after": seg_win},
     )
-    diag.agreement = agreement
+    diag.agreement, diag.friction_form = agreement, form
     diag.located_regimes = where_words(st.events)
     diag.ambiguous, diag.signals_left, diag.search = dec["ambiguous"], dec["left"], dec["search"]
     diag.contributions = _contributions(st, winner)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from compliance.effects import EFFECTS
 from compliance.diagnosis.candidates import FRICTION_LEVEL
+from compliance.diagnosis.friction_form import form_words
 from compliance.units.formatting import format_value
 
 # how each effect reads in words, with its main fitted value ({v} is filled in): ``Effect.explanation``
@@ -138,7 +139,7 @@ def explain(d) -> str:
     text = _explain_core(d)
     if d.verdict == "partially_explained":
         text += f" It does not explain everything: what is left sits on {_left(d)}."
-    return text + _contribution_words(d) + _ambiguity_words(d) + _empirical(d)
+    return text + form_words(getattr(d, "friction_form", None)) + _contribution_words(d) + _ambiguity_words(d) + _empirical(d)
 
 
 def _explain_core(d) -> str:

@@ -128,6 +128,7 @@ def diagnosis_to_dict(d) -> dict:
         "effect_search": _clean(d.search),
         "empirical": _clean(d.empirical),
         "split": _clean(getattr(d, "split", None)),
+        "friction_form": _clean(getattr(d, "friction_form", None)),
         "saved_model": d.saved_model,
         "notes": list(d.notes),
         "timing": {"seconds": json_number(d.seconds), "simulations": d.simulations, "jobs": d.jobs},

@@ -76,6 +76,9 @@ def _beats(scores, a: str, b: str, n: int) -> bool:
     return excess > 0 and (sb.chi2 - sa.chi2) >= MIN_GAIN * excess
 
 
+beats = _beats  # public: friction_form applies the same rule to the friction law's alternative form
+
+
 def verdict(scores: dict[str, Score], n: int, nominal_rms: dict, effect_names) -> tuple[str, str | None, str]:
     """Decide the verdict.
 
