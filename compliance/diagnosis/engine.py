@@ -138,6 +138,18 @@ def _prepare(cfg: PlantConfig, frame, meta: dict, stride: int, jobs: int) -> _St
     return st
 
 
+def _prepare_base(cfg: PlantConfig, frame, meta: dict, stride: int, jobs: int):
+    """Stages 1-2 with the friction law's other form tried as the base (friction_form.py)."""
+    st = _prepare(cfg, frame, meta, stride, jobs)
+    form = friction_form_check(st.rc, st.setup, st.model, st.fits["nominal"])
+    if form and form["adopted"]:  # the other friction law is the base of the whole search
+        cfg = cfg.replace(options={FORM_OPTION: form["adopted"]})
+        st = _prepare(cfg, frame, meta, stride, jobs)
+        st.sims += 2
+    st.sims += form["replays"] if form else 0
+    return cfg, st, form
+
+
 def _run(st: _Stage, tasks) -> None:
     for res, v in map_tasks(tasks, st.jobs, st.payload):
         st.fits[res.name] = res
@@ -303,13 +315,7 @@ def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | N
     t0 = time.perf_counter()
     jobs = default_jobs() if jobs is None else max(1, int(jobs))
     names = _check_effects(cfg, effects)
-    st = _prepare(cfg, frame, meta, stride, jobs)
-    form = friction_form_check(st.rc, st.setup, st.model, st.fits["nominal"])
-    if form and form["adopted"]:  # the other friction law is the base of the whole search
-        cfg = cfg.replace(options={FORM_OPTION: form["adopted"]})
-        st = _prepare(cfg, frame, meta, stride, jobs)
-        st.sims += 2
-    st.sims += form["replays"] if form else 0
+    cfg, st, form = _prepare_base(cfg, frame, meta, stride, jobs)
     _fit_singles(st, names, recalibrate)
     dec = _decide(st)
     winner, verdict_name = dec["winner"], dec["verdict"]
