@@ -67,7 +67,7 @@ def score_all(fits: dict, n: int) -> dict[str, Score]:
     return out
 
 
-def _beats(scores, a: str, b: str, n: int) -> bool:
+def beats(scores, a: str, b: str, n: int) -> bool:
     """True when candidate ``a`` is a significant, material improvement on the simpler ``b``."""
     sa, sb = scores[a], scores[b]
     if sb.bic - sa.bic < SIGNIFICANCE:
@@ -75,8 +75,6 @@ def _beats(scores, a: str, b: str, n: int) -> bool:
     excess = max(sb.chi2 - n, 0.0)
     return excess > 0 and (sb.chi2 - sa.chi2) >= MIN_GAIN * excess
 
-
-beats = _beats  # public: friction_form applies the same rule to the friction law's alternative form
 
 
 def verdict(scores: dict[str, Score], n: int, nominal_rms: dict, effect_names) -> tuple[str, str | None, str]:
@@ -102,13 +100,13 @@ def verdict(scores: dict[str, Score], n: int, nominal_rms: dict, effect_names) -
     effect_names = [e for e in effect_names if e in scores]
     within = max(nominal_rms.values(), default=0.0) <= NOISE_TOLERANCE
     ref = "nominal"
-    if "base" in scores and _beats(scores, "base", "nominal", n):
+    if "base" in scores and beats(scores, "base", "nominal", n):
         ref = "base"
     best_eff = min(effect_names, key=lambda e: scores[e].bic, default=None)
     winner = ref
-    if best_eff is not None and _beats(scores, best_eff, ref, n):
+    if best_eff is not None and beats(scores, best_eff, ref, n):
         winner = best_eff
-    elif best_eff is not None and ref == "base" and scores[best_eff].bic < scores["base"].bic and _beats(scores, best_eff, "nominal", n):
+    elif best_eff is not None and ref == "base" and scores[best_eff].bic < scores["base"].bic and beats(scores, best_eff, "nominal", n):
         winner = best_eff  # the effect explains what the recalibration does, more cheaply
     if within:
         return "no_mismatch", None, (
