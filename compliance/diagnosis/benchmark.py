@@ -375,7 +375,10 @@ def run_practice(directory, cfg: PlantConfig, *, library=None, jobs: int = 1) ->
         rows.append({"name": name, "truth": ", ".join(truth) or "none", "verdict": d.verdict, "winner": d.winner,
                      "correct": bool(correct), "ambiguous_with_truth": ambiguous_ok, "ambiguity": list(d.ambiguous),
                      "signals_left": dict(d.signals_left), "parameters": params, "seconds": d.seconds, "explanation": d.explanation,
-                     "fit_before": d.fit_before, "fit_after": d.fit_after, "main": main_parameter(d, truth, params)})
+                     "fit_before": d.fit_before, "fit_after": d.fit_after, "main": main_parameter(d, truth, params),
+                     # the verdict's own yardstick (re-synchronised replay, x floor), every fitted value, the lag scan
+                     "objective_before": d.objective_before, "objective_after": d.objective_after, "fitted": fitted,
+                     "split": d.split})
     mains = [r["main"] for r in rows if r["main"]]
     return {"recordings": rows, "correct": sum(r["correct"] for r in rows), "main_scored": len(mains),
             "main_within_25": sum(m["within_25"] for m in mains),

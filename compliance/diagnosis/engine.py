@@ -32,7 +32,7 @@ from compliance.diagnosis.fitted_model import fitted_plant, save_fitted
 from compliance.diagnosis.multi import CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_enough, contributions, set_effects, set_name
 from compliance.diagnosis.discriminate import design_test
 from compliance.diagnosis.empirical import empirical_term
-from compliance.diagnosis.split import split_scan
+from compliance.diagnosis.split import adopted_fit, split_scan
 from compliance.diagnosis.friction_form import OPTION as FORM_OPTION, friction_form_check
 from compliance.diagnosis.replay_fit import ReplaySetup, prepare_replay, replay_config, run_replay
 from compliance.diagnosis.residuals import UNITS, build_residual_model, null_recording, signal_fit, with_fail_level
@@ -319,6 +319,7 @@ def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | N
     _fit_singles(st, names, recalibrate)
     dec = _decide(st)
     winner, verdict_name = dec["winner"], dec["verdict"]
+    split = _split(st, winner, verdict_name, dec)
     agreement = {k: mask_agreement(st.model, st.nvec, st.vecs[k], st.event_mask) for k in st.fits if k in st.vecs}
     ranked = sorted((k for k in st.fits if k != "nominal"), key=lambda k: (dec["scores"][k].bic, -agreement.get(k, 0.0)))
     runner = (ranked[0] if ranked else None) if winner is None else next(
@@ -351,8 +352,8 @@ def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | N
     pair = dec["ambiguous"] or ([winner, runner] if suggest_test and winner and runner else [])
     diag.suggested_test = _suggest(st, pair)
     diag.empirical = _empirical(st, dec)
-    diag.split = _split(st, winner, verdict_name)
-    diag.simulations += len(diag.split["points"]) - 1 if diag.split else 0
+    diag.split = split
+    diag.simulations += split["replays"] if split else 0
     from compliance.diagnosis.explain import explain
 
     diag.explanation = explain(diag)
@@ -360,12 +361,19 @@ def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | N
     return diag
 
 
-def _split(st: _Stage, winner: str | None, verdict_name: str) -> dict | None:
-    """Does the recording pin the split of the winner's lag, or its total only (``split.split_scan``)?"""
+def _split(st: _Stage, winner: str | None, verdict_name: str, dec: dict) -> dict | None:
+    """Does the recording pin the split of the winner's lag, or its total only (``split.split_scan``)?
+    An undetermined split moves to the segments' estimate (the winner's fit, scores and what is left follow)."""
     lag = next((e for e in (winner or "").split("+") if e in EFFECTS and EFFECTS[e].lumped is not None), None)
     if lag is None or verdict_name == "unexplained":
         return None
-    return split_scan(FitContext(st.rc, st.setup, st.model), st.fits[winner], lag)
+    ctx = FitContext(st.rc, st.setup, st.model)
+    sp = split_scan(ctx, st.fits[winner], lag)
+    moved = adopted_fit(ctx, st.fits[winner], sp["estimate"]) if sp and sp["estimate"] else None
+    if moved is not None:
+        st.fits[winner], st.vecs[winner] = moved
+        dec.update(scores=score_all(st.fits, st.model.size), left=signals_left(_objective(st, winner)))
+    return sp and {**sp, "replays": ctx.sims}
 
 
 def _contributions(st: _Stage, winner: str | None) -> dict:

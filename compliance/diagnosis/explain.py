@@ -130,8 +130,14 @@ def _split_words(d, fp) -> str:
         out = [format_value(v, fp.unit) for v in sp.get("bracket", []) if v is not None]
         return (f" Along that valley the recording pins {fp.name.replace('_', ' ')} near {lo if lo == hi else f'{lo} - {hi}'}"
                 + (f" (the scan's {' and '.join(out)} fit worse)." if out else "."))
-    return (f" Along that valley every {fp.name.replace('_', ' ')} from {lo} to {hi} explains the recording as well as the "
-            f"fit (total lag within 4 % of its fit): this test does not determine the split, only the total.")
+    text = (f" Along that valley every {fp.name.replace('_', ' ')} from {lo} to {hi} explains the recording as well as the "
+            f"pooled fit (total lag within 4 % of its fit): the pooled fit does not determine the split, only the total.")
+    est = sp.get("estimate")
+    if est:
+        text += (f" The re-synchronised segments agree best at {format_value(est['value'], fp.unit)} (least trimmed squares: "
+                 f"the worst fifth of the segments, where a stick-slip event can decide, left out; trimmed chi2/N "
+                 f"{est['trimmed']:.2f} against {est['trimmed_fit']:.2f}), the value given above.")
+    return text
 
 
 def explain(d) -> str:

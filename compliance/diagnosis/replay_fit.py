@@ -35,7 +35,7 @@ from scipy.signal import savgol_filter
 
 from compliance.model.config import PlantConfig
 from compliance.errors import InputError, SimulationError
-from compliance.model.vector_slots import P_KI, P_KP, P_SD_ON, P_STROKE, S_PSUP, S_TA, S_TB, S_V, S_V2
+from compliance.model.vector_slots import P_KI, P_KP, P_SD_ON, P_SL_ON, P_SL_TAU, P_SL_TD, P_STROKE, S_PSUP, S_TA, S_TB, S_V, S_V2
 from compliance.model.plant_vector import load_curve_arrays, parameter_vector
 from compliance.model.rest_state import initial_state, set_rest_internal_states
 from compliance.diagnosis.operating_point import load_at_start
@@ -241,10 +241,16 @@ def _reset_state(cfg, P, setup: ReplaySetup, k: int, previous: np.ndarray, lx, l
     """State at sample ``k`` read from the recording (measured) and the previous segment (the rest)."""
     st = setup.states
     x = float(st["position"][k])
+    v = float(st["velocity"][k])
+    if P[P_SL_ON]:
+        # the recorded position is the sensor's, which trails the piston by its total lag (exactly for a
+        # delay, to first order for the lag): the piston is where the reading arrives that much later
+        later = setup.time[k] + P[P_SL_TAU] + P[P_SL_TD]
+        x = float(np.interp(later, setup.time, st["position"]))
+        v = float(np.interp(later, setup.time, st["velocity"]))
     pa = float(st["pressure_a"][k]) if "pressure_a" in st else float(previous[k, _OUT["pressure_a"]])
     pb = float(st["pressure_b"][k]) if "pressure_b" in st else float(previous[k, _OUT["pressure_b"]])
     y = initial_state(cfg, P, min(max(x, 0.0), P[P_STROKE]), (pa, pb))
-    v = float(st["velocity"][k])
     y[S_V] = v
     y[S_V2] = v
     y[S_TA] = previous[k, _OUT["temperature_a"]]  # gas temperatures are not measured: carried over

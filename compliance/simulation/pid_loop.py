@@ -18,9 +18,9 @@ from compliance.model.plant_vector import load_curve_arrays, parameter_vector
 from compliance.model.rest_state import initial_state
 from compliance.model.config import PlantConfig
 from compliance.model.pid_controller import first_order_filter_gain, pid_sample, saturate
-from compliance.model.vector_slots import P_FILT, P_KD, P_KI, P_KP, P_SL_ON, P_SL_TD, P_TSAMP, P_UCEN, P_ULIM, P_VD_ON, P_VD_TD, S_SP, S_X
+from compliance.model.vector_slots import P_FILT, P_KD, P_KI, P_KP, P_SL_ON, P_SL_TD, P_TSAMP, P_UCEN, P_ULIM, P_VD_ON, P_VD_TD, S_SP, S_V, S_X
 from compliance.simulation.rk4 import N_OUT, OUTPUT_COLUMNS, measured_position, non_physical, record_sample, rk4_step, rk4_workspace
-from compliance.simulation.rk4 import sensor_lag_advance, sensor_lag_coefficients, zoh_average
+from compliance.simulation.rk4 import sensor_lag_advance, sensor_lag_coefficients, sensor_lag_start, zoh_average
 from compliance.simulation.scenario import Scenario, sample_profile
 
 
@@ -62,8 +62,8 @@ def simulate_core(P, y0, ref, cmd, closed_loop, pos_noise, pos_quantum, lx, ly, 
     sensor = P[P_SL_ON] != 0.0
     x_hist = np.zeros(n_samples * n_sub + 1) if sensor else np.zeros(1)
     x_hist[0] = y[S_X]
-    x_sensor = xd_prev = y[S_X]  # the sensor starts at rest on the true position
     lag_decay, lag_ramp = sensor_lag_coefficients(P, h)
+    x_sensor, xd_prev, v0 = sensor_lag_start(P, y[S_X], y[S_V], sensor)
     alpha = first_order_filter_gain(P[P_FILT], ts)
     x_filt, integral = 0.0, 0.0
     valve_delay = P[P_VD_TD] if P[P_VD_ON] != 0.0 else 0.0
@@ -99,7 +99,7 @@ def simulate_core(P, y0, ref, cmd, closed_loop, pos_noise, pos_quantum, lx, ly, 
             step_index += 1
             if sensor:
                 x_sensor, xd_prev = sensor_lag_advance(x_hist, step_index, y[S_X], h, sensor_delay, x_sensor, xd_prev,
-                                                       lag_decay, lag_ramp)
+                                                       lag_decay, lag_ramp, v0)
         if non_physical(y):
             return k
     return -1

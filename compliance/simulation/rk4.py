@@ -13,7 +13,7 @@ import numpy as np
 from numba import njit
 
 from compliance.model.assembly import plant_rhs
-from compliance.model.vector_slots import A_FRIC, A_LOAD, A_OPEN, A_QA, A_QB, N_AUX, N_STATES, P_HT_ON, P_PS, P_SD_ON, P_SL_TAU, P_TS
+from compliance.model.vector_slots import A_FRIC, A_LOAD, A_OPEN, A_QA, A_QB, N_AUX, N_STATES, P_HT_ON, P_PS, P_SD_ON, P_SL_TAU, P_SL_TD, P_TS
 from compliance.model.vector_slots import S_PA, S_PB, S_PSUP, S_TA, S_TB, S_V, S_X
 
 OUTPUT_COLUMNS = (
@@ -138,8 +138,24 @@ def sensor_lag_coefficients(P, h):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def sensor_lag_advance(x_hist, step_index, x, h, delay, x_sensor, xd_prev, decay, ramp):
+def sensor_lag_start(P, x, v, on):
+    """(reading, delayed position [m], speed [m/s]) of the lagged sensor at the start of a run.
+
+    Where a steady motion at the initial speed ``v`` leaves it (at rest: on the true position ``x``):
+    a ramp trails a delay t_d and a first-order lag tau by v (t_d + tau). ``on``: the sensor lag is on.
+    """
+    if not on:
+        return x, x, 0.0
+    xd = x - v * P[P_SL_TD]
+    return xd - v * P[P_SL_TAU], xd, v
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def sensor_lag_advance(x_hist, step_index, x, h, delay, x_sensor, xd_prev, decay, ramp, v0):
     """Store the true position of step ``step_index`` and advance the delayed, lagged sensor one step.
+
+    Before t = 0 the piston is taken to have moved steadily at ``v0`` [m/s] (0: at rest), the
+    history a run started mid-motion (a re-synchronised replay segment) had.
 
     Returns
     -------
@@ -147,6 +163,7 @@ def sensor_lag_advance(x_hist, step_index, x, h, delay, x_sensor, xd_prev, decay
         (sensor reading [m], delayed position at this step [m]).
     """
     x_hist[step_index] = x
-    xd = interp_uniform(x_hist, h, step_index * h - delay)
+    t = step_index * h - delay
+    xd = interp_uniform(x_hist, h, t) if t >= 0.0 else x_hist[0] + v0 * t
     # first-order lag integrated exactly for an input linear over the step
     return decay * x_sensor + (1.0 - decay) * xd_prev + (xd - xd_prev) * ramp, xd

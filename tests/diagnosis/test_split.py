@@ -81,3 +81,42 @@ def test_a_pinned_split_is_bracketed_by_the_values_that_fit_worse():
     ctx = _Valley(lambda tau, td: 200.0 * (1.0 + 100.0 * ((tau - 0.02) / 0.02) ** 2))
     sp = split_scan(ctx, _fit(ctx, 0.02, 0.004), "sensor_lag")
     assert sp["bracket"] == [pytest.approx(0.018), pytest.approx(0.0224)]  # the scan's 0.9 and 1.12 x the fit
+
+
+def test_trimmed_chi2_leaves_out_the_worst_fifth_of_the_segments():
+    from compliance.diagnosis.split import trimmed_chi2
+
+    segments = np.repeat(np.arange(10), 20)
+    vec = np.ones(200)
+    vec[segments == 3] = 10.0  # one segment with a slip the model makes and the bench did not
+    assert float(vec @ vec) / vec.size == pytest.approx(10.9)
+    assert trimmed_chi2(vec, segments) == pytest.approx(1.0)  # 8 of 10 segments kept: the slip is out
+
+
+class _Segmented(_Valley):
+    """Ten segments: nine say the split is tau = 17.5 ms, one (a stick-slip burst) pulls the pooled optimum to 20 ms."""
+
+    def __init__(self):
+        super().__init__(lambda tau, td: 0.0)
+        self.setup = SimpleNamespace(resets=np.arange(0, M, M // 10))
+
+    def residual(self, params, values):
+        p = {fp.name: v for fp, v in zip(params, values)}
+        self.calls.append(p)
+        tau = p["time_constant"]
+        quiet = 0.5 + 1e4 * (tau - 0.0175) ** 2  # chi2 per residual in the nine segments that agree
+        burst = 10.0 + 1.125e5 * (tau - 0.022) ** 2  # ... and in the burst one: d(pooled)/d tau = 0 at 20 ms
+        per = np.full(M, quiet)
+        per[:M // 10] = burst
+        return np.tile(np.sqrt(per), len(SIGNALS)), object()
+
+
+def test_the_segments_estimate_an_undetermined_split_the_pooled_fit_misplaces():
+    ctx = _Segmented()
+    fit = _fit(ctx, 0.02, 0.004)
+    sp = split_scan(ctx, fit, "sensor_lag")
+    assert not sp["pinned"]
+    est = sp["estimate"]
+    assert est is not None and est["value"] == pytest.approx(0.018)  # the scan's 0.9 x the fit, nearest to 17.5 ms
+    assert est["trimmed"] < est["trimmed_fit"]
+    assert sum(est["values"]) == pytest.approx(0.024, rel=0.05)  # the total lag is held
