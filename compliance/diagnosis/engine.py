@@ -35,62 +35,17 @@ from compliance.diagnosis.empirical import empirical_term
 from compliance.diagnosis.split import adopted_fit, split_scan
 from compliance.diagnosis.friction_form import OPTION as FORM_OPTION, friction_form_check
 from compliance.diagnosis.replay_fit import ReplaySetup, prepare_replay, replay_config, run_replay
-from compliance.diagnosis.residuals import UNITS, build_residual_model, null_recording, signal_fit, with_fail_level
+from compliance.diagnosis.residuals import (UNITS, build_residual_model, null_recording, own_floor_objective, signal_fit,
+                                            with_fail_level)
 from compliance.diagnosis.select import (AMBIGUOUS_BIC, EXPLAINED_ENOUGH, NOISE_TOLERANCE, RESIDUAL_LIMIT, ambiguity_set, honest, same_physics,
                                          score_all, signals_left, verdict)
-from compliance.diagnosis.report_data import SCHEMA, diagnosis_to_dict
+from compliance.diagnosis.report_data import SCHEMA
+from compliance.diagnosis.result import Diagnosis
 from compliance.diagnosis.located import event_rms, locate_mismatch, mask_agreement, where_words
 from compliance.diagnosis.workers import default_jobs, map_tasks
 
 COMBINE_LEVEL = 3.0  # chi2/N of the best single explanation above which effects are refitted with the recalibration
 COMBINE_TOP = 1  # how many effects are refitted with the recalibration
-
-
-@dataclass
-class Diagnosis:
-    """Result of ``diagnose`` (``to_dict`` gives the documented JSON)."""
-
-    verdict: str
-    reason: str
-    winner: str | None
-    runner_up: str | None
-    fits: dict
-    scores: dict
-    fit_before: dict
-    fit_after: dict
-    objective_before: dict
-    objective_after: dict
-    windows: list
-    floors: dict
-    explanation: str
-    cfg: PlantConfig
-    fitted_cfg: PlantConfig | None
-    recording: str
-    seconds: float
-    simulations: int
-    jobs: int
-    notes: list = field(default_factory=list)
-    traces: dict = field(default_factory=dict)
-    saved_model: str | None = None
-    agreement: dict = field(default_factory=dict)  # candidate -> share of its chi-square gain inside the windows
-    located_regimes: list = field(default_factory=list)
-    ambiguous: list = field(default_factory=list)  # explanations the recording cannot tell apart (winner first)
-    signals_left: dict = field(default_factory=dict)  # signal -> normalised RMS above select.RESIDUAL_LIMIT after the winner
-    search: list = field(default_factory=list)  # rounds of the multi-effect search (multi.py)
-    contributions: dict = field(default_factory=dict)  # effect -> its own contribution in the winning set
-    suggested_test: dict | None = None  # discriminate.design_test for an ambiguous recording
-    empirical: dict | None = None  # empirical.empirical_term when the library leaves residual
-    split: dict | None = None  # split.split_scan: does the recording pin a lag's split or only its total
-    friction_form: dict | None = None  # friction_form.friction_form_check: another friction law as the base
-
-    def ranked(self) -> list[str]:
-        """Candidate names by BIC, best first (nominal included)."""
-        return sorted(self.scores, key=lambda k: self.scores[k].bic)
-
-    def to_dict(self) -> dict:
-        """The JSON document of docs/diagnosis-schema.md."""
-
-        return diagnosis_to_dict(self)
 
 
 @dataclass
@@ -235,7 +190,7 @@ def _decide(st: _Stage) -> dict:
             winner = kept[-1]["best"]
             reason = f"{' and '.join(set_effects(winner))} together explain {100*scores[winner].explained:.0f} % of the excess residual"
             verdict_name = "missing_physics" if scores[winner].explained >= EXPLAINED_ENOUGH else "unexplained"
-    after = _objective(st, winner) if winner else None
+    after = _own_floors(st, winner, verdict_name)
     verdict_name, reason = honest(verdict_name, winner, reason, after)
     objectives = {k: _objective(st, k) for k in st.fits if k != "nominal"}
     ambiguous = ambiguity_set(scores, winner, objectives) if verdict_name != "no_mismatch" else []
@@ -244,7 +199,21 @@ def _decide(st: _Stage) -> dict:
         reason = (f"{' and '.join(ambiguous)} explain the recording equally well (every signal within "
                   f"{RESIDUAL_LIMIT:g} x its floor, or BIC within {AMBIGUOUS_BIC:g}); another test tells them apart")
     return {"scores": scores, "verdict": verdict_name, "winner": winner, "reason": reason, "search": search,
-            "ambiguous": ambiguous, "left": signals_left(after if winner else _objective(st, "nominal"))}
+            "ambiguous": ambiguous, "after": after, "left": signals_left(after if winner else _objective(st, "nominal"))}
+
+
+def _own_floors(st: _Stage, winner: str | None, verdict_name: str) -> dict | None:
+    """What the winner leaves, x floor; a complete verdict's leftovers are judged against its own null floors too."""
+    after = _objective(st, winner) if winner else None
+    if verdict_name in ("missing_physics", "parameters_only") and signals_left(after) and winner in st.vecs:
+        w = st.fits[winner]
+        try:
+            own = own_floor_objective(st.model, apply(st.rc, w.params, w.values), st.setup, st.vecs[winner])
+        except (SimulationError, InputError):
+            return after
+        st.sims += 4  # two null draws, each a recording and its replay
+        after = {s: min(v, own.get(s, v)) for s, v in after.items()}
+    return after
 
 
 def _suggest(st: _Stage, ambiguous: list) -> dict | None:
@@ -339,7 +308,7 @@ def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | N
     diag = Diagnosis(
         verdict=verdict_name, reason=dec["reason"], winner=winner, runner_up=runner, fits=st.fits, scores=dec["scores"],
         fit_before=signal_fit(st.model, full_nom), fit_after=signal_fit(st.model, full_win) if full_win is not None else None,
-        objective_before=_objective(st, "nominal"), objective_after=_objective(st, winner) if winner else None,
+        objective_before=_objective(st, "nominal"), objective_after=dec["after"] if winner else None,
         windows=_window_rows(st, seg_win), floors=dict(st.model.floors), explanation="", cfg=cfg, fitted_cfg=fitted_cfg,
         recording=st.setup.source, seconds=0.0, simulations=st.sims, jobs=jobs, notes=notes,
         traces={"time": st.setup.time, "recorded": st.model.recorded, "before": full_nom, "after": full_win,
@@ -372,7 +341,8 @@ def _split(st: _Stage, winner: str | None, verdict_name: str, dec: dict) -> dict
     moved = adopted_fit(ctx, st.fits[winner], sp["estimate"]) if sp and sp["estimate"] else None
     if moved is not None:
         st.fits[winner], st.vecs[winner] = moved
-        dec.update(scores=score_all(st.fits, st.model.size), left=signals_left(_objective(st, winner)))
+        after = _own_floors(st, winner, verdict_name)
+        dec.update(scores=score_all(st.fits, st.model.size), after=after, left=signals_left(after))
     return sp and {**sp, "replays": ctx.sims}
 
 

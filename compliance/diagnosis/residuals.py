@@ -194,6 +194,26 @@ def null_replay_floors(cfg: PlantConfig, setup: ReplaySetup, sensor: dict) -> tu
 
 
 
+def own_floor_objective(model: ResidualModel, cfg: PlantConfig, setup: ReplaySetup, vec: np.ndarray) -> dict:
+    """Signal -> normalised RMS of an explanation's residual ``vec`` against its *own* floors.
+
+    The floors are what a correct model's replay leaves; ``build_residual_model`` measures them
+    with the declared (nominal) model. When the explanation is a plant with slower dynamics (a
+    spool at 35 rad/s, say), its replay amplifies the error of the injected noise estimate more, so
+    its own null bootstrap (``cfg``: the explanation's replay configuration) leaves more; each
+    sample is then judged against the larger of the two floors.
+    """
+    _, own = null_replay_floors(cfg, setup, model.sensor_noise)
+    m = model.index.size
+    out = {}
+    for i, s in enumerate(model.signals):
+        base = model.scale(s)
+        scale = np.maximum(base, own[s][model.index]) if s in own else base
+        r = vec[i * m:(i + 1) * m] * base / scale
+        out[s] = float(np.sqrt(np.mean(r * r))) if m else 0.0
+    return out
+
+
 def build_residual_model(cfg: PlantConfig, setup: ReplaySetup, *, stride: int = 5, nominal: dict | None = None) -> ResidualModel:
     """Estimate the noise floors and choose the samples of the fit.
 

@@ -255,3 +255,25 @@ def test_friction_level_and_pressure_dependent_friction_at_one_supply_are_ambigu
     data = d.to_dict()
     assert data["ambiguity"]["explanations"] == d.ambiguous
     assert "Suggested test" in d.explanation
+
+
+def test_a_slow_spool_is_judged_against_its_own_null_floors(cfg):
+    """The floors come from the declared plant's null bootstrap. A plant with a 34 rad/s spool (the
+    generated case that, fitted within 1 %, left its position 2.3 x the declared floor) amplifies the
+    error of the injected noise estimate more: its own null bootstrap leaves more position error, so
+    judged against the larger floor its leftovers fall, and never rise."""
+    from compliance.diagnosis.candidates import apply
+    from compliance.diagnosis.residuals import own_floor_objective
+
+    spool = {"valve_dynamics": {"natural_frequency": 34.4, "damping": 0.79, "delay": 0.0093}}
+    truth_cfg = cfg.replace(effects=spool)
+    frame, meta = synthesise(truth_cfg, "practice", x0=0.0488, load=1551.0, kd=20.0, noise=PRACTICE_NOISE, seed=2)
+    st = _prepare(cfg, frame, meta, 5, 1)
+    params = effect_params("valve_dynamics")
+    truth = [34.4, 0.79, 0.0093]
+    vec, _ = FitContext(st.rc, st.setup, st.model).residual(params, truth)
+    m = st.model.index.size
+    declared = {s: math.sqrt(float(r @ r) / m) for s, r in st.model.split(vec).items()}
+    own = own_floor_objective(st.model, apply(st.rc, params, truth), st.setup, vec)
+    assert all(own[s] <= declared[s] + 1e-12 for s in declared)
+    assert own["position"] < 0.9 * declared["position"]
