@@ -54,3 +54,22 @@ def test_a_moving_mass_three_times_the_data_sheet_is_found_beyond_the_flat_stret
     # resolve ~1 % of the value (0.2 % of the 1.8-decade log range)
     assert fitted.get("cylinder.moving_mass") == pytest.approx(truth, rel=0.05)
     assert res.chi2 < 0.25 * nominal
+
+
+def test_a_miscalibration_called_ambiguous_with_the_truth_named_is_counted_apart_from_misses():
+    """Friction level vs pressure-dependent friction at one supply pressure: not a hit, not a plain miss."""
+    from types import SimpleNamespace
+
+    from compliance.diagnosis.benchmark import format_summary, score_case, summarise
+    from compliance.diagnosis.concealed import Case
+
+    case = Case("miscalibration", "friction.level", {"friction.level": 1.5, "factor": 1.5}, None, {}, {"seed": 41})
+    diag = SimpleNamespace(verdict="ambiguous", winner="base", fits={}, ambiguous=["base", "pressure_dependent_friction"],
+                           seconds=1.0, simulations=1, runner_up="pressure_dependent_friction")
+    r = score_case(case, diag)
+    assert r.predicted == "ambiguous" and not r.correct and r.ambiguous_with_truth
+    diag.ambiguous = ["pressure_dependent_friction", "valve_offset"]  # the truth is not among those named
+    assert not score_case(case, diag).ambiguous_with_truth
+    s = summarise([r], [])
+    assert s["miscalibration_accuracy"] == 0.0 and s["ambiguous_with_truth"] == 1
+    assert "ambiguous with the truth" in format_summary({"summary": s, "seconds": 1.0})
