@@ -3,8 +3,9 @@
 - A null case: the nominal model's own recording, whose stick-slip replay leaves a burst that lifts
   its RMS against the constant floor above ``NOISE_TOLERANCE``; on the time-resolved floors (the
   fits' objective) it is within the noise, so the verdict is ``no_mismatch``.
-- A moving mass three times the data sheet at K_D = 20: chi-square is flat from 0.5 to 2 x the
-  nominal and drops only in a narrow valley around the truth, so the recalibration's scan must reach it.
+- A moving mass three times the data sheet at K_D = 20: chi-square does not fall from the nominal
+  towards the truth up to 2 x and drops only in a narrow valley around it, so the recalibration's scan
+  must reach it.
 """
 
 from __future__ import annotations
