@@ -107,7 +107,7 @@ def run(args) -> int:
 
     with progress_bar(None, "diagnose-benchmark", quiet=args.quiet, unit="case") as bar:
         def progress(r):
-            mark = "OK " if r.correct else "BAD"
+            mark = "OK " if r.correct else ("AMB" if r.ambiguous_with_truth else "BAD")
             err = "" if r.main_error is None else f" main-parameter error {100*r.main_error:.1f} %"
             if not args.quiet:
                 print(f"{mark} {r.kind:14s} {r.truth:28s} -> {r.predicted:28s} {r.seconds:5.1f} s{err}", flush=True)

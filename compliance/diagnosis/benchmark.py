@@ -25,6 +25,7 @@ from compliance.model.config import PlantConfig
 from compliance.effects import EFFECTS
 from compliance.diagnosis.candidates import FRICTION_LEVEL
 from compliance.diagnosis.concealed import MISCALIBRATIONS, Case, effect_case, miscalibration_case, null_case
+from compliance.diagnosis.practice_score import practice_correct
 
 
 @dataclass
@@ -50,6 +51,7 @@ class CaseResult:
     visibility: dict = field(default_factory=dict)
     runner_up: str | None = None
     visible: bool = True
+    ambiguous_with_truth: bool = False  # called ambiguous with the truth among the explanations named (not a hit)
 
 
 def predicted_label(diag) -> str:
@@ -122,6 +124,7 @@ def score_case(case: Case, diag) -> CaseResult:
         keys = {fp.key for fp in fit.params} if fit is not None else set()
         correct = diag.verdict == "parameters_only" and (case.truth in keys or (case.truth == FRICTION_LEVEL and FRICTION_LEVEL in keys))
     fitted, err = _main_error(case, diag)
+    _, amb = practice_correct(diag, [case.truth] if case.kind != "null" else [])
     red, sig, red_obj = _reduction(case, diag) if correct and case.kind != "null" else (None, None, None)
     return CaseResult(
         kind=case.kind, truth=case.truth, predicted=label, verdict=diag.verdict, correct=bool(correct),
@@ -130,7 +133,7 @@ def score_case(case: Case, diag) -> CaseResult:
         main_error=err, reduction=red, reduction_signal=sig, reduction_objective=red_obj,
         effective_error=effective_error(case.truth, case.params, fitted) if correct and case.kind == "effect" else None,
         seconds=diag.seconds, simulations=diag.simulations,
-        visibility=dict(case.visibility), runner_up=diag.runner_up, visible=case.visible,
+        visibility=dict(case.visibility), runner_up=diag.runner_up, visible=case.visible, ambiguous_with_truth=bool(amb),
     )
 
 
@@ -287,6 +290,7 @@ def summarise(results: list[CaseResult], effects) -> dict:
         "median_seconds": float(np.median([r.seconds for r in results])) if results else None,
         "max_seconds": float(max((r.seconds for r in results), default=0.0)),
         "n_cases": len(results),
+        "ambiguous_with_truth": sum(r.ambiguous_with_truth for r in eff + mis),
         "not_visible": [{"kind": r.kind, "truth": r.truth, "seed": r.seed, "predicted": r.predicted} for r in hidden],
     }
 
@@ -311,6 +315,8 @@ def format_summary(report: dict) -> str:
     lines.append(f"top-1 accuracy (effect cases):      {pct(s['top1_accuracy'])}")
     lines.append(f"null cases called no_mismatch:      {pct(s['null_accuracy'])}")
     lines.append(f"miscalibrations called parameters:  {pct(s['miscalibration_accuracy'])}")
+    if s.get("ambiguous_with_truth"):
+        lines.append(f"not hits, called ambiguous with the truth among the explanations named: {s['ambiguous_with_truth']}")
     mr = s["median_reduction"]
     mo = s.get("median_reduction_objective")
     lines.append(f"median residual after/before:       {'n/a' if mr is None else f'{mr:.3f}'} full closed-loop replay "

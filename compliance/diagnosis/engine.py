@@ -180,7 +180,9 @@ def _decide(st: _Stage) -> dict:
     n = st.model.size
     scores = score_all(st.fits, n)
     effect_like = [k for k in st.fits if k not in ("nominal", "base")]
-    verdict_name, winner, reason = verdict(scores, n, st.nominal_rms, effect_like)
+    # "within the floor" on the objective every other verdict is judged on (time-resolved floors,
+    # select.NOISE_TOLERANCE), not on the constant floor the JSON reports
+    verdict_name, winner, reason = verdict(scores, n, _objective(st, "nominal"), effect_like)
     search = []
     if winner is not None and winner != "base" and verdict_name != "no_mismatch":
         search = _search_sets(st, winner)

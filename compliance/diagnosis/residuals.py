@@ -218,8 +218,8 @@ def build_residual_model(cfg: PlantConfig, setup: ReplaySetup, *, stride: int = 
     """Estimate the noise floors and choose the samples of the fit.
 
     Each floor is the larger of the signal's sensor noise and what a correct model's replay
-    leaves (``null_replay_floors``): one constant per signal (reported, and the yardstick of
-    ``no_mismatch``) and one along the test (the weights of the fit).
+    leaves (``null_replay_floors``): one constant per signal (reported) and one along the test (the
+    weights of the fit, and the yardstick of ``no_mismatch``: ``select.NOISE_TOLERANCE``).
 
     Parameters
     ----------
