@@ -285,7 +285,10 @@ def run_replay(cfg: PlantConfig, setup: ReplaySetup, *, noise: np.ndarray | None
         if k1 <= k0:
             continue
         if i == 0:
-            y0 = initial_state(cfg, P, setup.initial_position, setup.initial_pressures)  # held at rest
+            # held at rest where the recording starts: a settled servo sits off its set-point by its
+            # steady error (a generated case: 10 um), which the piston, stuck, keeps until it moves
+            x0 = float(setup.states["position"][0]) if "position" in setup.states else setup.initial_position
+            y0 = initial_state(cfg, P, min(max(x0, 0.0), P[P_STROKE]), setup.initial_pressures)
             ref = setup.reference[k0:k1 + 1]
         else:
             y0 = _reset_state(cfg, P, setup, k0, out, lx, ly)
