@@ -26,6 +26,7 @@ BIC). A complete verdict pays nothing.
 
 from __future__ import annotations
 
+import math
 from types import SimpleNamespace
 
 from compliance.model.config import plant_to_toml
@@ -115,20 +116,21 @@ def form_after_effects(check: dict, rc, setup, model, fits: dict, jobs: int) -> 
         "screened": {effect: chi2 replayed with the other form}, "refitted": {effect: chi2}, "best",
         "share_of_excess", "delta_bic"}``.
     """
-    other = next(f for f in check["tried"]) if check["tried"] else None
+    other = next(iter(check["tried"]), None)  # the other form, when its nominal replay ran
     out = {**check, "after": None}
     if other is None:
         return out
     screened, replays = {}, 0
     for name, f in fits.items():
-        if name in EFFECTS and f.chi2 < float("inf"):
+        if name in EFFECTS and math.isfinite(f.chi2):
             tried = friction_form_check(apply(rc, f.params, f.values), setup, model, f)["tried"]
             replays += 1
             if other in tried and tried[other] < f.chi2:  # the other form helps with this effect on
                 screened[name] = tried[other]
     order = sorted(screened, key=screened.get)[:FORM_REFITS]
     payload = (plant_to_toml(rc.replace(options={OPTION: other})), setup, model)
-    refits = {f"{r.name}@{other}": r for r, _ in map_tasks([("effect", effect_candidate(e)) for e in order], jobs, payload)}
+    tasks = [("effect", effect_candidate(e)) for e in order]
+    refits = {f"{r.name}@{other}": r for r, _ in map_tasks(tasks, jobs, payload)} if tasks else {}
     replays += sum(r.sims + 1 for r in refits.values())
     out["replays"] = check["replays"] + replays
     scores = score_all({**fits, **refits}, model.size)
@@ -137,7 +139,7 @@ def form_after_effects(check: dict, rc, setup, model, fits: dict, jobs: int) -> 
              "refitted": {k.split("@")[0]: float(r.chi2) for k, r in refits.items()}, "best": None,
              "share_of_excess": 0.0, "delta_bic": 0.0}
     if refits:
-        best = min(refits, key=lambda k: refits[k].chi2)
+        best = min(refits, key=lambda k: scores[k].bic)
         excess = max(fits[ref].chi2 - model.size, 1e-12)
         after.update(best=best.split("@")[0], share_of_excess=float((fits[ref].chi2 - refits[best].chi2) / excess),
                      delta_bic=float(scores[ref].bic - scores[best].bic))
