@@ -5,7 +5,7 @@ difference from the fitted model (finer integration step, another friction form,
 column, an operating point anywhere on the stroke; ``compliance.diagnosis.pairs``). Target:
 both effects named in >= 80 % of the cases.
 
-Run: .venv/bin/python benchmarks/diagnose_pairs.py [--cases 6] [--seed 1] [--jobs 2] [--json out.json]
+Run: .venv/bin/python benchmarks/diagnose_pairs.py [--cases 6] [--seed 1] [--jobs 2] [--only 9,21] [--json out.json]
 Not part of the timed test suite (each case is a full diagnosis, 20-100 s on 2 shared cores).
 """
 
@@ -25,12 +25,14 @@ def main() -> int:
     ap.add_argument("--cases", type=int, default=6)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--only", help="comma-separated case numbers to run alone (e.g. 9,21), each as in the full run")
     ap.add_argument("--json", dest="json_out")
     args = ap.parse_args()
     from compliance.model.config import load_plant
     from compliance.diagnosis.pairs import run_pairs
 
-    out = run_pairs(load_plant("plant-a"), cases=args.cases, seed=args.seed, jobs=args.jobs)
+    out = run_pairs(load_plant("plant-a"), cases=args.cases, seed=args.seed, jobs=args.jobs,
+                    only=[int(i) for i in args.only.split(",")] if args.only else None)
     print(f"\nboth effects named: {out['both_named']}/{out['cases']} ({100*out['rate']:.0f} %; target >= 80 %) "
           f"in {out['seconds']:.0f} s, CPU {out['cpu_seconds']:.0f} s ({out['cpu_seconds']/max(out['cases'], 1):.0f} s per case)")
     other = out["cases"] - out["identifiable"]

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field, replace as dc_replace
 
 import numpy as np
 
-from compliance.model.config import PlantConfig, plant_to_toml
+from compliance.model.config import PlantConfig, plant_to_toml, _suggest as _suggest_name
 from compliance.effects import EFFECTS
 from compliance.errors import InputError, SimulationError
 from compliance.diagnosis.candidates import Candidate, apply, base_params, effect_candidate, signature_order
@@ -33,7 +33,7 @@ from compliance.diagnosis.multi import CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_e
 from compliance.diagnosis.discriminate import design_test
 from compliance.diagnosis.empirical import empirical_term
 from compliance.diagnosis.split import adopted_fit, split_scan
-from compliance.diagnosis.friction_form import OPTION as FORM_OPTION, friction_form_check
+from compliance.diagnosis.friction_form import OPTION as FORM_OPTION, RETRY_VERDICTS, form_after_effects, friction_form_check
 from compliance.diagnosis.replay_fit import ReplaySetup, prepare_replay, replay_config, run_replay
 from compliance.diagnosis.residuals import (UNITS, build_residual_model, null_recording, own_floor_objective, signal_fit,
                                             with_fail_level)
@@ -71,14 +71,12 @@ def _check_effects(cfg: PlantConfig, effects) -> list[str]:
     names = [e for e in EFFECTS if e not in cfg.effects] if effects is None else list(effects)
     for e in names:
         if e not in EFFECTS:
-            from compliance.model.config import _suggest
-
-            raise InputError(f"--effects: '{e}' is not a declared effect{_suggest(e, EFFECTS)} (known: {', '.join(EFFECTS)})")
+            raise InputError(f"--effects: '{e}' is not a declared effect{_suggest_name(e, EFFECTS)} (known: {', '.join(EFFECTS)})")
     return names
 
 
-def _prepare(cfg: PlantConfig, frame, meta: dict, stride: int, jobs: int) -> _Stage:
-    """Stages 1-2: the nominal replay, floors, located windows."""
+def _prepare(cfg: PlantConfig, frame, meta: dict, stride: int, jobs: int, sims: int = 0) -> _Stage:
+    """Stages 1-2: the nominal replay, floors, located windows (``sims``: replays already run for this diagnosis)."""
     setup = prepare_replay(cfg, frame, meta)
     rc = replay_config(cfg, setup)
     nominal_sim = run_replay(rc, setup)
@@ -88,21 +86,31 @@ def _prepare(cfg: PlantConfig, frame, meta: dict, stride: int, jobs: int) -> _St
     nominal_rms = {s: v["rms_normalised"] for s, v in signal_fit(model, nominal_sim).items()}
     nvec = model.vector(nominal_sim)
     st = _Stage(setup, rc, nominal_sim, model, events, event_mask, nominal_rms, nvec, (plant_to_toml(rc), setup, model), jobs)
+    st.sims += sims
     chi2, parts = chi2_parts(model, nvec)
     st.fits["nominal"] = FitResult("nominal", (), [], [], chi2, parts, model.size, 0, 0.0, "nominal model")
     return st
 
 
-def _prepare_base(cfg: PlantConfig, frame, meta: dict, stride: int, jobs: int):
-    """Stages 1-2 with the friction law's other form tried as the base (friction_form.py)."""
+def _based_search(cfg: PlantConfig, frame, meta: dict, stride: int, jobs: int, names, recalibrate: bool):
+    """Stages 1-5 on the friction law's form that fits (friction_form.py): the other form is the base from the start
+    when it beats the nominal, or after an incomplete verdict when effects refitted under it beat the declared form."""
     st = _prepare(cfg, frame, meta, stride, jobs)
     form = friction_form_check(st.rc, st.setup, st.model, st.fits["nominal"])
     if form and form["adopted"]:  # the other friction law is the base of the whole search
         cfg = cfg.replace(options={FORM_OPTION: form["adopted"]})
-        st = _prepare(cfg, frame, meta, stride, jobs)
-        st.sims += 2
+        st = _prepare(cfg, frame, meta, stride, jobs, st.sims)
+    _fit_singles(st, names, recalibrate)
+    dec = _decide(st)
+    if form and not form["adopted"] and dec["verdict"] in RETRY_VERDICTS:
+        form = form_after_effects(form, st.rc, st.setup, st.model, st.fits, jobs)
+        if form["adopted"]:  # ... and the whole search runs again on it
+            cfg = cfg.replace(options={FORM_OPTION: form["adopted"]})
+            st = _prepare(cfg, frame, meta, stride, jobs, st.sims)
+            _fit_singles(st, names, recalibrate)
+            dec = _decide(st)
     st.sims += form["replays"] if form else 0
-    return cfg, st, form
+    return cfg, st, form, dec
 
 
 def _run(st: _Stage, tasks) -> None:
@@ -150,8 +158,7 @@ def _search_sets(st: _Stage, winner: str) -> list[dict]:
             break
         _run(st, tasks)
         c = max(1.0, min(f.chi2 / max(n - f.k, 1) for f in st.fits.values() if math.isfinite(f.chi2)))
-        tried = sorted((_extended(st, t[1], t[2]) for t in tasks),
-                       key=lambda f: f.chi2)
+        tried = sorted((_extended(st, t[1], t[2]) for t in tasks), key=lambda f: f.chi2)
         best = tried[0]
         times = np.tile(st.setup.time[st.model.index], len(st.model.signals))  # residuals are signal blocks
         vecs = (st.vecs[current.name], st.vecs[best.name], times) if current.name in st.vecs else None
@@ -286,9 +293,7 @@ def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | N
     t0 = time.perf_counter()
     jobs = default_jobs() if jobs is None else max(1, int(jobs))
     names = _check_effects(cfg, effects)
-    cfg, st, form = _prepare_base(cfg, frame, meta, stride, jobs)
-    _fit_singles(st, names, recalibrate)
-    dec = _decide(st)
+    cfg, st, form, dec = _based_search(cfg, frame, meta, stride, jobs, names, recalibrate)
     winner, verdict_name = dec["winner"], dec["verdict"]
     split = _split(st, winner, verdict_name, dec)
     agreement = {k: mask_agreement(st.model, st.nvec, st.vecs[k], st.event_mask) for k in st.fits if k in st.vecs}
@@ -321,12 +326,9 @@ def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | N
     diag.ambiguous, diag.signals_left, diag.search = dec["ambiguous"], dec["left"], dec["search"]
     diag.contributions = _contributions(st, winner)
     pair = dec["ambiguous"] or ([winner, runner] if suggest_test and winner and runner else [])
-    diag.suggested_test = _suggest(st, pair)
-    diag.empirical = _empirical(st, dec)
-    diag.split = split
+    diag.suggested_test, diag.empirical, diag.split = _suggest(st, pair), _empirical(st, dec), split
     diag.simulations += split["replays"] if split else 0
     from compliance.diagnosis.explain import explain
-
     diag.explanation = explain(diag)
     diag.seconds = time.perf_counter() - t0
     return diag

@@ -119,8 +119,9 @@ def _cpu() -> float:
     return t.user + t.system + t.children_user + t.children_system
 
 
-def run_pairs(cfg, *, cases: int = 6, seed: int = 1, jobs: int = 1, library=None, log=print) -> dict:
-    """Generate and diagnose ``cases`` two-effect cases (pairs and variants in turn).
+def run_pairs(cfg, *, cases: int = 6, seed: int = 1, jobs: int = 1, library=None, log=print, only=None) -> dict:
+    """Generate and diagnose ``cases`` two-effect cases (pairs and variants in turn); ``only``: just these case
+    numbers (each still the case it is in the full run: pair, variant and seed from its number).
 
     Returns the rows, the count of cases with both effects named (over all cases and over the
     identifiable ones, ``truth_share``), the non-identifiable cases given an honest incomplete
@@ -130,7 +131,7 @@ def run_pairs(cfg, *, cases: int = 6, seed: int = 1, jobs: int = 1, library=None
 
     t0 = time.perf_counter()
     rows = []
-    for i in range(cases):
+    for i in (range(cases) if only is None else only):
         case = pair_case(cfg, PAIRS[i % len(PAIRS)], seed + i, VARIANTS[i % len(VARIANTS)])
         c0 = _cpu()
         d = diagnose(cfg, case["frame"], case["meta"], effects=library, jobs=jobs)
@@ -138,7 +139,7 @@ def run_pairs(cfg, *, cases: int = 6, seed: int = 1, jobs: int = 1, library=None
         rows.append(score_pair(case, d, truth_share(cfg, case)))
         r = rows[-1]
         r["cpu_seconds"] = cpu
-        log(f"{'+'.join(r['pair']):45s} {r['variant']:13s} -> {r['verdict']:20s} {r['winner']} "
+        log(f"{i:2d} {'+'.join(r['pair']):45s} {r['variant']:13s} -> {r['verdict']:20s} {r['winner']} "
             f"(both named: {r['both_named']}; truth explains {100*r['truth_share']:.0f} %; {r['seconds']:.0f} s, CPU {cpu:.0f} s)")
     both = sum(r["both_named"] for r in rows)
     ident = [r for r in rows if r["identifiable"]]
