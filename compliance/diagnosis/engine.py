@@ -65,6 +65,7 @@ class _Stage:
     fits: dict = field(default_factory=dict)
     vecs: dict = field(default_factory=dict)
     sims: int = 2
+    rebased: bool = False  # the friction law's other form is the base (friction_form.py)
 
 
 def _check_effects(cfg: PlantConfig, effects) -> list[str]:
@@ -100,6 +101,7 @@ def _based_search(cfg: PlantConfig, frame, meta: dict, stride: int, jobs: int, n
     if form and form["adopted"]:  # the other friction law is the base of the whole search
         cfg = cfg.replace(options={FORM_OPTION: form["adopted"]})
         st = _prepare(cfg, frame, meta, stride, jobs, st.sims)
+        st.rebased = True
     _fit_singles(st, names, recalibrate)
     dec = _decide(st)
     if form and not form["adopted"] and dec["verdict"] in RETRY_VERDICTS:
@@ -107,6 +109,7 @@ def _based_search(cfg: PlantConfig, frame, meta: dict, stride: int, jobs: int, n
         if form["adopted"]:  # ... and the whole search runs again on it
             cfg = cfg.replace(options={FORM_OPTION: form["adopted"]})
             st = _prepare(cfg, frame, meta, stride, jobs, st.sims)
+            st.rebased = True
             _fit_singles(st, names, recalibrate)
             dec = _decide(st)
     st.sims += form["replays"] if form else 0
@@ -212,9 +215,12 @@ def _decide(st: _Stage) -> dict:
 
 
 def _own_floors(st: _Stage, winner: str | None, verdict_name: str) -> dict | None:
-    """What the winner leaves, x floor; a complete verdict's leftovers are judged against its own null floors too."""
+    """What the winner leaves, x floor; a complete verdict's leftovers are judged against its own null floors too,
+    unless the base is already another friction form (one relaxation of the yardstick at a time: on the pairs
+    benchmark, floors from a substitute friction law plus its winner's own passed wrong pairs as complete)."""
     after = _objective(st, winner) if winner else None
-    if verdict_name in ("missing_physics", "parameters_only") and signals_left(after) and winner in st.vecs:
+    if verdict_name in ("missing_physics", "parameters_only") and signals_left(after) and winner in st.vecs \
+            and not st.rebased:
         w = st.fits[winner]
         try:
             own = own_floor_objective(st.model, apply(st.rc, w.params, w.values), st.setup, st.vecs[winner])
