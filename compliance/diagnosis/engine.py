@@ -347,7 +347,7 @@ def _split(st: _Stage, winner: str | None, verdict_name: str, dec: dict) -> dict
     if lag is None or verdict_name == "unexplained":
         return None
     ctx = FitContext(st.rc, st.setup, st.model)
-    sp = split_scan(ctx, st.fits[winner], lag)
+    sp = split_scan(ctx, st.fits[winner], lag, st.vecs.get(winner))
     moved = adopted_fit(ctx, st.fits[winner], sp["estimate"]) if sp and sp["estimate"] else None
     if moved is not None:
         st.fits[winner], st.vecs[winner] = moved

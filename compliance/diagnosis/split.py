@@ -166,8 +166,9 @@ def _connected(points: list, fitted: float, ok) -> list[float]:
     return [values[lo], values[hi]]
 
 
-def split_scan(ctx, fit, effect: str) -> dict | None:
-    """Scan the lumped valley of ``effect`` in the fitted candidate ``fit`` (``fit.FitContext`` ``ctx``).
+def split_scan(ctx, fit, effect: str, vec: np.ndarray | None = None) -> dict | None:
+    """Scan the lumped valley of ``effect`` in the fitted candidate ``fit`` (``fit.FitContext`` ``ctx``);
+    ``vec``: the fit's own residual vector when the caller has it (else it is replayed once).
 
     Returns
     -------
@@ -194,8 +195,12 @@ def split_scan(ctx, fit, effect: str) -> dict | None:
     m = ctx.model.index.size
     segments = _segments(ctx)
     fit_worst = max(math.sqrt(c / m) for c in fit.chi2_signal.values())
-    own = _replay_point(ctx, fit, list(fit.values), segments)
-    points = [(vals[main], fit.chi2 / ctx.model.size, fit_worst, own[2] if own else math.inf, list(fit.values))]
+    if vec is not None:
+        own_trimmed = trimmed_chi2(vec, segments)
+    else:
+        own = _replay_point(ctx, fit, list(fit.values), segments)
+        own_trimmed = own[2] if own else math.inf
+    points = [(vals[main], fit.chi2 / ctx.model.size, fit_worst, own_trimmed, list(fit.values))]
     limit = AMBIGUOUS_RATIO * fit.chi2 / ctx.model.size
     for f in SPLIT_FACTORS:
         value = vals[main] * f
