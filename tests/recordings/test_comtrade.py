@@ -153,17 +153,14 @@ def test_binary_data_declared_ascii_is_refused(tmp_path, run):
         read_recording(path)
 
 
-def test_secondary_values_without_a_usable_ratio_are_refused(tmp_path, run):
+@pytest.mark.parametrize("fields,message", [
+    (",0,0,S", r"analog channel 4 'pressure_a': P/S = S .* ratio primary:secondary = 0:0"),  # S without a usable ratio
+    (",2.0,1.0,", r"'pressure_a': P/S flag '\(empty\)' is neither P nor S.*2:1.*cannot be told"),  # ambiguous
+])
+def test_primary_secondary_that_cannot_be_resolved_is_refused(tmp_path, run, fields, message):
     path = _write(tmp_path, run, "2013-secondary-ratio-2")
-    _edit_cfg(path, ",2.0,1.0,S", ",0,0,S")
-    with pytest.raises(InputError, match=r"analog channel 4 'pressure_a': P/S = S .* ratio primary:secondary = 0:0"):
-        read_recording(path)
-
-
-def test_a_missing_primary_secondary_flag_with_a_ratio_is_ambiguous(tmp_path, run):
-    path = _write(tmp_path, run, "2013-secondary-ratio-2")
-    _edit_cfg(path, ",2.0,1.0,S", ",2.0,1.0,")
-    with pytest.raises(InputError, match=r"'pressure_a': P/S flag '\(empty\)' is neither P nor S.*2:1.*cannot be told"):
+    _edit_cfg(path, ",2.0,1.0,S", fields)
+    with pytest.raises(InputError, match=message):
         read_recording(path)
 
 
