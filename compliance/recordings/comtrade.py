@@ -67,21 +67,26 @@ def primary_scale(channel, revision: str, where: str) -> float:
                      "set the flag to P or S")
 
 
-def _ascii_decimals(data: bytes, column: int) -> int:
-    """Most digits after the decimal point in one field of every ASCII sample line."""
-    fields = (line.split(b",")[column] for line in data.splitlines())
-    return max((len(f.strip().partition(b".")[2]) for f in fields), default=0)
+def _ascii_decimals(data: bytes) -> list[int]:
+    """Most digits after the decimal point in each field of the ASCII sample lines (0 for integer data)."""
+    lines = data.splitlines()
+    width = lines[0].count(b",") + 1 if lines else 0
+    if b"." not in data:
+        return [0] * width  # the usual case: integer samples, as the 1999 edition writes them
+    most = [0] * width
+    for line in lines:
+        for k, f in enumerate(line.split(b",")):
+            most[k] = max(most[k], len(f.strip().partition(b".")[2]))
+    return most
 
 
-def _raw_resolution(layout: DataLayout, channel, raw: np.ndarray, data: bytes, index: int) -> float:
+def _raw_resolution(layout: DataLayout, channel, raw: np.ndarray, decimals: int) -> float:
     """Smallest step of a channel's ``a*x+b`` values the file can hold [channel unit]."""
     a = abs(float(channel.a))
     if layout.file_type == "FLOAT32":
         finite = np.abs(raw[np.isfinite(raw)])
         return a * float(np.spacing(np.float32(finite.max() if finite.size else 1.0)))
-    if layout.file_type == "ASCII":
-        return a * 10.0 ** -_ascii_decimals(data, 2 + index)
-    return a
+    return a * 10.0 ** -decimals
 
 
 def _parse(parts, data: bytes, layout: DataLayout):
@@ -136,6 +141,7 @@ def read_comtrade(path: Path, cmap: ColumnMap | None) -> RecordingSource:
     scales = [primary_scale(ch, revision, f"{parts.cfg_where}: analog channel {ch.n} '{name}'")
               for ch, name in zip(cfg.analog_channels, ids)]
     units = [str(ch.uu).strip() or None for ch in cfg.analog_channels]
+    decimals = _ascii_decimals(data)[2:] if layout.file_type == "ASCII" else [0] * len(ids)
 
     def position(spec: ColumnSpec) -> int:
         return column_position(spec, ids, parts.cfg_where, "analog channel", f"there are {len(ids)}", "channels")
@@ -148,7 +154,7 @@ def read_comtrade(path: Path, cmap: ColumnMap | None) -> RecordingSource:
         j = position(spec)
         ch = cfg.analog_channels[j]
         values = (raw[j] - float(ch.b)) / float(ch.a) if float(ch.a) else raw[j]
-        return {"resolution": _raw_resolution(layout, ch, values, data, j) * scales[j], "skew": float(ch.skew) * 1e-6}
+        return {"resolution": _raw_resolution(layout, ch, values, decimals[j]) * scales[j], "skew": float(ch.skew) * 1e-6}
 
     return RecordingSource(ids, get, lambda i: f"sample {i + 1}", time=time, extra=_recording_facts(rec, parts, layout),
                            facts=facts)

@@ -30,8 +30,9 @@ from compliance.recordings.column_map import CANONICAL_UNITS
 
 __all__ = ["FILE_TYPES", "comtrade_bytes"]
 
-# raw integer range per data type (the most negative value marks a missing sample, C37.111-2013 clause 8)
+# raw integer range per data type, and the value that marks a missing sample (C37.111-1999/2013)
 _INT_RANGE = {"ASCII": 99998, "BINARY": 32767, "BINARY32": 2147483647}
+_MISSING = {"ASCII": 99999, "BINARY": -32768, "BINARY32": -2147483648}
 _DTYPE = {"BINARY": "<i2", "BINARY32": "<i4", "FLOAT32": "<f4"}
 FILE_TYPES = {"1999": ("ASCII", "BINARY"), "2013": ("ASCII", "BINARY", "BINARY32", "FLOAT32")}
 _MAX_STAMP = 4294967294  # 0xFFFFFFFF marks a missing time stamp
@@ -42,7 +43,8 @@ def _scaling(values: np.ndarray, file_type: str) -> tuple[float, float]:
     """a, b with a*raw + b = value over the channel's range (a = 1, b = 0 for FLOAT32)."""
     if file_type == "FLOAT32":
         return 1.0, 0.0
-    lo, hi = float(np.min(values)), float(np.max(values))
+    finite = values[np.isfinite(values)]
+    lo, hi = (float(np.min(finite)), float(np.max(finite))) if finite.size else (0.0, 0.0)
     mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
     top = _INT_RANGE[file_type]
     if not half > 0:
@@ -64,6 +66,21 @@ def _time_plan(time: np.ndarray) -> tuple[list[str], np.ndarray, float]:
     return rates, stamps, mult
 
 
+def _field(text: str) -> str:
+    """A free-text .cfg field: no comma (the separator) and no line break."""
+    return " ".join(str(text).replace(",", " ").split())
+
+
+def _raw(values: np.ndarray, a: float, b: float, file_type: str) -> np.ndarray:
+    """The stored samples of one channel: a*raw + b = value, NaN as the standard's missing value."""
+    if file_type == "FLOAT32":
+        return values
+    top = _INT_RANGE[file_type]
+    raw = np.clip(np.rint((values - b) / a), -top, top)
+    raw[~np.isfinite(values)] = _MISSING[file_type]
+    return raw
+
+
 def _stamp(t: _dt.datetime) -> str:
     return t.strftime("%d/%m/%Y,%H:%M:%S.%f")
 
@@ -74,6 +91,8 @@ def _channels(frame: pd.DataFrame, ratios: dict) -> list[tuple[str, np.ndarray, 
     for name in frame.columns:
         if name == "time" or frame[name].dtype.kind not in "fiub":
             continue
+        if "," in str(name) or not str(name).strip():
+            raise InputError(f"column {name!r}: a COMTRADE channel id must be non-empty and hold no comma")
         values = frame[name].to_numpy(dtype=np.float64)
         ratio = ratios.get(name)
         k = float(ratio[0]) / float(ratio[1]) if ratio else 0.0
@@ -120,13 +139,12 @@ def comtrade_bytes(frame: pd.DataFrame, *, station: str, device: str = "govcheck
     chans = _channels(frame, ratios or {})
     rates, stamps, mult = _time_plan(time)
     scales = [_scaling(v, file_type) for _, v, _, _ in chans]
-    top = _INT_RANGE.get(file_type, 0)
-    raws = [v if file_type == "FLOAT32" else np.clip(np.rint((v - b) / a), -top, top)
-            for (_, v, _, _), (a, b) in zip(chans, scales)]
+    raws = [_raw(v, a, b, file_type) for (_, v, _, _), (a, b) in zip(chans, scales)]
     start = start or _dt.datetime(1970, 1, 1)
-    lines = [f"{station},{device},{revision}", f"{len(chans)},{len(chans)}A,0D"]
+    lines = [f"{_field(station)},{_field(device)},{revision}", f"{len(chans)},{len(chans)}A,0D"]
     for i, ((name, _, unit, k), (a, b), raw) in enumerate(zip(chans, scales, raws), 1):
-        lo, hi = (float(np.min(raw)), float(np.max(raw))) if raw.size else (0.0, 0.0)
+        kept = raw[np.isfinite(raw) & (raw != _MISSING.get(file_type))]
+        lo, hi = (float(np.min(kept)), float(np.max(kept))) if kept.size else (0.0, 0.0)
         ratio = f"{k!r},1.0,S" if k else "1.0,1.0,P"
         lo_hi = f"{lo:.9g},{hi:.9g}" if file_type == "FLOAT32" else f"{int(lo)},{int(hi)}"
         lines.append(f"{i},{name},,,{unit},{a!r},{b!r},0,{lo_hi},{ratio}")

@@ -129,6 +129,35 @@ def test_a_factor_is_the_resolution_and_a_sidecar_resolution_can_only_coarsen_it
     assert meta["channels"]["pressure_a"]["resolution"] > 1e-9  # the file is coarser than the sidecar claims
 
 
+def test_ascii_numbers_with_decimals_resolve_their_last_decimal_on_the_primary_side(tmp_path):
+    """A 2013 ASCII file written with decimals: resolution = a x the last decimal place x primary/secondary."""
+    cfg = ["bench,rig1,2013", "2,2A,0D", "1,position,,,mm,1,0,0,-99999,99999,1,1,P",
+           "2,pressure_a,,,bar,0.5,0,0,-99999,99999,10,1,S",
+           "0", "1", "1000,3", "01/01/2024,00:00:00.000000", "01/01/2024,00:00:00.250000", "ASCII", "1", "0,0", "F,0"]
+    (tmp_path / "r.cfg").write_text("\r\n".join(cfg) + "\r\n", encoding="ascii")
+    (tmp_path / "r.dat").write_text("1,0,12.125,1.5\r\n2,1000,12.25,1.25\r\n3,2000,12.5,1.0\r\n", encoding="ascii")
+    cmap = {"columns": {"position": {"column": "position"}, "pressure_a": {"column": "pressure_a", "kind": "abs"}}}
+    frame, meta = read_recording(tmp_path / "r.cfg", cmap, required=("position", "pressure_a"))
+    np.testing.assert_allclose(frame["position"], [0.012125, 0.01225, 0.0125], rtol=1e-12)
+    np.testing.assert_allclose(frame["pressure_a"], [7.5e5, 6.25e5, 5e5], rtol=1e-12)  # 0.5 x raw bar x 10 / 1
+    assert meta["channels"]["position"]["resolution"] == pytest.approx(1e-6)  # 1 x 0.001 mm
+    assert meta["channels"]["pressure_a"]["resolution"] == pytest.approx(0.5 * 0.01 * 10 * 1e5)  # a x 0.01 bar x 10
+    assert meta["trigger_time"] == pytest.approx(0.25)
+
+
+@pytest.mark.parametrize("revision,file_type", [("1999", "ASCII"), ("2013", "BINARY32"), ("2013", "BINARY")])
+def test_a_missing_sample_is_written_as_the_standards_missing_value_and_refused_on_reading(tmp_path, run, revision,
+                                                                                           file_type):
+    _, _, df = run
+    frame = df.copy()
+    frame.loc[2, "position"] = np.nan
+    for suffix, data in comtrade_bytes(frame, station="s", revision=revision, file_type=file_type).items():
+        (tmp_path / f"r{suffix}").write_bytes(data)
+    assert np.isnan(np.asarray(_package_read(tmp_path / "r.cfg", use_double_precision=True).analog[0])[2])
+    with pytest.raises(InputError, match=r"column 'position' has NaN/empty/infinite values at sample 3"):
+        read_recording(tmp_path / "r.cfg")
+
+
 # ----------------------------------------------------------------------------- bad files
 def _edit_cfg(path: Path, old: str, new: str) -> None:
     text = path.read_bytes().decode("ascii")
