@@ -100,16 +100,15 @@ def _parse(parts, data: bytes, layout: DataLayout):
     return rec
 
 
-def _layout(parts) -> tuple[DataLayout, object]:
+def _layout(parts) -> DataLayout:
     import comtrade
 
     cfg = comtrade.Cfg(ignore_warnings=True)
     try:
         cfg.read(parts.cfg_text)
-        layout = DataLayout(str(cfg.ft).strip().upper(), int(cfg.sample_rates[-1][1]), cfg.analog_count, cfg.status_count)
+        return DataLayout(str(cfg.ft).strip().upper(), int(cfg.sample_rates[-1][1]), cfg.analog_count, cfg.status_count)
     except Exception as exc:  # the comtrade package raises bare Exceptions on bad files
         raise InputError(f"{parts.cfg_where}: not a readable COMTRADE configuration ({exc.__class__.__name__}: {exc})") from None
-    return layout, cfg
 
 
 def read_comtrade(path: Path, cmap: ColumnMap | None) -> RecordingSource:
@@ -130,7 +129,7 @@ def read_comtrade(path: Path, cmap: ColumnMap | None) -> RecordingSource:
         primary/secondary flag, an unknown channel.
     """
     parts = load_parts(path)
-    layout, _ = _layout(parts)
+    layout = _layout(parts)
     data = check_data(parts, layout)
     rec = _parse(parts, data, layout)
     cfg = rec.cfg
@@ -165,10 +164,12 @@ def _recording_facts(rec, parts, layout: DataLayout) -> dict:
     extra = {"station_name": str(rec.station_name).strip(), "recording_device": str(rec.rec_dev_id).strip(),
              "comtrade": {"revision": str(cfg.rev_year).strip(), "file_type": layout.file_type, "form": parts.form,
                           "time_from": "time stamps" if cfg.timestamp_critical else "sample rate"}}
-    if cfg.start_timestamp is not None:
-        extra["start_timestamp"] = cfg.start_timestamp.isoformat()
-    if cfg.trigger_timestamp is not None:
-        extra["trigger_timestamp"] = cfg.trigger_timestamp.isoformat()
-        if cfg.start_timestamp is not None:
-            extra["trigger_time"] = (cfg.trigger_timestamp - cfg.start_timestamp).total_seconds()
+    # the comtrade package gives an empty time stamp as year 1; such a stamp is left out, not reported as a date
+    start, trigger = (t if t is not None and t.year > 1 else None for t in (cfg.start_timestamp, cfg.trigger_timestamp))
+    if start is not None:
+        extra["start_timestamp"] = start.isoformat()
+    if trigger is not None:
+        extra["trigger_timestamp"] = trigger.isoformat()
+        if start is not None:
+            extra["trigger_time"] = (trigger - start).total_seconds()
     return extra
