@@ -158,6 +158,34 @@ def test_a_missing_sample_is_written_as_the_standards_missing_value_and_refused_
         read_recording(tmp_path / "r.cfg")
 
 
+THIRD_PARTY = Path(__file__).resolve().parents[1] / "data" / "comtrade"  # python-comtrade's samples (tests/data/README.md)
+
+
+@pytest.mark.parametrize("name", ["sample_float32.cff", "sample_ascii.cff", "sample_bin.cfg"])
+def test_files_written_by_other_tools_read_as_the_comtrade_package_reads_them(name):
+    """2013 FLOAT32 and ASCII .cff with status channels, 1999 16-bit BINARY: same samples, same time axis.
+
+    The ASCII one is a relay's secondary-side record (P/S = s, CT ratio 933:1): govcheck gives
+    the primary currents, 933 x what the package gives.
+    """
+    from compliance.recordings.comtrade import read_comtrade
+
+    src = read_comtrade(THIRD_PARTY / name, None)
+    rec = _package_read(THIRD_PARTY / name, use_double_precision=True)
+    np.testing.assert_array_equal(src.time, np.asarray(rec.time))
+    for k, ch in enumerate(rec.cfg.analog_channels):
+        spec = type("Spec", (), {"column": k, "name": ch.name})()
+        values, unit = src.get(spec)
+        ratio = ch.primary / ch.secondary if ch.pors.strip().upper() == "S" else 1.0
+        np.testing.assert_allclose(values, ratio * np.asarray(rec.analog[k]), rtol=1e-15)
+        assert unit == (ch.uu.strip() or None)
+        if rec.ft.upper() == "BINARY":
+            assert src.facts(spec)["resolution"] == pytest.approx(abs(ch.a))
+    if name == "sample_ascii.cff":
+        assert rec.cfg.analog_channels[0].pors.strip() == "s" and src.facts(spec)["resolution"] == pytest.approx(
+            0.1138916015625 * 933)  # a x the CT ratio: the integer samples' step in primary amperes
+
+
 # ----------------------------------------------------------------------------- bad files
 def _edit_cfg(path: Path, old: str, new: str) -> None:
     text = path.read_bytes().decode("ascii")
