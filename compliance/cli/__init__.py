@@ -34,8 +34,9 @@ _COMMANDS = (
 def build_parser() -> argparse.ArgumentParser:
     """Build the argument parser with every available sub-command."""
     from compliance import __version__
+    from compliance.cli.common import GovcheckParser
 
-    parser = argparse.ArgumentParser(
+    parser = GovcheckParser(
         prog="govcheck",
         description=(
             "Acceptance harness for pneumatic gate servo-positioners of hydro-turbine speed "

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 
 from compliance.errors import InputError
 from compliance.units import parse_quantity
@@ -25,6 +26,20 @@ _OUTPUT_HELP = {
     "pdf": "write the PDF report to FILE.pdf",
 }
 _METAVAR = {"json": "FILE.json", "junit": "FILE.xml", "report": "FILE.html", "pdf": "FILE.pdf"}
+
+
+class GovcheckParser(argparse.ArgumentParser):
+    """An argument parser that reads a word starting with a minus and a digit as a value, never an option.
+
+    argparse takes only plain negative numbers (``-5``, ``-0.5``) as values; ``--steps -5%@1s``,
+    ``--x0 -1mm`` or ``--load -1e3`` would be refused as unknown options. No govcheck option
+    starts with a digit, so every such word is a (negative) quantity. Sub-command parsers
+    inherit the class (``add_subparsers`` uses the parent's class).
+    """
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(r"^-\.?\d")  # argparse's hook for "a negative number"
 
 
 def wrap_description(text: str) -> str:

@@ -1,4 +1,4 @@
-"""``govcheck simulate``: one nonlinear simulation of a plant, written to CSV/Parquet with its sidecar."""
+"""``govcheck simulate``: one nonlinear simulation of a plant, written to CSV/Parquet/COMTRADE with its sidecar."""
 
 from __future__ import annotations
 
@@ -15,6 +15,7 @@ from compliance.simulation.profiles import Profile, parse_sine, steps
 MAX_DURATION = 3600.0  # [s] one simulation; longer is a typo (1e9 s would need TiB of memory)
 MAX_SAMPLES = 4_000_000  # output rows (~0.5 GB of columns)
 PLOT_SUFFIXES = (".png", ".svg", ".pdf")
+OUTPUT_SUFFIXES = (".csv", ".csv.gz", ".parquet", ".cfg", ".cff")
 SIDECAR_MARK = "# govcheck simulate sidecar"
 
 
@@ -34,6 +35,7 @@ def register(sub):
             "govcheck simulate models/plant-a.toml --x0 '136 mm' --load '11.4 kN' --steps '2%@1s,-2%@4s' --duration 7 -o run.csv",
             "govcheck simulate plant-a --x0 80mm --sine 8mm,0.05Hz --duration 40 -o sine.parquet --plot sine.png",
             "govcheck simulate plant-a --command '3V@0.5s,0V@2s' --duration 3 -o open.csv",
+            "govcheck simulate plant-a --x0 136mm --steps '-5%@1s' --duration 3 -o run.cfg",
         ],
     )
     add_plant_argument(p)
@@ -47,7 +49,9 @@ def register(sub):
     p.add_argument("--flow-control", choices=("on", "off"), help="install/remove the 2V2/2V3 flow-control valves (default: as configured)")
     p.add_argument("--noise", action="store_true", help="add seeded sensor noise (20 um position, 300 Pa pressures, 16-bit)")
     p.add_argument("--seed", type=int, default=0, help="noise seed, a whole number >= 0 (default 0)")
-    p.add_argument("-o", "--output", required=True, metavar="FILE.csv", help="output file: .csv, .csv.gz or .parquet (the sidecar FILE.toml goes beside it)")
+    p.add_argument("-o", "--output", required=True, metavar="FILE.csv",
+                   help="output file: .csv, .csv.gz, .parquet, or COMTRADE (IEEE C37.111-2013, BINARY32): .cfg (with "
+                        "FILE.dat beside it) or the single file .cff; the sidecar FILE.toml goes beside it")
     p.add_argument("--plot", metavar="FILE.png", help="also write a plot of position, command and pressures (.png, .svg or .pdf)")
     return p
 
@@ -127,7 +131,9 @@ def build_scenario(cfg, args):
 def _check_output(path: str) -> None:
     from compliance.files.outputs import check_output
 
-    check_output(path, "-o/--output", (".csv", ".csv.gz", ".parquet"))
+    check_output(path, "-o/--output", OUTPUT_SUFFIXES)
+    if path.lower().endswith(".cfg"):
+        check_output(Path(path).with_suffix(".dat"), "-o/--output (its COMTRADE .dat)")
 
 
 def sidecar_text(cfg, scenario, plant: str) -> str:
@@ -175,6 +181,26 @@ def _plant_reference(source: str, side: Path) -> str:
     if source in reference_plants() and not Path(source).exists():
         return source
     return os.path.relpath(Path(source).resolve(), side.resolve().parent)
+
+
+def _trigger_time(df) -> float:
+    """First change of the set-point (or, open loop, of the valve command) [s]; 0 when nothing changes."""
+    col = df["reference"] if df["reference"].nunique() > 1 else df["valve_command"]
+    moved = (col != col.iloc[0]).to_numpy()
+    return float(df["time"].iloc[int(moved.argmax())]) if moved.any() else 0.0
+
+
+def output_files(df, path: str, station: str, description: str) -> list[tuple[Path, bytes]]:
+    """(file, bytes) of a run, made in memory: one CSV / Parquet / .cff file, or a COMTRADE .dat then its .cfg."""
+    name = path.lower()
+    if name.endswith((".cfg", ".cff")):
+        from compliance.recordings.comtrade_write import comtrade_bytes
+
+        files = comtrade_bytes(df, station=station, single_file=name.endswith(".cff"), trigger_time=_trigger_time(df),
+                               header=description)
+        # the .dat first: a reader that finds the new .cfg finds its data
+        return [(Path(path).with_suffix(suffix), files[suffix]) for suffix in (".dat", ".cfg", ".cff") if suffix in files]
+    return [(Path(path), frame_bytes(df, path))]
 
 
 def frame_bytes(df, path: str) -> bytes:
@@ -237,13 +263,15 @@ def run(args) -> int:
     cfg = plant_from_args(args)
     scenario = build_scenario(cfg, args)
     df = simulate(cfg, scenario)
-    data = frame_bytes(df, args.output)
+    files = output_files(df, args.output, cfg.name, f"govcheck simulate of {cfg.name}, {scenario.duration:g} s")
     plot = plot_bytes(df, args.plot, f"{cfg.name}: simulated") if args.plot else None
-    write_bytes_atomic(args.output, data)
+    for target, data in files:
+        write_bytes_atomic(target, data)
     write_text_atomic(side, sidecar_text(cfg, scenario, _plant_reference(source, side)))
     if plot is not None:
         write_bytes_atomic(args.plot, plot)
     err = (df.reference - df.position_true).abs().iloc[-1]
-    print(f"simulated {scenario.duration:g} s of {cfg.name} -> {args.output} + {side} ({len(df)} samples); "
+    written = " + ".join(str(t) for t, _ in files)
+    print(f"simulated {scenario.duration:g} s of {cfg.name} -> {written} + {side} ({len(df)} samples); "
           f"final position {df.position_true.iloc[-1]*1e3:.2f} mm, final |error| {err*1e3:.3f} mm")
     return 0

@@ -19,7 +19,8 @@ from compliance.recordings.column_map import CANONICAL_UNITS, ColumnMap, ColumnS
 from compliance.errors import InputError
 from compliance.units import convert_array
 
-__all__ = ["CANONICAL_ORDER", "RecordingSource", "build_frame", "canonical_specs", "column_position", "numeric_column"]
+__all__ = ["CANONICAL_ORDER", "RecordingSource", "build_frame", "canonical_specs", "channel_facts", "column_position",
+           "numeric_column"]
 
 CANONICAL_ORDER = ("time", "position", "reference", "valve_command", "pressure_a", "pressure_b", "supply_pressure")
 
@@ -33,6 +34,8 @@ class RecordingSource:
     row: Callable[[int], str]  # 0-based sample index -> "line 57" / "sample 12"
     time: np.ndarray | None = None  # formats that carry their own time axis (COMTRADE) [s]
     extra: dict | None = None
+    # per-channel facts the file states (COMTRADE): {"resolution": in the file's unit, "skew": s}
+    facts: Callable[[ColumnSpec], dict] | None = None
 
 
 def column_position(spec: ColumnSpec, names: list[str], where: str, noun: str, too_few: str, listing: str) -> int:
@@ -107,6 +110,21 @@ def canonical_specs(path, src: RecordingSource, cmap: ColumnMap | None) -> list[
     return specs
 
 
+def _to_si(path, src: RecordingSource, spec: ColumnSpec, cmap: ColumnMap | None, raw: np.ndarray, file_unit):
+    """One raw column in SI (the map's gain and offset, then its unit or the file's); and the unit used."""
+    values = spec.gain * raw + spec.offset if (spec.gain != 1.0 or spec.offset != 0.0) else raw
+    unit = spec.unit or file_unit
+    where = f"{path}: column '{spec.column}' -> '{spec.name}'"
+    if cmap is None and src.time is None:
+        unit = None  # canonical files are SI by definition
+    if unit is not None or spec.kind == "gauge":
+        if not spec.si_unit:
+            values = convert_array(values, unit or "dimensionless", "dimensionless", where)
+        else:
+            values = convert_array(values, unit or spec.si_unit, spec.si_unit, where, pressure_kind=spec.kind)
+    return np.asarray(values, dtype=float), unit
+
+
 def build_frame(path, src: RecordingSource, specs: list[ColumnSpec], cmap: ColumnMap | None):
     """Canonical DataFrame (SI) and a description of where each column came from.
 
@@ -122,19 +140,10 @@ def build_frame(path, src: RecordingSource, specs: list[ColumnSpec], cmap: Colum
         described["time"] = "file time axis [s]"
     for spec in specs:
         raw, file_unit = src.get(spec)
-        values = spec.gain * raw + spec.offset if (spec.gain != 1.0 or spec.offset != 0.0) else raw
-        unit = spec.unit or file_unit
-        where = f"{path}: column '{spec.column}' -> '{spec.name}'"
-        if cmap is None and src.time is None:
-            unit = None  # canonical files are SI by definition
-        if unit is not None or spec.kind == "gauge":
-            if not spec.si_unit:
-                values = convert_array(values, unit or "dimensionless", "dimensionless", where)
-            else:
-                values = convert_array(values, unit or spec.si_unit, spec.si_unit, where, pressure_kind=spec.kind)
+        values, unit = _to_si(path, src, spec, cmap, raw, file_unit)
         if spec.name in data:
             raise InputError(f"{path}: two columns map to '{spec.name}'")
-        data[spec.name] = np.asarray(values, dtype=float)
+        data[spec.name] = values
         kind = f" {spec.kind}" if spec.kind else ""
         described[spec.name] = f"{spec.column} [{unit or spec.si_unit or '-'}{kind}]"
     lengths = {k: len(v) for k, v in data.items()}
@@ -142,3 +151,21 @@ def build_frame(path, src: RecordingSource, specs: list[ColumnSpec], cmap: Colum
         raise InputError(f"{path}: columns have different lengths: {lengths}")
     order = [c for c in CANONICAL_ORDER if c in data] + [c for c in data if c not in CANONICAL_ORDER]
     return pd.DataFrame({c: data[c] for c in order}), described
+
+
+def channel_facts(path, src: RecordingSource, specs: list[ColumnSpec], cmap: ColumnMap | None) -> dict:
+    """Canonical name -> the facts the file states about that channel, resolution in SI.
+
+    The resolution is a step, so it goes through the same conversion as the values as the
+    difference of two converted values (offsets such as gauge -> absolute cancel).
+    """
+    if src.facts is None:
+        return {}
+    out = {}
+    for spec in specs:
+        facts = dict(src.facts(spec))
+        _, file_unit = src.get(spec)
+        step, _ = _to_si(path, src, spec, cmap, np.array([0.0, float(facts["resolution"])]), file_unit)
+        facts["resolution"] = abs(float(step[1] - step[0]))
+        out[spec.name] = facts
+    return out

@@ -8,7 +8,7 @@
   settling rows to drop);
 - MATLAB / dSPACE ``.mat`` exports (``scipy.io.loadmat``; plain variables, struct fields,
   dSPACE ``Y(i).Name`` / ``Y(i).Data`` records);
-- COMTRADE (IEEE C37.111) ``.cfg`` / ``.dat`` pairs (the ``comtrade`` package);
+- COMTRADE (IEEE C37.111-1999/2013) ``.cfg`` / ``.dat`` pairs and ``.cff`` single files;
 - Parquet (pandas / pyarrow).
 
 Everything that is not a clean recording raises one ``InputError`` naming the file, the
@@ -30,7 +30,7 @@ import pandas as pd
 
 from compliance.recordings.column_map import ColumnMap, load_column_map
 from compliance.errors import InputError
-from compliance.recordings.columns import RecordingSource, build_frame, canonical_specs
+from compliance.recordings.columns import RecordingSource, build_frame, canonical_specs, channel_facts
 from compliance.recordings.comtrade import partner_file, read_comtrade
 from compliance.recordings.delimited import TEXT_SUFFIXES, read_text_table
 from compliance.recordings.mat import read_mat
@@ -51,7 +51,7 @@ def read_recording(path, column_map=None, *, required=DEFAULT_REQUIRED):
     Parameters
     ----------
     path : str or pathlib.Path
-        ``.csv``, ``.csv.gz``, ``.txt``, ``.mat``, ``.cfg`` / ``.dat`` (COMTRADE) or ``.parquet``.
+        ``.csv``, ``.csv.gz``, ``.txt``, ``.mat``, ``.cfg`` / ``.dat`` or ``.cff`` (COMTRADE) or ``.parquet``.
     column_map : str, pathlib.Path, dict, ColumnMap or None
         How the file's columns map to canonical names (see ``compliance.recordings.column_map``). None
         means the file already uses canonical names and SI units (absolute pressures).
@@ -65,7 +65,9 @@ def read_recording(path, column_map=None, *, required=DEFAULT_REQUIRED):
         ``pressure_a`` / ``pressure_b`` / ``supply_pressure`` [Pa abs], and any other mapped
         column in SI (``force`` [N]...). Metadata: the sidecar (and the map's ``[metadata]``)
         with quantities converted to SI floats, plus ``source_path``, ``format``,
-        ``column_map``, ``columns`` (canonical -> source description), ``dropped_rows``.
+        ``column_map``, ``columns`` (canonical -> source description), ``dropped_rows``; for
+        COMTRADE also ``trigger_time`` [s], ``comtrade`` (edition, data type, form) and
+        ``channels[name]`` = ``{"resolution": SI step, "skew": s}``.
 
     Raises
     ------
@@ -98,6 +100,7 @@ def read_recording(path, column_map=None, *, required=DEFAULT_REQUIRED):
     meta.update(read_sidecar(path))
     if src.extra:
         meta.update(src.extra)
+    _merge_channel_facts(meta, channel_facts(path, src, specs, cmap))
     time_spec = cmap.spec("time") if cmap is not None else None
     check_time_base(path, frame["time"].to_numpy(), meta,
                     unit_given=src.time is not None or (time_spec is not None and bool(time_spec.unit)))
@@ -112,6 +115,25 @@ def read_recording(path, column_map=None, *, required=DEFAULT_REQUIRED):
     return frame, meta
 
 
+def _merge_channel_facts(meta: dict, facts: dict) -> None:
+    """The file's per-channel facts into ``meta["channels"]`` beside the sidecar's ``[channels.NAME]``.
+
+    A resolution stated by both is the coarser one: the recording resolves neither finer than
+    its file's quantum nor finer than the sensor the sidecar describes.
+    """
+    if not facts:
+        return
+    channels = meta.setdefault("channels", {})
+    for name, given in facts.items():
+        entry = channels.setdefault(name, {})
+        if not isinstance(entry, dict):
+            continue
+        for key, value in given.items():
+            old = entry.get(key)
+            numeric = isinstance(old, (int, float)) and not isinstance(old, bool)
+            entry[key] = max(float(old), value) if key == "resolution" and numeric else (old if old is not None else value)
+
+
 def _detect_format(path: Path, cmap: ColumnMap | None) -> str:
     if cmap is not None and cmap.format:
         return cmap.format
@@ -119,7 +141,7 @@ def _detect_format(path: Path, cmap: ColumnMap | None) -> str:
     if name.endswith(".gz"):
         name = name[:-3]
     suffix = Path(name).suffix
-    if suffix == ".cfg" or (suffix == ".dat" and partner_file(path, ".cfg") is not None):
+    if suffix in (".cfg", ".cff") or (suffix == ".dat" and partner_file(path, ".cfg") is not None):
         return "comtrade"
     if suffix in TEXT_SUFFIXES:
         return "csv"
@@ -129,7 +151,7 @@ def _detect_format(path: Path, cmap: ColumnMap | None) -> str:
         return "parquet"
     raise InputError(
         f"{path}: unknown recording format '{suffix}'; expected .csv, .csv.gz, .txt, .mat, "
-        f".cfg/.dat (COMTRADE) or .parquet (or set format = ... in the column map)"
+        f".cfg/.dat or .cff (COMTRADE) or .parquet (or set format = ... in the column map)"
     )
 
 

@@ -219,10 +219,37 @@ for cid, c, frag, rate in [
 ]:
     case(cid, CT, frag, {"bad.cfg": (lambda ws, c=c, rate=rate: W.write_comtrade(ws, "bad", c, rate)), "bad.toml": W.SIDECAR})
 case("comtrade-lonely-cfg", CT, "bad", {"bad.cfg": "bench,rig1,1999\n"})
+
+
+def spoilt_comtrade(ws, spoil, **kw):
+    """The good recording as a COMTRADE pair, then one of its files changed by ``spoil(cfg_text, dat_bytes)``."""
+    cfg = W.write_comtrade(ws, "bad", W.recording_columns(), **kw)
+    dat = ws / "bad.dat"
+    text, data = spoil(cfg.read_text(encoding="ascii"), dat.read_bytes())
+    cfg.write_text(text, encoding="ascii")
+    dat.write_bytes(data)
+
+
+for cid, kw, spoil, frag in [
+    ("comtrade-short-dat", {}, lambda c, d: (c, d[: len(d) // 2]), "shorter than the .cfg declares"),
+    ("comtrade-short-binary-dat", {"file_type": "BINARY32", "revision": "2013"},
+     lambda c, d: (c, d[:-7]), "shorter than the .cfg declares"),
+    ("comtrade-binary-declared-ascii", {"file_type": "BINARY32", "revision": "2013"},
+     lambda c, d: (c.replace("BINARY32", "ASCII"), d), "binary data declared ASCII"),
+    ("comtrade-secondary-without-ratio", {"ratios": {"pressure_a": (2.0, 1.0)}},
+     lambda c, d: (c.replace(",2.0,1.0,S", ",0,0,S"), d), "P/S = S"),
+    ("comtrade-ambiguous-primary-secondary", {"ratios": {"pressure_a": (2.0, 1.0)}},
+     lambda c, d: (c.replace(",2.0,1.0,S", ",2.0,1.0,X"), d), "cannot be told"),
+]:
+    case(cid, CT, frag, {"bad.cfg": (lambda ws, s=spoil, kw=kw: spoilt_comtrade(ws, s, **kw)), "bad.toml": W.SIDECAR})
+case("comtrade-cff-without-data", "validate plant.toml bad.cff", "DAT ---' section",
+     {"bad.cff": "--- file type: CFG ---\nbench,rig1,2013\n", "bad.toml": W.SIDECAR})
 case("comtrade-malformed-cfg", CT, "bad", {"bad.cfg": "bench\nnot,a,cfg\n", "bad.dat": "1,0,1\n"})
 
 # ------------------------------------------------------------------------------------- CLI arguments
 SIM = "simulate plant.toml -o out/run.csv"
+case("sim-negative-step-after-the-end", "simulate plant.toml --steps -5%@99s -o out/run.cfg", "later than --duration")
+case("sim-comtrade-dat-suffix", "simulate plant.toml -o out/run.dat", ".cfg, .cff")
 for cid, extra, frag in [
     ("sim-duration-1e9", "--duration 1e9", "3600"),
     ("sim-duration-negative", "--duration -1", "positive"),

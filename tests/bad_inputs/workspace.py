@@ -102,19 +102,17 @@ def write_parquet(path: Path, cols: dict[str, np.ndarray]) -> None:
     pd.DataFrame(cols).to_parquet(path, index=False)
 
 
-def write_comtrade(folder: Path, stem: str, cols: dict[str, np.ndarray], rate: float = 1000.0) -> Path:
-    """COMTRADE 1999 ASCII pair (analog channels named as the canonical columns, SI units)."""
-    names = [n for n in cols if n != "time"]
-    n = len(cols["time"])
-    cfg = ["bench,rig1,1999", f"{len(names)},{len(names)}A,0D"]
-    units = {"position": "m", "reference": "m", "valve_command": "V"}
-    for i, name in enumerate(names, 1):
-        cfg.append(f"{i},{name},,,{units.get(name, 'Pa')},1e-6,0,0,-2147483647,2147483647,1,1,P")
-    cfg += ["50", "1", f"{rate:g},{n}", "01/01/2024,00:00:00.000000", "01/01/2024,00:00:00.000000", "ASCII", "1"]
-    (folder / f"{stem}.cfg").write_text("\n".join(cfg) + "\n", encoding="utf-8")
-    dat = [f"{k + 1},{int(round(k * 1e6 / rate))}," + ",".join(str(int(round(cols[c][k] / 1e-6))) for c in names)
-           for k in range(n)]
-    (folder / f"{stem}.dat").write_text("\n".join(dat) + "\n", encoding="utf-8")
+def write_comtrade(folder: Path, stem: str, cols: dict[str, np.ndarray], rate: float = 1000.0,
+                   file_type: str = "ASCII", revision: str = "1999", ratios: dict | None = None) -> Path:
+    """COMTRADE pair (analog channels named as the canonical columns, SI units) declaring ``rate`` [Hz]."""
+    import pandas as pd
+
+    from compliance.recordings.comtrade_write import comtrade_bytes
+
+    frame = pd.DataFrame({**cols, "time": np.arange(len(cols["time"])) / rate})
+    for suffix, data in comtrade_bytes(frame, station="bench", device="rig1", revision=revision, file_type=file_type,
+                                       ratios=ratios).items():
+        (folder / f"{stem}{suffix}").write_bytes(data)
     return folder / f"{stem}.cfg"
 
 

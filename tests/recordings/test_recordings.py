@@ -173,7 +173,7 @@ def test_comtrade_pair_with_map_and_channel_units(tmp_path):
                         "pressure_a": {"column": "pA", "kind": "abs"},
                         "valve_command": {"column": 2}}}
     df, meta = read_recording(cfg, cmap)
-    rtol = 2e-7  # the comtrade package holds analog samples as float32 (eps 6e-8)
+    rtol = 1e-12  # read in double precision (the comtrade package's default float32 would give 6e-8)
     np.testing.assert_allclose(df["time"], [0.0, 0.001, 0.002, 0.003], atol=1e-9)  # 1 kHz from the cfg
     np.testing.assert_allclose(df["position"], [0.012, 0.0125, 0.013, 0.0135], rtol=rtol)
     np.testing.assert_allclose(df["pressure_a"], [5e5, 5.5e5, 6e5, 6.5e5], rtol=rtol)
@@ -187,7 +187,7 @@ def test_comtrade_pair_with_map_and_channel_units(tmp_path):
 def test_comtrade_canonical_channel_names(tmp_path):
     cfg = _comtrade_pair(tmp_path, [("position", "mm"), ("valve_command", "V")], [(1.0, 0.1), (2.0, 0.2), (3.0, 0.3)])
     df, _ = read_recording(cfg)
-    np.testing.assert_allclose(df["position"], [0.001, 0.002, 0.003], rtol=2e-7)  # float32 samples
+    np.testing.assert_allclose(df["position"], [0.001, 0.002, 0.003], rtol=1e-12)  # double precision
 
 
 def test_parquet_canonical(tmp_path):
