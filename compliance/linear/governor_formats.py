@@ -76,11 +76,16 @@ class GovernorModel:
     def family(self) -> dict:
         """Which model to pick, and why."""
         ratio = max(self.UO, -self.UC) / min(self.UO, -self.UC) - 1.0
-        pick = "HYGOV4" if ratio > HYGOV4_RATIO else "HYGOV"
+        small = 0.05 / self.Tg  # [pu/s] initial gate speed a 5 % step asks of a lag Tg
+        why = [f"opening and closing rates differ by {100 * ratio:.0f} %" + (" (> 10 %): only HYGOV4 carries both (UO, UC)"
+                                                                           if ratio > HYGOV4_RATIO else " (<= 10 %)")]
+        if small > 0.5 * self.VELM:
+            why.append(f"a 5 % step asks {small:.2f} pu/s of the lag, comparable with VELM {self.VELM:.2f} pu/s: HYGOV's limit on "
+                       "the integrator ramps the desired gate before the Tg lag and slows small steps; "
+                       "HYGOV4's limit on the gate velocity does not")
+        pick = "HYGOV4" if (ratio > HYGOV4_RATIO or small > 0.5 * self.VELM) else "HYGOV"
         return {"recommended": pick, "andes_models": list(ANDES_MODELS), "opening_closing_rate_difference": ratio,
-                "why": (f"opening and closing rates differ by {100 * ratio:.0f} % "
-                        + ("(> 10 %): HYGOV4 carries both (UO, UC); HYGOV's single VELM is set to the faster one"
-                           if pick == "HYGOV4" else "(<= 10 %): HYGOV's single VELM represents both")),
+                "why": "; ".join(why),
                 "notes": ["ANDES 2.0 has HYGOV, HYGOVDB and HYGOV4; there is no IEEEG3.",
                           "In HYGOV, VELM limits the rate of the integrator (the desired gate), not the gate: the gate "
                           "follows it through the Tg lag, so VELM is reached one Tg into a long move.",
