@@ -136,3 +136,8 @@ def test_documented_example_runs(cfg, capsys):
     for line in re.findall(r"^# (.+)$", code, flags=re.M):
         if line.startswith("->"):
             assert line[3:] in out, line
+
+
+def test_state_feedback_controller_is_refused_with_a_clear_error():
+    with pytest.raises(InputError, match="state_feedback.*PID only"):
+        controller_nlsys(load_plant("plant-b"))
