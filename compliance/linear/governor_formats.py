@@ -12,7 +12,7 @@ Model structure (read from the ANDES 2.0 source, ``andes/models/governor/hygov.p
   lag, so in a long move the gate speed settles at VELM one Tg after c starts ramping.
 - HYGOV4: pilot servo lag Tp -> gain 1/Tg -> gate-velocity limits [UC, UO] -> gate integrator,
   closed by the droop feedback Rperm + Rtemp Tr s/(1 + Tr s). The limits act on the gate itself.
-  With the feedback at unity (Rperm = 1 pu on the machine base, Rtemp = 0) the gate is a lag Tg
+  With the feedback at unity (Rperm = 1 pu on the system base, Rtemp = 0) the gate is a lag Tg
   with separate opening/closing rate limits: the bare positioner this module describes.
 """
 
@@ -91,7 +91,8 @@ class GovernorModel:
                           "follows it through the Tg lag, so VELM is reached one Tg into a long move.",
                           "In HYGOV4 the limits UO/UC act on the gate velocity; Tg is the gain of the gate integrator "
                           "inside the droop feedback, equal to the positioner's time constant only when that feedback "
-                          "is unity (Rperm = 1 pu, Rtemp = 0); with droop the gate loop's time constant is Tg/(Rperm + Rtemp).",
+                          "is unity (Rperm = 1 pu on the system base, Rtemp = 0); with droop the gate loop's time constant is "
+                          "Tg/(Rperm + Rtemp) on the system base.",
                           "HYGOVDB's dead band (dbL/dbU) is on the speed input, not the gate: the servo's dead-zone steady "
                           "error has no place in these models (PSS/E HYGOV4's DB2 is ignored by ANDES)."]}
 
@@ -110,7 +111,8 @@ class GovernorModel:
         tp = max(s["dead_time"] or 0.0, 1e-3)
         return {"HYGOV": {"Tg": s["Tg"], "VELM": s["VELM"], "GMAX": s["GMAX"], "GMIN": s["GMIN"]},
                 "HYGOV4": {"Tg": s["Tg"], "Tp": tp, "UO": s["UO"], "UC": s["UC"], "PMAX": s["GMAX"], "PMIN": s["GMIN"]},
-                "HYGOV4_bare_positioner": {"Rperm": 1.0, "Rtemp": 0.0},
+                "HYGOV4_bare_positioner": {"Rperm": "Tn/Sb on the machine base (1 pu on Sb: ANDES scales Rperm by Sb/Tn "
+                                                    "while the gate integrator's input stays on Sb)", "Rtemp": 0.0},
                 "Tn": "the unit's rating [MVA]: the machine base of GMAX, GMIN, VELM, UO, UC, PMAX, PMIN",
                 "scaling": "ANDES converts power=True parameters (GMAX, GMIN, VELM, UO, UC, PMAX, PMIN, qNL, Dt, Hdam) "
                            "from Tn (or the generator's Sn when Tn = 0) to the system base Sb by Tn/Sb, and R, r, Rperm, "
