@@ -30,17 +30,20 @@ def register(subparsers):
         ],
     )
     add_plant_argument(p)
-    p.add_argument("--at", default="50 %", help="operating position, e.g. '136 mm', 0.136 or '85 %%' (default: mid stroke)")
-    p.add_argument("--load", default="none", help="closing load, e.g. '11.4 kN', 11400, 'curve' or 'none' (default)")
+    p.add_argument("--at", default=None, help="operating position, e.g. '136 mm', 0.136 or '85 %%' (default: mid stroke; "
+                   "with --governor the nominal point, where the load curve reaches the nominal force)")
+    p.add_argument("--load", default=None, help="closing load, e.g. '11.4 kN', 11400, 'curve' or 'none' (default: none; "
+                   "with --governor the load curve)")
     p.add_argument("--gain", choices=("mean", "opening", "closing"), default="mean",
                    help="valve slope of the linear model: mean of both directions (default) or one direction")
     p.add_argument("--flow-control", action=argparse.BooleanOptionalAction, default=None,
-                   help="force the meter-out flow-control valves in or out (default: as configured)")
+                   help="force the meter-out flow-control valves in or out (default: as configured; with --governor in)")
     p.add_argument("--map", action="store_true", help="operating map of time constant and margins over stroke x load")
     p.add_argument("--crosscheck", action="store_true", help="compare with nonlinear 1 %% and 5 %% steps at the paper's operating points")
-    p.add_argument("--governor", action="store_true", help="equivalent HYGOV parameters (Tg, VELM, UO/UC, GMAX/GMIN)")
+    p.add_argument("--governor", action="store_true",
+                   help="equivalent gate-servo parameters for HYGOV / HYGOV4 (Tg, VELM, UO/UC, GMAX/GMIN), ANDES table, PSS/E record")
     p.add_argument("--stroke-load", default="default",
-                   help="load during the governor's full-stroke runs: a force, 'curve' or 'none' (default: the stroke average of the load curve)")
+                   help="load during the governor's large moves: a force, 'curve' or 'none' (default: the load curve)")
     add_outputs(p, "json", help={"json": "write everything as JSON to FILE.json"})
     p.add_argument("--governor-json", metavar="FILE.json", help="write only the HYGOV parameters as JSON (implies --governor)")
     p.add_argument("--plot", metavar="FILE.png", help="write Bode, Nyquist, pole-zero and step plots (.png, .svg or .pdf)")
@@ -79,15 +82,28 @@ def parse_load(text, flag: str = "--load"):
         return parse_quantity(t, "N", f"{flag} {text!r}")
 
 
+def _point(cfg, args, governor: bool):
+    """(position [m], load, flow_control) of the analysis; with --governor the governor's own point and circuit."""
+    from compliance.linear.governor_model import nominal_point
+
+    x_n, load_n = nominal_point(cfg) if governor else (None, None)
+    L = cfg.p("cylinder.stroke")
+    x = _position(args.at, L) if args.at is not None else (x_n if governor else 0.5 * L)
+    load = parse_load(args.load) if args.load is not None else (load_n if governor else None)
+    flow_control = args.flow_control if args.flow_control is not None else (True if governor else None)
+    return x, load, flow_control
+
+
 def _fmt(v, scale=1.0, digits=3, unit=""):
     return "-" if v is None else f"{v*scale:.{digits}f} {unit}".rstrip()
 
 
-def _summary(cfg, a) -> str:
+def _summary(cfg, a, flow_control=None) -> str:
     f, op = a.figures, a.op
+    circuit = {True: ", flow-control valves in", False: ", flow-control valves out", None: ""}[flow_control]
     load = "none" if op.load is None else (f"curve ({op.load_force/1e3:.2f} kN)" if isinstance(op.load, str) else f"{op.load_force/1e3:.2f} kN")
     lines = [
-        f"plant {cfg.name}: linear model at {op.position*1e3:.1f} mm, load {load}, valve slope '{a.info['gain']}'",
+        f"plant {cfg.name}: linear model at {op.position*1e3:.1f} mm, load {load}, valve slope '{a.info['gain']}'{circuit}",
         f"  trim pressures p_A {op.pressure_a/1e5:.3f} bar abs, p_B {op.pressure_b/1e5:.3f} bar abs (p_A + p_B = p_s + p_atm)",
         f"  states {', '.join(a.plant.state_labels)} ({a.info['unobservable_or_uncontrollable_states']} mode(s) not seen from u_d to x)",
         f"  pneumatic natural frequency {_fmt(f['natural_frequency_hz'], 1, 2, 'Hz')} (analytic {_fmt(f['natural_frequency_analytic_hz'], 1, 2, 'Hz')}), "
@@ -116,10 +132,13 @@ def run(args) -> int:
     check_args_outputs(args, (args.governor_json, "--governor-json", (".json",)), (args.plot, "--plot", _PLOT_SUFFIXES))
     cfg = plant_from_args(args)
     L = cfg.p("cylinder.stroke")
-    x = _position(args.at, L)
-    load = parse_load(args.load)
-    a = analyse(cfg, x, load, flow_control=args.flow_control, gain=args.gain)
-    summary = _summary(cfg, a)
+    governor = bool(args.governor or args.governor_json)
+    x, load, flow_control = _point(cfg, args, governor)
+    sl = None
+    if governor:  # parsed before any work: a bad --stroke-load is exit 2 with nothing run
+        sl = "default" if args.stroke_load == "default" else parse_load(args.stroke_load, "--stroke-load")
+    a = analyse(cfg, x, load, flow_control=flow_control, gain=args.gain)
+    summary = _summary(cfg, a, flow_control)
     print(summary.splitlines()[0] if args.quiet else summary)
     out = {"schema": "govcheck-linear/1", "plant": cfg.name, "path": cfg.path, "digest": cfg.digest, "analysis": a.to_dict()}
     omap = None
@@ -143,12 +162,12 @@ def run(args) -> int:
         print("\ncross-check, linear vs nonlinear time constant (metric: dead time to 63.2 % of the commanded step):")
         print(crosscheck_table(rows))
         out["crosscheck"] = jsonable(rows)
-    if args.governor or args.governor_json:
+    if governor:
         from compliance.linear.governor_model import governor_parameters
 
-        sl = "default" if args.stroke_load == "default" else parse_load(args.stroke_load, "--stroke-load")
-        gov = governor_parameters(cfg, stroke_load=sl)
-        print("\nequivalent HYGOV parameters:")
+        reuse = a if args.gain == "mean" else None  # Tg_linear is the mean-slope figure of the same point
+        gov = governor_parameters(cfg, position=x, load=load, stroke_load=sl, flow_control=flow_control, linear=reuse)
+        print(f"\nequivalent gate-servo parameters ({gov.basis()['circuit']}; pu on the machine base, gate = stroke):")
         print(gov.table())
         out["governor"] = gov.to_dict()
         if args.governor_json:

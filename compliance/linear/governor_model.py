@@ -1,34 +1,43 @@
-"""Equivalent parameters of the gate servo for power-system hydro-governor models (HYGOV family).
+"""The gate servo measured the way a speed governor moves it, for power-system hydro-governor models.
 
-Power-system dynamic models reduce the gate servo to a first-order lag with rate and position
-limits: HYGOV (PSS/E, PowerWorld; IEEE PES TR "Dynamic Models for Turbine-Governors in Power
-System Studies", 2013, ch. 3) uses the gate servo time constant Tg, one gate velocity limit VELM
-[pu/s] and the gate limits GMAX/GMIN [pu]; IEEEG3 and HYGOV4 carry separate opening and closing
-rate limits UO and UC [pu/s]. Gate position in pu is x/stroke (0 closed, 1 fully open).
+Power-system models reduce the gate servo to a lag with rate and position limits (HYGOV, HYGOV4;
+IEEE PES TR "Dynamic Models for Turbine-Governors in Power System Studies", 2013, ch. 3). This
+module measures those figures on the nonlinear simulator, all with ONE circuit (the meter-out
+flow-control valves 2V2/2V3 in by default: they are the governor's opening/closing-time setting,
+seed 000 section 5.2) and ONE load (the configuration's load curve: the force the gate sees):
 
-- Tg: the servo-positioner time constant at the nominal operating point, from 5 % steps of the
-  nonlinear simulator (what a commissioning step test measures), with the linear value beside it;
-- UO/UC: full-stroke closed-loop runs with the flow-control valves installed under a constant
-  load (the stroke average of the load curve by default), speed from the straight part of the
-  trace (25-75 % of stroke, ``metrics.stroke_time``); VELM = the slower of the two.
+- Tg: time constant of +/-5 % steps from rest at the operating point (nominal load on the load
+  curve), dead time subtracted (``metrics.step_response``, the one IEC 61362 metric); the dead time
+  and the dead-zone steady error are kept beside it (HYGOV leaves both out);
+- UO/UC: reference steps from rest at the operating points to the far end stop (opening from the
+  lower points, closing from the upper ones: what a load pick-up or a load rejection commands),
+  gate speed over 25-75 % of stroke (``metrics.stroke_time``) and the peak speed beside it;
+- the end-stop strokes of a commissioning stroke-time test, for comparison only.
+
+``compliance.linear.governor_formats`` turns the figures into HYGOV / HYGOV4 / ANDES / PSS/E text.
 """
 
 from __future__ import annotations
 
-import json
-from dataclasses import dataclass, field
-
 import numpy as np
 
 from compliance import metrics as M
-from compliance.model.config import PlantConfig
 from compliance.errors import InputError
-from compliance.files.jsonable import jsonable
-from compliance.linear.analysis import analyse
+from compliance.linear.governor_formats import GovernorModel
 from compliance.linear.maps import nonlinear_step
-from compliance.simulation.profiles import Profile
+from compliance.model.config import PlantConfig
+from compliance.model.dead_zone_stall import stall_error
 from compliance.simulation import Scenario, simulate
+from compliance.simulation.profiles import Profile
 from compliance.simulation.scenario import stroke_start_pressures
+
+__all__ = ["OPENING_STARTS", "CLOSING_STARTS", "gate_move", "governor_parameters", "nominal_point"]
+
+# Rest positions [fraction of stroke] the large moves start from (our choice): below 25 % for an
+# opening and above 75 % for a closing, so the whole 25-75 % span is crossed; the nominal point is added.
+OPENING_STARTS = (0.0, 0.10, 0.20)
+CLOSING_STARTS = (0.80, 0.90, 1.00)
+MOVE_DURATION = 20.0  # [s] simulated per move: a 25-75 % crossing at 0.05 pu/s still fits
 
 
 def nominal_point(cfg: PlantConfig) -> tuple[float, float | str | None]:
@@ -46,117 +55,105 @@ def nominal_point(cfg: PlantConfig) -> tuple[float, float | str | None]:
     return float(np.clip(x, 0.0, L)), "curve"
 
 
-def stroke_average_load(cfg: PlantConfig) -> float | None:
-    """Mean closing force of the load curve over the whole stroke [N] (None without a curve)."""
-    if cfg.load_curve is None:
-        return None
-    xs, fs = cfg.load_curve
-    x = np.linspace(0.0, cfg.p("cylinder.stroke"), 2001)
-    return float(np.mean(np.interp(x, xs, fs)))
+def gate_move(cfg: PlantConfig, start: float, direction: str, load, *, flow_control: bool | None = True,
+              from_end_stop: bool = False) -> dict:
+    """One closed-loop move from ``start`` [m] to the far end stop, measured like a stroke-time test.
 
-
-def stroke_speed(cfg: PlantConfig, direction: str, load, *, flow_control: bool = True, timeout: float = 30.0) -> dict:
-    """Full-stroke closed-loop run: a reference step from one end stop to the other, speed from 25-75 % of stroke.
+    Parameters
+    ----------
+    start : float
+        Initial position [m]; at rest there (chambers balancing the load, p_A + p_B = p_s + p_atm,
+        the simulator's rest state) unless ``from_end_stop`` (the driving side exhausted, the other at
+        supply: the state a hold at the end stop leaves, ``stroke_start_pressures``).
+    direction : {"opening", "closing"}
+    load : float, "curve" or None
+        Closing force [N], the configuration's load curve, or none.
 
     Returns
     -------
     dict
-        direction, full-stroke time [s] (extrapolated from 25-75 %), speed [m/s], rate [pu/s],
-        peak speed [m/s], t25/t75 [s].
+        start [m], direction, rate over 25-75 % of stroke [pu/s] (pu = stroke), the full-stroke time
+        it implies [s], peak speed [m/s] and [pu/s], t25/t75 [s] after the reference step.
     """
     L = cfg.p("cylinder.stroke")
-    x0, x1 = (0.0, L) if direction == "opening" else (L, 0.0)
-    ref = Profile(np.array([0.0, 0.1, 0.1]), np.array([x0, x0, x1]))
-    # from the end stop as the hold there leaves the chambers, like the full_stroke procedure
-    df = simulate(cfg, Scenario(timeout, x0, reference=ref, load=load, flow_control=flow_control,
-                                initial_pressures=stroke_start_pressures(cfg, direction)))
+    end = L if direction == "opening" else 0.0
+    lead = 0.1
+    ref = Profile(np.array([0.0, lead, lead]), np.array([start, start, end]))
+    p0 = stroke_start_pressures(cfg, direction) if from_end_stop else None
+    df = simulate(cfg, Scenario(MOVE_DURATION, start, reference=ref, load=load, flow_control=flow_control,
+                                initial_pressures=p0))
     t, x = M.frame_columns(df, "time", "position")
     T, t1, t2, why = M.stroke_time(t, x, L, direction)
     if T is None:
-        raise InputError(f"{cfg.path or cfg.name}: full-stroke {direction} run with load {load!r} failed: {why}")
-    vmax = M.speed_extremes(t, x)[1 if direction == "opening" else 2]
-    return {"direction": direction, "stroke_time": T, "speed": L / T, "rate_pu_per_s": 1.0 / T, "peak_speed": vmax, "t25": t1, "t75": t2}
+        raise InputError(f"{cfg.path or cfg.name}: {direction} move from {start * 1e3:.0f} mm with load {load!r} "
+                         f"did not cross 25-75 % of stroke in {MOVE_DURATION:.0f} s: {why}")
+    peak = M.speed_extremes(t, x)[1 if direction == "opening" else 2]
+    return {"start": start, "start_pu": start / L, "direction": direction, "from": "end stop" if from_end_stop else "rest",
+            "rate_pu_per_s": 1.0 / T, "stroke_time": T, "peak_speed": peak, "peak_pu_per_s": peak / L,
+            "t25": t1 - lead, "t75": t2 - lead}
 
 
-@dataclass
-class GovernorModel:
-    """HYGOV-style equivalent parameters with their basis."""
+def _starts(cfg: PlantConfig, x_nominal: float) -> tuple[list[float], list[float]]:
+    L = cfg.p("cylinder.stroke")
+    up = sorted({round(f * L, 9) for f in OPENING_STARTS} | ({round(x_nominal, 9)} if x_nominal <= 0.25 * L else set()))
+    down = sorted({round(f * L, 9) for f in CLOSING_STARTS} | ({round(x_nominal, 9)} if x_nominal >= 0.75 * L else set()))
+    return up, down
 
-    Tg: float
-    Tg_linear: float | None
-    UO: float
-    UC: float
-    GMAX: float = 1.0
-    GMIN: float = 0.0
-    basis: dict = field(default_factory=dict)
 
-    @property
-    def VELM(self) -> float:
-        """HYGOV's single gate velocity limit [pu/s]: the slower of opening and closing."""
-        return min(self.UO, abs(self.UC))
-
-    def to_dict(self) -> dict:
-        """JSON-serialisable parameters, units and basis."""
-        return jsonable({
-            "model": "HYGOV",
-            "parameters": {"Tg": self.Tg, "VELM": self.VELM, "GMAX": self.GMAX, "GMIN": self.GMIN},
-            "rate_limits": {"UO": self.UO, "UC": self.UC},
-            "units": {"Tg": "s", "VELM": "pu/s", "GMAX": "pu", "GMIN": "pu", "UO": "pu/s", "UC": "pu/s (negative: closing)"},
-            "Tg_linear": self.Tg_linear,
-            "basis": self.basis,
-        })
-
-    def to_json(self) -> str:
-        """The parameters as a JSON document."""
-        return json.dumps(self.to_dict(), indent=2)
-
-    def table(self) -> str:
-        """Plain parameter table."""
-        rows = [("Tg", f"{self.Tg:.3f}", "s", "gate servo time constant (nonlinear 5 % steps at the nominal point)"),
-                ("Tg (linear)", "-" if self.Tg_linear is None else f"{self.Tg_linear:.3f}", "s", "same, from the linear model"),
-                ("VELM", f"{self.VELM:.4f}", "pu/s", "gate velocity limit (HYGOV, slower direction)"),
-                ("UO", f"{self.UO:.4f}", "pu/s", f"max opening rate (full stroke {1/self.UO:.2f} s)"),
-                ("UC", f"{self.UC:.4f}", "pu/s", f"max closing rate (full stroke {1/abs(self.UC):.2f} s)"),
-                ("GMAX", f"{self.GMAX:.2f}", "pu", "maximum gate (stroke end)"),
-                ("GMIN", f"{self.GMIN:.2f}", "pu", "minimum gate (closed)")]
-        w = max(len(r[0]) for r in rows)
-        return "\n".join(f"{n:<{w}}  {v:>8} {u:<5} {m}" for n, v, u, m in rows)
+def _tg_steps(cfg: PlantConfig, x: float, load, step: float, flow_control) -> list[dict]:
+    """The +/- ``step`` closed-loop steps from rest at ``x``: time constant, dead time, steady error, peak speed."""
+    L = cfg.p("cylinder.stroke")
+    out = []
+    for s in (step, -step):
+        if 0.0 <= x + s * L <= L:
+            r = nonlinear_step(cfg, x, load, s, flow_control=flow_control)
+            out.append({"step": s, "time_constant": r.time_constant, "dead_time": r.dead_time,
+                        "steady_error": r.steady_state_error, "peak_speed": r.max_speed,
+                        "rate_limited": bool(r.rate_limited), "why": r.reasons.get("time_constant")})
+    return out
 
 
 def governor_parameters(cfg: PlantConfig, *, position: float | None = None, load="default", stroke_load="default",
-                        step: float = 0.05) -> GovernorModel:
-    """Equivalent HYGOV parameters of a plant configuration.
+                        flow_control: bool | None = True, step: float = 0.05, linear=None) -> GovernorModel:
+    """Equivalent gate-servo parameters of a plant configuration (HYGOV / HYGOV4 family).
 
     Parameters
     ----------
     cfg : PlantConfig
     position, load :
-        Operating point of Tg [m], load; default ``nominal_point`` (nominal load on the load curve).
-    stroke_load : float, "curve" or None
-        Load during the full-stroke runs; default a constant force equal to the stroke average of
-        the load curve (a straight trace whose speed is the average rate; 5.9 kN for plant A, near
-        the 5.7 kN at which seed 000 set its throttles), none without a curve. "curve" follows the
-        curve (speed then varies along the stroke; 25-75 % gives the average over that span).
+        Operating point of Tg [m] and its load; default ``nominal_point`` (nominal load on the load curve).
+    stroke_load : float, "curve", None or "default"
+        Load during the large moves; default the load curve (the force the gate sees), none without one.
+    flow_control : bool or None
+        Meter-out flow-control valves for every run (default True: the governor's opening/closing-time
+        setting is part of the servo; None: as configured).
     step : float
-        Step size for Tg, fraction of stroke (5 %: 1 % steps stall in the valve dead zone).
+        Step size for Tg, fraction of stroke (1 % steps stall in the valve dead zone).
+    linear : LinearAnalysis, optional
+        The linear analysis at the same point (reused for Tg_linear instead of computed again).
     """
+    from compliance.linear.analysis import analyse
+
     L = cfg.p("cylinder.stroke")
     x_n, load_n = nominal_point(cfg)
     x = x_n if position is None else position
     ld = load_n if (isinstance(load, str) and load == "default") else load
-    sl = stroke_average_load(cfg) if (isinstance(stroke_load, str) and stroke_load == "default") else stroke_load
-    taus = []
-    for s in (step, -step):
-        if 0.0 <= x + s * L <= L:
-            tau = nonlinear_step(cfg, x, ld, s).time_constant
-            if tau is not None:
-                taus.append(tau)
-    lin = analyse(cfg, x, ld, detail=False).figures["time_constant"]
-    tg = float(np.mean(taus)) if taus else lin
-    up = stroke_speed(cfg, "opening", sl)
-    down = stroke_speed(cfg, "closing", sl)
-    basis = {"Tg_point": {"position": x, "load": ld}, "Tg_steps": [step, -step], "Tg_nonlinear_samples": taus,
-             "Tg_source": "nonlinear 5 % steps" if taus else "linear model (nonlinear steps stalled)",
-             "stroke_runs": {"load": sl, "flow_control": True, "opening": up, "closing": down,
-                             "method": "closed loop, reference step end to end, 25-75 % of stroke extrapolated"}}
-    return GovernorModel(tg, lin, up["rate_pu_per_s"], -down["rate_pu_per_s"], basis=basis)
+    sl = ("curve" if cfg.load_curve is not None else None) if (isinstance(stroke_load, str) and stroke_load == "default") else stroke_load
+    steps = _tg_steps(cfg, x, ld, step, flow_control)
+    taus = [s["time_constant"] for s in steps if s["time_constant"] is not None]
+    if linear is None:
+        linear = analyse(cfg, x, ld, flow_control=flow_control, detail=False)
+    tg_lin = linear.figures["time_constant"]
+    up, down = _starts(cfg, x)
+    moves = [gate_move(cfg, s, "opening", sl, flow_control=flow_control) for s in up]
+    moves += [gate_move(cfg, s, "closing", sl, flow_control=flow_control) for s in down]
+    end_stop = [gate_move(cfg, a, d, sl, flow_control=flow_control, from_end_stop=True) for a, d in ((0.0, "opening"), (L, "closing"))]
+    dead = [s["dead_time"] for s in steps if s["dead_time"] is not None]
+    return GovernorModel(
+        name=cfg.name, stroke=L,
+        Tg=float(np.mean(taus)) if taus else tg_lin, Tg_linear=tg_lin,
+        Tg_source="nonlinear steps" if taus else "linear model (the nonlinear steps stalled)",
+        dead_time=float(np.mean(dead)) if dead else None,
+        steady_error={"opening": stall_error(cfg, "opening"), "closing": stall_error(cfg, "closing")},
+        point={"position": x, "load": ld, "load_force": linear.op.load_force},
+        stroke_load=sl, flow_control=flow_control, steps=steps, moves=moves, end_stop=end_stop)

@@ -1,14 +1,16 @@
-"""govcheck plants as python-control objects: the nonlinear plant and its linearisation.
+"""govcheck plants as python-control objects: the nonlinear plant (active states only) and its linearisation.
 
-- :func:`to_nlsys` wraps THE plant right-hand side (``compliance.model.assembly.plant_rhs``)
-  and the configuration's parameter vector in a ``control.NonlinearIOSystem`` with named
-  states, input and outputs, for simulation or analysis in a user's own python-control code;
-- :func:`operating_point` gives the state and valve input at rest at a position and load
-  (the trim govcheck's linear analysis uses), to start ``control.input_output_response`` or
-  ``control.linearize`` from;
-- :func:`to_statespace` gives the linearisation as a ``control.StateSpace`` from the controller
-  output u_d [V] to the position [m]: the same model ``govcheck linear`` analyses (the valve's
-  dead zone seen through the dead-zone compensation as an effective gain, docs/linear.md).
+- :func:`to_nlsys` wraps THE plant right-hand side (``compliance.model.assembly.plant_rhs``) in a
+  ``control.NonlinearIOSystem`` whose states are only those the configuration makes live: position,
+  velocity, both chamber pressures, the LuGre bristle of each moving body, and the declared states of
+  the effects switched on (an effect that is off has no state here). States and outputs are named
+  with their SI unit (``position_m``, ``pressure_a_Pa``); the parameter vector is exposed through
+  ``params`` (core names of ``compliance.model.vector_slots.PARAM_NAMES``, SI);
+- :func:`operating_point` gives the state and valve input at rest at a position and load (the trim
+  govcheck's linear analysis uses); ``compliance.linear.nlsys_loop`` adds the controller, the closed
+  loop and a physically checked ``find_operating_point``;
+- :func:`to_statespace` gives the linearisation as a ``control.StateSpace`` u_d [V] -> position [m]:
+  the model ``govcheck linear`` analyses.
 
 The valve's pure delays (an effect's ``delay`` parameters) are applied by the simulator outside
 the right-hand side and are not part of the NonlinearIOSystem; add ``control.pade`` if needed.
@@ -19,24 +21,71 @@ from __future__ import annotations
 
 import numpy as np
 
+from compliance.effects.catalogue import ALL_EFFECTS
 from compliance.model.assembly import plant_rhs
-
-from compliance.model.plant_vector import load_curve_arrays, parameter_vector
-
-from compliance.model.rest_state import initial_state
 from compliance.model.config import PlantConfig
-from compliance.model.vector_slots import AUX_NAMES, N_AUX, N_STATES, STATE_NAMES
+from compliance.model.plant_vector import load_curve_arrays, parameter_vector
+from compliance.model.rest_state import initial_state
+from compliance.model.vector_slots import (AUX_NAMES, EFFECT_SLOTS, N_AUX, N_STATES, P_FRM, P_UCEN, PARAM_NAMES,
+                                           S_PA, S_PB, S_V, S_V2, S_X, S_X2, S_Z1, S_Z2, STATE_NAMES)
 
-__all__ = ["INPUT", "OUTPUTS", "operating_point", "to_nlsys", "to_statespace"]
+__all__ = ["INPUT", "OPENING_INPUT", "OUTPUTS", "STATE_UNITS", "active_states", "labelled", "operating_point",
+           "to_nlsys", "to_statespace", "valve_command_for_opening"]
 
-INPUT = "valve_command"  # [V] at the valve (after compensation and saturation)
-OUTPUTS = ("position", "pressure_a", "pressure_b") + AUX_NAMES  # [m], [Pa abs], then the aux signals (SI)
-_STATE_INDEX = {n: i for i, n in enumerate(STATE_NAMES)}
+INPUT = "valve_command_V"  # [V] at the valve (after compensation, saturation and the centre voltage)
+OPENING_INPUT = "opening"  # [-] the same command expressed as the static opening it gives (signed, > 0 opens)
+OUTPUTS = ("position", "pressure_a", "pressure_b") + AUX_NAMES  # then the aux signals (SI)
+# SI unit of every state and output, for the labels (our own table; the core stores bare SI floats)
+STATE_UNITS = {"position": "m", "velocity": "m_s", "pressure_a": "Pa", "pressure_b": "Pa", "temperature_a": "K",
+               "temperature_b": "K", "bristle_1": "m", "bristle_2": "m", "position_2": "m", "velocity_2": "m_s",
+               "spool_position": "V", "spool_velocity": "V_s", "supply_pressure": "Pa", "line_pressure_a": "Pa",
+               "line_pressure_b": "Pa"}
+OUTPUT_UNITS = {"position": "m", "pressure_a": "Pa", "pressure_b": "Pa", "friction_force": "N", "load_force": "N",
+                "flow_a": "kg_s", "flow_b": "kg_s", "opening": "1", "pneumatic_force": "N", "supply_flow": "kg_s"}
+_PLANT_PARAMS = tuple(n for n in PARAM_NAMES if n not in ("kp", "ki", "kd", "ts", "filt_hz", "lc", "cdz_pos", "cdz_neg",
+                                                          "cslope_pos", "cslope_neg", "u_lim"))
+
+
+def labelled(name: str, units: dict = STATE_UNITS) -> str:
+    """``position`` -> ``position_m``: a signal name with its SI unit (python-control names cannot hold brackets)."""
+    return f"{name}_{units[name]}"
+
+
+def active_states(P: np.ndarray) -> list[int]:
+    """Indices of the states that move for this parameter vector (state-vector order).
+
+    x, v, p_A, p_B always; the LuGre bristle of each body (bristle_2 only with a compliant linkage,
+    otherwise it copies bristle_1, as position_2/velocity_2 copy position/velocity); the declared
+    states of every effect switched on.
+    """
+    keep = {S_X, S_V, S_PA, S_PB}
+    linkage = bool(P[EFFECT_SLOTS["linkage_compliance"][0]])
+    if P[P_FRM] == 0.0:  # LuGre (compliance.model.assembly._body_friction)
+        keep |= {S_Z1, S_Z2} if linkage else {S_Z1}
+    for eff in ALL_EFFECTS:
+        if P[EFFECT_SLOTS[eff.name][0]]:
+            keep |= {s.index for s in eff.states}
+    return sorted(keep)
+
+
+def valve_command_for_opening(P: np.ndarray, opening: float) -> float:
+    """The valve command [V] whose static opening is ``opening`` (inverse of ``physics.valve_opening``).
+
+    The path opening is (u - dz)/(u_sat - dz) beyond the dead zone (the slope md cancels), so
+    u = centre + dz + o (u_sat - dz) for o > 0, mirrored with zme for o < 0, the centre at o = 0.
+    """
+    from compliance.model.vector_slots import P_DZN, P_DZP, P_USAT
+
+    if opening > 0.0:
+        return P[P_UCEN] + P[P_DZP] + opening * (P[P_USAT] - P[P_DZP])
+    if opening < 0.0:
+        return P[P_UCEN] - abs(P[P_DZN]) + opening * (P[P_USAT] - abs(P[P_DZN]))
+    return P[P_UCEN]
 
 
 def to_nlsys(cfg: PlantConfig, *, load: float | str | None = None, flow_control: bool | None = None,
-             name: str | None = None):
-    """The nonlinear plant as a ``control.NonlinearIOSystem``.
+             name: str | None = None, input: str = "valve_command"):
+    """The nonlinear plant as a ``control.NonlinearIOSystem`` with only its active states.
 
     Parameters
     ----------
@@ -48,46 +97,83 @@ def to_nlsys(cfg: PlantConfig, *, load: float | str | None = None, flow_control:
         Install / remove the meter-out flow-control valves (None: as configured).
     name : str, optional
         System name (default: the plant's name).
+    input : {"valve_command", "opening"}
+        The valve command [V] (``valve_command_V``), or the same command as the static opening it
+        gives [-] (``opening``; > 0 opens, 0 at the centre): linearising at the null through the
+        ``opening`` input gives the flow just past the dead-zone edge, where the voltage input sees
+        the dead zone's zero slope.
 
     Returns
     -------
     control.NonlinearIOSystem
-        Continuous time; states ``STATE_NAMES`` (position [m], velocity [m/s], pressures [Pa abs],
-        temperatures [K], bristle deflections [m], ...; states of effects that are off stay
-        constant); input ``valve_command`` [V]; outputs ``OUTPUTS`` (position [m], chamber
-        pressures [Pa abs], friction and load force [N], mass flows [kg/s], valve opening [-],
-        pneumatic force [N], supply flow [kg/s]).
+        Continuous time; states ``labelled(name)`` of :func:`active_states` (``position_m``,
+        ``velocity_m_s``, ``pressure_a_Pa`` absolute, ...); outputs ``position_m``, ``pressure_a_Pa``,
+        ``pressure_b_Pa``, ``friction_force_N``, ``load_force_N``, ``flow_a_kg_s``, ``flow_b_kg_s``,
+        ``opening_1``, ``pneumatic_force_N``, ``supply_flow_kg_s``; ``params``: the plant's core
+        parameter vector entries by name (SI), e.g. ``{"p_supply": 8e5, "mass": 30.0}``. The inactive
+        states are held at the configuration's rest values (``template`` attribute: the full vector).
     """
     import control
 
-    P = parameter_vector(cfg, load=load, flow_control=flow_control)
+    P0 = parameter_vector(cfg, load=load, flow_control=flow_control)
     lx, ly = load_curve_arrays(cfg)
+    keep = np.array(active_states(P0))
+    template = initial_state(cfg, P0, 0.5 * cfg.p("cylinder.stroke"))
+    index = {n: i for i, n in enumerate(PARAM_NAMES)}
+    defaults = {n: float(P0[index[n]]) for n in _PLANT_PARAMS}
+    by_opening = input == "opening"
+    if input not in ("valve_command", "opening"):
+        raise ValueError(f"input must be 'valve_command' or 'opening', not {input!r}")
 
-    def _eval(x, u):
+    def _vector(params):
+        if not params:
+            return P0
+        P = P0.copy()
+        for k, v in params.items():
+            if k in defaults and v != defaults[k]:
+                P[index[k]] = v
+        return P
+
+    def _eval(x, u, params):
+        P = _vector(params)
+        y = template.copy()
+        y[keep] = x
+        if S_Z2 not in keep:  # shadow copies of the rigid linkage (assembly.plant_rhs writes them alike)
+            y[S_Z2] = y[S_Z1]
+        if S_X2 not in keep:
+            y[S_X2], y[S_V2] = y[S_X], y[S_V]
+        u0 = float(np.ravel(u)[0])
+        cmd = valve_command_for_opening(P, u0) if by_opening else u0
         dy = np.zeros(N_STATES)
         aux = np.zeros(N_AUX)
-        plant_rhs(np.ascontiguousarray(x, dtype=float), P, float(np.ravel(u)[0]), lx, ly, dy, aux)
-        return dy, aux
+        plant_rhs(y, P, cmd, lx, ly, dy, aux)
+        return dy[keep], y, aux
 
     def updfcn(t, x, u, params):
-        return _eval(x, u)[0]
+        return _eval(x, u, params)[0]
 
     def outfcn(t, x, u, params):
-        aux = _eval(x, u)[1]
-        return np.concatenate(([x[_STATE_INDEX["position"]], x[_STATE_INDEX["pressure_a"]], x[_STATE_INDEX["pressure_b"]]], aux))
+        _, y, aux = _eval(x, u, params)
+        return np.concatenate(([y[S_X], y[S_PA], y[S_PB]], aux))
 
-    return control.nlsys(updfcn, outfcn, inputs=[INPUT], outputs=list(OUTPUTS), states=list(STATE_NAMES),
-                         name=name or cfg.name)
+    sys = control.nlsys(updfcn, outfcn, inputs=[OPENING_INPUT if by_opening else INPUT],
+                        outputs=[labelled(n, OUTPUT_UNITS) for n in OUTPUTS],
+                        states=[labelled(STATE_NAMES[i]) for i in keep], name=name or cfg.name, params=defaults)
+    sys.template = template
+    sys.core_index = keep  # where each state sits in the full STATE_NAMES vector
+    sys.rest_state = lambda position: initial_state(cfg, P0, position)[keep]  # govcheck's rest convention
+    return sys
 
 
 def operating_point(cfg: PlantConfig, position: float, load: float | str | None = None, *,
-                    flow_control: bool | None = None) -> tuple[np.ndarray, float]:
+                    flow_control: bool | None = None, full: bool = False) -> tuple[np.ndarray, float]:
     """State and valve input of the plant at rest at ``position`` [m] under ``load`` (the linear trim).
 
     Returns
     -------
     (numpy.ndarray, float)
-        The full state (layout ``STATE_NAMES``) and the valve command at rest [V] (the valve null).
+        The active states (:func:`active_states`, the layout of :func:`to_nlsys`; the full
+        ``STATE_NAMES`` vector with ``full``) and the valve command at rest [V] (the valve null).
 
     Raises
     ------
@@ -97,9 +183,9 @@ def operating_point(cfg: PlantConfig, position: float, load: float | str | None 
     from compliance.linear.trim import trim
 
     op = trim(cfg, position, load, flow_control=flow_control)
-    state = initial_state(cfg, parameter_vector(cfg, load=load, flow_control=flow_control), position,
-                          (op.pressure_a, op.pressure_b))
-    return state, float(op.valve_null)
+    P = parameter_vector(cfg, load=load, flow_control=flow_control)
+    state = initial_state(cfg, P, position, (op.pressure_a, op.pressure_b))
+    return (state if full else state[active_states(P)]), float(op.valve_null)
 
 
 def to_statespace(cfg: PlantConfig, position: float, load: float | str | None = None, *, gain: str = "mean",

@@ -90,6 +90,8 @@ def linear_section(linear: dict | None, start: int) -> tuple[dict | None, list[d
 
 def governor_basis(b: dict) -> list[str]:
     """Where the HYGOV figures come from, in sentences (never a raw dict)."""
+    if b.get("sentences"):  # the governor export writes its own (compliance.linear.governor_formats)
+        return [str(s) for s in b["sentences"]]
     out = []
     pt = b.get("Tg_point") or {}
     samples = [v for v in b.get("Tg_nonlinear_samples") or [] if isinstance(v, (int, float))]
