@@ -187,7 +187,7 @@ def _run_friction(args, first, meta) -> int:
             raise InputError(f"{path}: not a friction-bench run like {args.recordings[0]} (needs force and no valve command)")
         runs.append((f, m))
     bore = parse_quantity(args.friction_bore, "m", "--friction-bore") if args.friction_bore else None
-    result = diagnose_friction(runs, bore=bore)
+    result = diagnose_friction(runs, bore=bore, jobs=args.jobs)
     data = result.to_dict()
     if args.json:
         write_json_atomic(args.json, _finish(data, args))
