@@ -246,9 +246,12 @@ def hac_information(jac_data: np.ndarray, vec: np.ndarray, model: ResidualModel,
     """
     k = jac_data.shape[1]
     s = np.zeros((k, k))
-    m = model.index.size
-    for b in range(len(model.signals)):
-        g = jac_data[b * m:(b + 1) * m] * vec[b * m:(b + 1) * m, None]
+    # one block per signal; a joint model of several recordings (joint.py) has blocks of its own lengths
+    sizes = getattr(model, "block_sizes", None) or [model.index.size] * len(model.signals)
+    start = 0
+    for m in sizes:
+        g = jac_data[start:start + m] * vec[start:start + m, None]
+        start += m
         s += g.T @ g
         for lg in range(1, min(lag, m - 1) + 1):
             c = g[lg:].T @ g[:-lg]
