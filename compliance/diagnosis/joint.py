@@ -17,7 +17,9 @@ classic case: at one supply pressure the mean chamber pressure barely changes, s
 higher friction level and a rise of 30 % at that pressure are the same plant; at 70 % of the
 supply they are not.
 
-The candidate fits run on the shared executor (``campaign.executor.map_tasks``; a Dask
+An effect none of whose declared grid points removes ``SCREEN_SHARE`` (2 %) of the nominal
+excess chi-square is not refined (reported at its best grid point, marked ``screened``): each
+refinement costs one replay per recording per step. The candidate fits run on the shared executor (``campaign.executor.map_tasks``; a Dask
 scheduler with ``scheduler``). Not done jointly (the single-recording diagnosis does them):
 the multi-effect search, the friction-form check, the empirical term and the lag split.
 """
@@ -41,6 +43,7 @@ from compliance.diagnosis.report_data import SCHEMA
 from compliance.diagnosis.select import AMBIGUOUS_BIC, RESIDUAL_LIMIT, ambiguity_set, honest, score_all, signals_left, verdict
 
 _WORKER: dict = {}  # token -> JointContext, built once per worker process
+SCREEN_SHARE = 0.02  # share of the nominal excess chi-square an effect's best grid point must remove to be refined
 
 
 @dataclass
@@ -123,13 +126,14 @@ def _worker_context(payload) -> JointContext:
 
 
 def _task(payload, task):
-    """One joint fit on a worker: ('base', params, penalty) or ('effect', name); returns (FitResult, residual vector)."""
+    """One joint fit on a worker: ('base', params, penalty) or ('effect', name, screen chi-square); returns
+    (FitResult, residual vector)."""
     ctx = _worker_context(payload)
     if task[0] == "base":
         res, log = forward_select_base(ctx, task[1], penalty=task[2])
         res.scan = log
     else:
-        res = fit_candidate(ctx, effect_candidate(task[1]), None)
+        res = fit_candidate(ctx, effect_candidate(task[1]), None, screen=task[2])
     vec, _ = ctx.residual(res.params, res.values)
     return res, vec
 
@@ -165,6 +169,7 @@ class JointDiagnosis:
                 "parameters": [{"name": fp.key, "kind": fp.kind, "value": json_number(v), "stderr": json_number(e), "unit": fp.unit}
                                for fp, v, e in zip(f.params, f.values, f.stderr)],
                 "per_recording": _per_recording(self.objectives[name], self.recordings),
+                "screened": f.message.startswith("screened"),
             })
         return {"schema": SCHEMA, "kind": "joint", "verdict": self.verdict, "reason": self.reason, "winner": self.winner,
                 "ambiguous": self.ambiguous, "n_residuals": self.n, "recordings": self.recordings, "effects": effects,
@@ -226,7 +231,11 @@ def _fit_all(stages, labels, names, recalibrate, jobs, scheduler) -> tuple[dict,
     bparams = (base_params(stages[0].rc, keys) if keys else base_params(stages[0].rc)) if recalibrate else ()
     if bparams:
         tasks.append(("base", bparams, 2.0 * math.log(n) * max(1.0, chi2_nom / n)))
-    tasks += [("effect", e) for e in signature_order(names, excess)]
+    # an effect none of whose grid points removes SCREEN_SHARE of the nominal excess is not refined (our choice:
+    # a candidate must remove select.MIN_GAIN = 25 % to matter; the refinement of one that starts at 2 % costs the
+    # same replays as a real one, times the number of recordings)
+    screen = chi2_nom - SCREEN_SHARE * max(chi2_nom - n, 0.0)
+    tasks += [("effect", e, screen) for e in signature_order(names, excess)]
     token = f"joint-{time.time_ns()}"
     payload = (token, tuple(labels), [(plant_to_toml(s.rc), s.setup, s.model) for s in stages])
     results, stats = map_tasks(_task, payload, tasks, workers=jobs, scheduler=scheduler, progress=False,
