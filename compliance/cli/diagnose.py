@@ -213,7 +213,15 @@ def _run_joint(args, plant_arg, effects) -> int:
     for flag, value in (("--save-model", args.save_model), ("--report", args.report), ("--suggest-test", args.suggest_test)):
         if value:
             raise InputError(f"{flag}: not available for a joint diagnosis of several recordings (use --json)")
-    parse_scheduler(args.scheduler)  # a bad address is exit 2 before any work
+    from compliance.cli.sweep import _check_scheme
+
+    _check_scheme(*parse_scheduler(args.scheduler))  # a bad address is exit 2 before any work (the sweep's check)
+    seen = set()
+    for path in args.recordings:
+        key = Path(path).resolve()
+        if key in seen:
+            raise InputError(f"{path}: given twice; a joint diagnosis needs different recordings of the plant")
+        seen.add(key)
     recs = [read_recording(path, args.column_map) for path in args.recordings]
     plant = plant_arg or sidecar_plant(recs[0][1], args.recordings[0])
     if not plant:
