@@ -80,7 +80,7 @@ def test_earns_needs_most_runs_and_a_median_gain():
     assert not earns(table([0.98, 0.98, 0.98, 0.98]), table([1.0, 1.0, 1.0, 1.0]))["earned"]  # 2 % gain only
 
 
-def test_real_o_ring_fixture_held_out_table():
+def test_real_o_ring_fixture_held_out_table(tmp_path):
     """Four real O-ring runs (heads of the 1, 3, 5, 7 bar files): every pressure predicted by the law fitted on
     the other three. Measured: median held-out / in-sample 1.5 with each run's force zero as fitted, 1.2 with the
     held-out run's own zero (the run-to-run offsets of up to ~1 N are the bench's, reported, not modelled)."""
@@ -88,7 +88,8 @@ def test_real_o_ring_fixture_held_out_table():
 
     files = sorted((DATA / "zillen").glob("O-ring257_*bar_head1000.csv"))
     assert len(files) == 4
-    d = diagnose_friction([read_recording(f, "zillen-friction", required=("time",)) for f in files], jobs=1).to_dict()
+    diag = diagnose_friction([read_recording(f, "zillen-friction", required=("time",)) for f in files], jobs=1)
+    d = diag.to_dict()
     (seal,) = d["seals"]
     h = seal["holdout"]
     assert [round(r["pressure_gauge"] / 1e5) for r in h["runs"]] == [1, 3, 5, 7]
@@ -99,3 +100,7 @@ def test_real_o_ring_fixture_held_out_table():
     assert h["median_ratio"] <= 2.0
     assert seal["position_effect"]["runs"] == 4
     assert "Out of sample" in seal["explanation"]
+    from compliance.report.friction import write_friction_report
+
+    html = write_friction_report(diag, tmp_path / "f.html").read_text()
+    assert "Out of sample: each pressure predicted" in html and "O-ring257_7bar_head1000.csv" in html
