@@ -125,17 +125,23 @@ def _worker_context(payload) -> JointContext:
     return _WORKER[token]
 
 
-def _task(payload, task):
-    """One joint fit on a worker: ('base', params, penalty) or ('effect', name, screen chi-square); returns
-    (FitResult, residual vector)."""
+def _task(payload, task) -> FitResult:
+    """One joint fit on a worker: ('base', params, penalty) or ('effect', name, screen chi-square)."""
     ctx = _worker_context(payload)
     if task[0] == "base":
         res, log = forward_select_base(ctx, task[1], penalty=task[2])
         res.scan = log
-    else:
-        res = fit_candidate(ctx, effect_candidate(task[1]), None, screen=task[2])
-    vec, _ = ctx.residual(res.params, res.values)
-    return res, vec
+        return res
+    return fit_candidate(ctx, effect_candidate(task[1]), None, screen=task[2])
+
+
+def _prepare_task(context, item):
+    """Stages 1-2 of the single-recording engine on one recording (a worker task)."""
+    from compliance.diagnosis.engine import prepare_recording
+
+    cfg, stride = context
+    frame, meta = item
+    return prepare_recording(cfg, frame, meta, stride, 1)
 
 
 @dataclass
@@ -201,21 +207,23 @@ def _conditions(stage) -> dict:
             "sample_time": rc.p("controller.sample_time"), "duration": float(st.time[-1])}
 
 
-def _stages(cfg: PlantConfig, recordings, stride: int) -> tuple[list, list]:
-    """Stages 1-2 of the single-recording engine on each recording; labels R1, R2, ... (or the file names)."""
-    from compliance.diagnosis.engine import prepare_recording
+def _stages(cfg: PlantConfig, recordings, stride: int, jobs, scheduler) -> tuple[list, list]:
+    """Stages 1-2 of the single-recording engine on each recording, in parallel; labels R1, R2, ... in order."""
+    from compliance.campaign.executor import map_tasks, warm_up
 
-    stages, labels = [], []
     for i, (frame, meta) in enumerate(recordings, 1):
         if "reference" not in frame.columns:
             raise InputError(f"{meta.get('source_path', f'recording {i}')}: a joint diagnosis needs closed-loop recordings "
                              "(a 'reference' column); diagnose an open-loop recording on its own")
-        stages.append(prepare_recording(cfg, frame, meta, stride, 1))
-        labels.append(f"R{i}")
-    return stages, labels
+    warm_up(cfg)  # the compiled core loaded once, before the workers fork
+    stages, stats = map_tasks(_prepare_task, (cfg, stride), list(recordings), workers=jobs, scheduler=scheduler,
+                              progress=False, label="replays", retries=0)
+    if stats.failed:  # bad input (InputError) is raised by the executor itself; this is a bug
+        raise RuntimeError(f"replay of recording {stats.errors[0][0] + 1} failed: {stats.errors[0][1]}")
+    return stages, [f"R{i}" for i in range(1, len(stages) + 1)]
 
 
-def _fit_all(stages, labels, names, recalibrate, jobs, scheduler) -> tuple[dict, dict, object]:
+def _fit_all(stages, labels, names, recalibrate, jobs, scheduler) -> tuple[dict, object]:
     """Stage 3, joint: the recalibration and one fit per effect, each with one parameter set for every recording."""
     from compliance.model.config import plant_to_toml
     from compliance.campaign.executor import map_tasks
@@ -242,10 +250,7 @@ def _fit_all(stages, labels, names, recalibrate, jobs, scheduler) -> tuple[dict,
                                label="joint fits", retries=1)
     if stats.failed:
         raise RuntimeError(f"joint fit failed: {stats.errors[0][1]}")
-    fits, vecs = {}, {}
-    for res, vec in results:
-        fits[res.name], vecs[res.name] = res, vec
-    return fits, vecs, stats
+    return {res.name: res for res in results}, stats
 
 
 def diagnose_joint(cfg: PlantConfig, recordings, *, effects=None, jobs: int | None = None, scheduler: str | None = None,
@@ -280,8 +285,8 @@ def diagnose_joint(cfg: PlantConfig, recordings, *, effects=None, jobs: int | No
     if not recordings:
         raise InputError("a joint diagnosis needs at least one recording")
     names = check_effects(cfg, effects)
-    stages, labels = _stages(cfg, recordings, stride)
-    fits, vecs, stats = _fit_all(stages, labels, names, recalibrate, jobs, scheduler)
+    stages, labels = _stages(cfg, recordings, stride, jobs, scheduler)
+    fits, stats = _fit_all(stages, labels, names, recalibrate, jobs, scheduler)
     model = JointModel([s.model for s in stages], labels)
     n = model.size
     nvec = np.concatenate([s.nvec for s in stages])
@@ -301,7 +306,7 @@ def diagnose_joint(cfg: PlantConfig, recordings, *, effects=None, jobs: int | No
                                                                     for k, v in _conditions(s).items()},
              "n_residuals": s.model.size, "floors": {k: json_number(v) for k, v in s.model.floors.items()}}
             for lab, s in zip(labels, stages)]
-    sims = sum(s.sims for s in stages) + sum(f.sims + len(stages) for k, f in fits.items() if k != "nominal")
+    sims = sum(s.sims for s in stages) + sum(f.sims for k, f in fits.items() if k != "nominal")
     notes = [f"{lab}: {note}" for lab, s in zip(labels, stages) for note in s.setup.notes]
     return JointDiagnosis(verdict_name, reason, winner, ambiguous, fits, scores, objectives, recs, n,
                           time.perf_counter() - t0, sims, stats.workers, stats.backend, notes)
