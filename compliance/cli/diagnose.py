@@ -41,13 +41,16 @@ def register(sub):
             "govcheck diagnose plant-a run.csv.gz --effects heat_transfer,internal_leakage --save-model fitted.toml",
             "govcheck diagnose tests/data/practice/practice_valve_dynamics.csv.gz --report diag.html",
             "govcheck diagnose O-ring257_*bar.csv --column-map zillen-friction --friction-bore '25.7 mm' --report f.html",
+            "govcheck diagnose plant-a run-8bar.csv run-5.6bar.csv --json joint.json   # shared physics, each run's conditions",
         ],
         usage="govcheck diagnose [options] [CONFIG] RECORDING [RECORDING ...]",
     )
-    add_recording_inputs(p, "the recording file(s); several only for friction runs")
+    add_recording_inputs(p, "the recording file(s); several closed-loop recordings of one plant are diagnosed jointly")
     p.add_argument("--effects", help="comma-separated candidate effects (default: every declared effect)")
     p.add_argument("--no-recalibration", action="store_true", help="do not consider recalibrating base parameters")
     add_jobs(p)
+    p.add_argument("--scheduler", metavar="ADDR", help="several recordings: run the joint fits on Dask (local:N or "
+                                                        "tcp://host:8786); default the local process pool")
     p.add_argument("--friction-bore", help='friction bench: piston bore, e.g. "25.7 mm" (else the column map\'s metadata)')
     add_outputs(p, "json", "report", help={"json": "write the diagnosis (docs/diagnosis-schema.md) to FILE.json",
                                            "report": "write an HTML report with the before/after figures to FILE.html"})
@@ -81,7 +84,7 @@ def run(args) -> int:
     if _is_friction(first):
         return _run_friction(args, first, meta)
     if len(args.recordings) > 1:
-        raise InputError(f"{args.recordings[1]}: one servo recording at a time (several files are for friction-bench runs)")
+        return _run_joint(args, plant_arg, effects)
     frame, meta = read_recording(args.recordings[0], args.column_map)
     from compliance.model.config import load_plant
     from compliance.diagnosis.engine import diagnose, save_fitted
@@ -187,7 +190,7 @@ def _run_friction(args, first, meta) -> int:
             raise InputError(f"{path}: not a friction-bench run like {args.recordings[0]} (needs force and no valve command)")
         runs.append((f, m))
     bore = parse_quantity(args.friction_bore, "m", "--friction-bore") if args.friction_bore else None
-    result = diagnose_friction(runs, bore=bore)
+    result = diagnose_friction(runs, bore=bore, jobs=args.jobs)
     data = result.to_dict()
     if args.json:
         write_json_atomic(args.json, _finish(data, args))
@@ -196,4 +199,44 @@ def _run_friction(args, first, meta) -> int:
 
         write_friction_report(result, args.report)
     print(format_friction(data, args.quiet))
+    return 0
+
+
+def _run_joint(args, plant_arg, effects) -> int:
+    """Several closed-loop recordings of one plant: one diagnosis with shared physics (diagnosis.joint)."""
+    from compliance.campaign.executor import parse_scheduler
+    from compliance.cli.progress import progress
+    from compliance.diagnosis.joint import diagnose_joint, format_joint
+    from compliance.model.config import load_plant
+    from compliance.recordings.reader import read_recording
+
+    for flag, value in (("--save-model", args.save_model), ("--report", args.report), ("--suggest-test", args.suggest_test)):
+        if value:
+            raise InputError(f"{flag}: not available for a joint diagnosis of several recordings (use --json)")
+    from compliance.cli.sweep import _check_scheme
+
+    _check_scheme(*parse_scheduler(args.scheduler))  # a bad address is exit 2 before any work (the sweep's check)
+    seen = set()
+    for path in args.recordings:
+        key = Path(path).resolve()
+        if key in seen:
+            raise InputError(f"{path}: given twice; a joint diagnosis needs different recordings of the plant")
+        seen.add(key)
+    recs = [read_recording(path, args.column_map) for path in args.recordings]
+    plant = plant_arg or sidecar_plant(recs[0][1], args.recordings[0])
+    if not plant:
+        raise InputError(f"{args.recordings[0]}: no CONFIG given and the sidecar names no 'plant'")
+    cfg = load_plant(plant)
+    for path, (frame, meta) in zip(args.recordings, recs):
+        check_sidecar_conditions(cfg, meta, path)
+        if "reference" not in frame.columns:
+            raise InputError(f"{path}: no 'reference' column; a joint diagnosis needs closed-loop recordings")
+    with progress(1, "diagnose", quiet=args.quiet, unit="stage", first=f"{len(recs)} recordings, shared physics") as bar:
+        diag = diagnose_joint(cfg, recs, effects=effects, jobs=args.jobs, scheduler=args.scheduler,
+                              recalibrate=not args.no_recalibration)
+        bar.update(1)
+    data = diag.to_dict()
+    if args.json:
+        write_json_atomic(args.json, _finish(data, args))
+    print(format_joint(data, args.quiet))
     return 0

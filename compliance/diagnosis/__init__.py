@@ -6,6 +6,8 @@ Public API:
   replay, locate, fit every candidate, select by BIC, explain; ``to_dict()`` is the JSON of
   docs/diagnosis-schema.md) and ``save_fitted(diagnosis, path)``;
 - ``diagnose_friction(runs, bore=None)`` -> ``FrictionDiagnosis`` (seal-friction bench runs);
+- ``diagnose_joint(cfg, recordings)`` -> ``JointDiagnosis`` (several closed-loop recordings of one
+  plant: shared physics, each recording's own conditions and floors);
 - ``run_benchmark(cfg, ...)`` and ``run_practice(directory, cfg)`` (the proof on generated
   concealed-effect cases and on recordings with answers).
 
@@ -18,13 +20,15 @@ simplex, least squares), ``recalibration`` (base parameters), ``multi`` (several
 pin a lag's split or only its total), ``empirical`` (the missing force
 outside the library), ``located`` (where the model misses), ``explain`` (the paragraph),
 ``fitted_model`` (the fitted plant), ``engine`` (the chain),
-``concealed`` / ``benchmark`` / ``practice_score`` (the proof), ``friction_models`` / ``friction_diagnosis`` /
+``joint`` (several recordings at once),
+``concealed`` / ``benchmark`` / ``practice_score`` (the proof), ``friction_models`` / ``friction_fit`` /
+``friction_position`` / ``friction_holdout`` / ``friction_diagnosis`` / ``friction_explain``
 (the friction bench; its report is compliance/report/friction.py).
 """
 
 from __future__ import annotations
 
-__all__ = ["diagnose", "save_fitted", "Diagnosis", "diagnose_friction", "run_benchmark", "run_practice"]
+__all__ = ["diagnose", "save_fitted", "Diagnosis", "diagnose_friction", "diagnose_joint", "run_benchmark", "run_practice"]
 
 
 def __getattr__(name):  # lazy: importing the package does not compile the simulator
@@ -36,6 +40,10 @@ def __getattr__(name):  # lazy: importing the package does not compile the simul
         from compliance.diagnosis.friction_diagnosis import diagnose_friction
 
         return diagnose_friction
+    if name == "diagnose_joint":
+        from compliance.diagnosis.joint import diagnose_joint
+
+        return diagnose_joint
     if name in ("run_benchmark", "run_practice"):
         from compliance.diagnosis import benchmark
 

@@ -156,6 +156,8 @@ def suggestion_lines(suggestion: dict | None) -> list[str]:
     for row in suggestion["tests"]:
         diff = "not simulated" if row["difference"] is None else f"{row['difference']:.2f} on {row['signal']}"
         lines.append(f"    {row['test']:48s} {diff}")
+    lines.append("  once recorded: govcheck diagnose CONFIG THIS_RECORDING NEW_RECORDING (both at once: shared physics, "
+                 "each with its own conditions)")
     return lines
 
 

@@ -376,4 +376,7 @@ def _safe_replay(cfg: PlantConfig, setup: ReplaySetup, notes: list, what: str):
         return None
 
 
-__all__ = ["Diagnosis", "diagnose", "save_fitted", "default_jobs", "SCHEMA", "UNITS", "NOISE_TOLERANCE"]
+# stages 1-2 of one recording and the candidate list, public for the joint diagnosis (joint.py)
+prepare_recording, check_effects = _prepare, _check_effects
+
+__all__ = ["Diagnosis", "diagnose", "prepare_recording", "check_effects", "save_fitted", "default_jobs", "SCHEMA", "UNITS", "NOISE_TOLERANCE"]

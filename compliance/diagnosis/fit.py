@@ -246,9 +246,12 @@ def hac_information(jac_data: np.ndarray, vec: np.ndarray, model: ResidualModel,
     """
     k = jac_data.shape[1]
     s = np.zeros((k, k))
-    m = model.index.size
-    for b in range(len(model.signals)):
-        g = jac_data[b * m:(b + 1) * m] * vec[b * m:(b + 1) * m, None]
+    # one block per signal; a joint model of several recordings (joint.py) has blocks of its own lengths
+    sizes = getattr(model, "block_sizes", None) or [model.index.size] * len(model.signals)
+    start = 0
+    for m in sizes:
+        g = jac_data[start:start + m] * vec[start:start + m, None]
+        start += m
         s += g.T @ g
         for lg in range(1, min(lag, m - 1) + 1):
             c = g[lg:].T @ g[:-lg]
@@ -284,7 +287,8 @@ def scan_points(ctx: FitContext, params, points: list[list[float]]) -> list[floa
     return out
 
 
-def fit_candidate(ctx: FitContext, cand: Candidate, base_fit: FitResult | None, *, max_nfev: int = MAX_NFEV) -> FitResult:
+def fit_candidate(ctx: FitContext, cand: Candidate, base_fit: FitResult | None, *, max_nfev: int = MAX_NFEV,
+                  screen: float | None = None) -> FitResult:
     """Fit one effect on top of the recalibrated base, co-fitting the recalibrated base parameters.
 
     The effect's grid is scanned with the base parameters at their recalibrated values; the
@@ -292,6 +296,9 @@ def fit_candidate(ctx: FitContext, cand: Candidate, base_fit: FitResult | None, 
     them along a valley (a spool delay against a slower spool, a sensor delay against its lag),
     so a second local fit starts from the best grid point with another main-parameter value
     when it is within ``SECOND_START`` of the best, and the better result is kept.
+
+    ``screen`` (a chi-square): when no grid point gets below it, the candidate is not refined and
+    its result is the best grid point (``message`` says so; no standard errors).
     """
     t0 = time.perf_counter()
     sims0 = ctx.sims
@@ -306,6 +313,13 @@ def fit_candidate(ctx: FitContext, cand: Candidate, base_fit: FitResult | None, 
     all_params = tuple(eparams) + bparams
     chis = scan_points(ctx, all_params, points)
     best = int(np.argmin(chis))
+    if screen is not None and chis[best] > screen:
+        vec, _ = ctx.residual(all_params, points[best])
+        chi2, parts = chi2_parts(ctx.model, vec)
+        return FitResult(cand.name, tuple(all_params), list(points[best]), [math.nan] * len(all_params), chi2, parts,
+                         ctx.model.size, ctx.sims - sims0, time.perf_counter() - t0,
+                         "screened: no point of its grid removes enough to be refined",
+                         [(dict(zip([fp.key for fp in all_params], p)), c) for p, c in zip(points, chis)])
     res = least_squares_fit(ctx, cand.name, all_params, points[best], max_nfev=max_nfev)
     if len(eparams) > 1:
         others = [i for i in np.argsort(chis) if points[i][0] != points[best][0]]

@@ -32,8 +32,10 @@ from scipy.signal import savgol_filter
 from compliance.errors import InputError
 from compliance.files.jsonable import json_number
 from compliance.units import ATMOSPHERE_PA
-from compliance.diagnosis.friction_models import core_equivalent
 from compliance.diagnosis.friction_fit import LAWS, PRESLIDING, PRESSURE_EFFECT, LawFit, fit_law
+from compliance.diagnosis.friction_position import POSITION_FRICTION
+from compliance.diagnosis.friction_explain import explain_friction, format_friction  # noqa: F401 (re-exported)
+from compliance.diagnosis.friction_holdout import holdout_words, position_words, prove_out_of_sample
 from compliance.diagnosis.friction_runs import Run
 from compliance.diagnosis.noise_floor import sensor_noise_std
 from compliance.diagnosis.report_data import SCHEMA
@@ -48,7 +50,8 @@ MIN_SLIDING_SPEED = 1e-3  # m/s; slower samples are not "steady sliding"
 # differentiated from a noisy position, whose error adds ~1-2 x the force noise near the Stribeck hump
 FRICTION_RESIDUAL_LIMIT = 3.0
 UNITS = {"bias": "N", "bias_per_pressure": "N/Pa", "coulomb": "N", "static": "N", "stribeck_velocity": "m/s",
-         "viscous": "N*s/m", "pressure_coefficient": "N/Pa", "bristle_stiffness": "N/m"}
+         "viscous": "N*s/m", "pressure_coefficient": "N/Pa", "bristle_stiffness": "N/m", "reference_position": "m",
+         **{q.name: q.unit for q in POSITION_FRICTION.params}}
 MEANING = {
     "bias": "force-sensor zero (direction-independent)",
     "bias_per_pressure": "piston-area error: direction-independent force per Pa of chamber pressure",
@@ -58,6 +61,8 @@ MEANING = {
     "viscous": "viscous coefficient b",
     "pressure_coefficient": "rise of F_C and F_S per Pa of chamber gauge pressure, k_p",
     "bristle_stiffness": "LuGre bristle stiffness sigma0 (pre-sliding distance = F_C/sigma0)",
+    "reference_position": "x_r, centre of the position-dependent friction (median position of the runs; not fitted)",
+    **{q.name: q.meaning for q in POSITION_FRICTION.params},
 }
 
 
@@ -185,6 +190,8 @@ class SealDiagnosis:
     explanation: str
     noise_floor: float
     structure: dict | None = None  # friction_structure: what the law leaves, named (empirical)
+    holdout: dict | None = None  # friction_holdout: each pressure predicted by the law fitted on the others
+    position: dict | None = None  # friction_holdout: does position_dependent_friction earn its parameters held out
 
     def to_dict(self) -> dict:
         """JSON-ready (SI units; see docs/diagnosis-schema.md, friction)."""
@@ -213,14 +220,20 @@ class SealDiagnosis:
                            for r, a in zip(self.runs, win.rms_per_run())} if win else None),
             "windows": self.located, "windows_after": self.located_after,
             "noise_floor": {"value": json_number(self.noise_floor), "unit": "N"},
-            "structure_left": self.structure,
+            "structure_left": self.structure, "holdout": self.holdout, "position_effect": self.position,
         }
 
 
 
 
-def diagnose_seal(runs: list[Run]) -> SealDiagnosis:
-    """Fit the baseline and each candidate law to one seal's runs; select; explain."""
+def _scores(fits: dict, n: int) -> dict:
+    scores = score_all({"nominal": _as_fit(fits["baseline"]), **{k: _as_fit(v) for k, v in fits.items() if k != "baseline"}}, n)
+    scores["baseline"] = scores.pop("nominal")
+    return scores
+
+
+def diagnose_seal(runs: list[Run], jobs: int | None = None) -> SealDiagnosis:
+    """Fit the baseline and each candidate law to one seal's runs; select; prove out of sample; explain."""
     fits = {"baseline": fit_law(runs, "baseline")}
     b = fits["baseline"].params
     warm = {"bias": b["bias"], "bias_per_pressure": b["bias_per_pressure"], "coulomb": b["coulomb"],
@@ -241,8 +254,7 @@ def diagnose_seal(runs: list[Run]) -> SealDiagnosis:
                           "bristle_stiffness": math.log10(fits[PRESLIDING].params["bristle_stiffness"])})
         fits[name] = fit_law(runs, name, start)
     n = fits["baseline"].n
-    scores = score_all({"nominal": _as_fit(fits["baseline"]), **{k: _as_fit(v) for k, v in fits.items() if k != "baseline"}}, n)
-    scores["baseline"] = scores.pop("nominal")
+    scores = _scores(fits, n)
     located = locate_friction(runs, fits["baseline"])
     floor = float(np.median([r.floor for r in runs]))
     rms_norm = math.sqrt(fits["baseline"].chi2 / n)
@@ -261,13 +273,21 @@ def diagnose_seal(runs: list[Run]) -> SealDiagnosis:
             if k != best and set(k.split("+")) < set(best.split("+")) and scores[k].bic - scores[best].bic < SIGNIFICANCE:
                 winner = k
         verdict = "missing_physics" if scores[winner].explained >= EXPLAINED_ENOUGH else "unexplained"
+    proof = prove_out_of_sample(runs, fits, winner or "baseline", verdict != "no_mismatch", jobs=jobs)
+    if proof["law"] != (winner or "baseline"):  # position_dependent_friction earned its parameters held out ...
+        scores = _scores(fits, n)
+        if scores[winner or "baseline"].bic - scores[proof["law"]].bic >= SIGNIFICANCE:  # ... and by BIC
+            winner = proof["law"]
+            cands.append(winner)
+            verdict = "missing_physics" if scores[winner].explained >= EXPLAINED_ENOUGH else "unexplained"
     ranked = sorted(cands, key=lambda k: scores[k].bic)
     runner = next((k for k in ranked if k != winner), None)
     located_after = locate_friction(runs, fits[winner]) if winner else None
     after = math.sqrt(fits[winner].chi2 / n) if winner else rms_norm
     if verdict == "missing_physics" and after > FRICTION_RESIDUAL_LIMIT:
         verdict = "partially_explained"  # as select.honest: complete only within the stated multiple of the noise
-    diag = SealDiagnosis(runs[0].seal, runs, fits, scores, verdict, winner, runner, located, located_after, "", floor)
+    diag = SealDiagnosis(runs[0].seal, runs, fits, scores, verdict, winner, runner, located, located_after, "", floor,
+                         holdout=proof["holdout"], position=proof["position"])
     if verdict != "no_mismatch":
         diag.structure = friction_structure(runs, fits[winner or "baseline"])
     diag.explanation = explain_friction(diag)
@@ -275,6 +295,8 @@ def diagnose_seal(runs: list[Run]) -> SealDiagnosis:
         diag.explanation += (f" The law leaves {after:.1f} times the force noise (complete only within "
                              f"{FRICTION_RESIDUAL_LIMIT:g});"
                              f" empirical suggestion, not a declared effect: {diag.structure['words']}")
+    if diag.holdout:
+        diag.explanation += holdout_words(diag.holdout, diag.seal) + position_words(diag.position)
     return diag
 
 
@@ -282,56 +304,6 @@ def _as_fit(f: LawFit):
     from compliance.diagnosis.fit import FitResult
 
     return FitResult(f.name, tuple(range(f.k)), [], [], f.chi2, {}, f.n)
-
-
-def explain_friction(d: SealDiagnosis) -> str:
-    """One paragraph for a plant engineer."""
-    base = d.fits["baseline"]
-    rb = base.rms_per_run()
-    runs = d.runs
-    lo, hi = int(np.argmin([r.pressure for r in runs])), int(np.argmax([r.pressure for r in runs]))
-    bp = base.params
-    text = (f"Seal {d.seal}: a pressure-independent Stribeck law (F_C {bp['coulomb']:.2f} N, F_S {bp['static']:.2f} N, "
-            f"b {bp['viscous']:.0f} N*s/m) leaves an RMS friction error of {np.mean(rb):.2f} N over the {len(runs)} runs "
-            f"({math.sqrt(base.chi2 / base.n):.0f} times the force noise of {d.noise_floor:.2f} N).")
-    loc = d.located
-    trend = loc.get("pressure_trend")
-    if trend:
-        text += (f" Where it fails: in steady sliding the seal rubs {abs(trend['per_bar']):.2f} N per bar "
-                 f"{'harder' if trend['per_bar'] > 0 else 'less'} than the law says as the pressure rises "
-                 f"({trend['span']:+.2f} N across the pressures)")
-    else:
-        text += " Where it fails:"
-    if loc.get("reversal_excess"):
-        text += (f"{';' if trend else ''} after each reversal the residual is {loc['reversal_excess']:.1f} times its sliding level "
-                 f"- the friction builds up over the first millimetres of travel instead of jumping.")
-    else:
-        text += "."
-    if d.verdict == "no_mismatch":
-        return text + " The law already fits within the force noise: nothing is missing."
-    if d.winner is None:
-        tested = "pressure-dependent friction, pre-sliding hysteresis" if PRESSURE_EFFECT in d.fits else (
-            "pre-sliding hysteresis; pressure dependence needs runs at two or more pressures")
-        return text + f" None of the candidate physics ({tested}) removes enough of it: unexplained."
-    w = d.fits[d.winner]
-    p = w.params
-    parts = []
-    if "pressure_coefficient" in p:
-        parts.append(f"seal friction that rises with the chamber pressure (k_p = {p['pressure_coefficient']*1e5:.2f} N/bar "
-                     f"on F_C and F_S{core_equivalent(p)})")
-    if "bristle_stiffness" in p:
-        pm = float(np.mean([r.pressure for r in runs]))
-        fc = p["coulomb"] + p.get("pressure_coefficient", 0.0) * pm
-        parts.append(f"pre-sliding hysteresis at reversals (LuGre bristles, sigma0 = {p['bristle_stiffness']/1e3:.3g} N/mm: "
-                     f"the friction builds up over a pre-sliding distance F_C/sigma0 of about {fc/p['bristle_stiffness']*1e3:.2f} mm "
-                     f"at {pm/1e5:.1f} bar)")
-    ra = w.rms_per_run()
-    text += (f" The missing physics: {' and '.join(parts)}. Adding it cuts the RMS friction error from {np.mean(rb):.2f} N to "
-             f"{np.mean(ra):.2f} N ({rb[lo]:.2f} -> {ra[lo]:.2f} N at {runs[lo].pressure/1e5:.1f} bar, "
-             f"{rb[hi]:.2f} -> {ra[hi]:.2f} N at {runs[hi].pressure/1e5:.1f} bar).")
-    if d.verdict == "unexplained":
-        text += " It still leaves most of the error: the rest is physics outside these candidates (e.g. position-dependent friction)."
-    return text
 
 
 @dataclass
@@ -350,7 +322,7 @@ class FrictionDiagnosis:
                 "seals": [s.to_dict() for s in self.seals], "timing": {"seconds": self.seconds}}
 
 
-def diagnose_friction(runs, *, bore: float | None = None) -> FrictionDiagnosis:
+def diagnose_friction(runs, *, bore: float | None = None, jobs: int | None = None) -> FrictionDiagnosis:
     """Diagnose friction-bench runs, grouped per seal (file name before the pressure).
 
     Parameters
@@ -358,6 +330,8 @@ def diagnose_friction(runs, *, bore: float | None = None) -> FrictionDiagnosis:
     runs : sequence of (DataFrame, metadata)
     bore : float, optional
         Piston bore [m] (else from the metadata).
+    jobs : int, optional
+        Worker processes of the held-out fits (default: the available cores).
     """
     import time as _time
 
@@ -369,25 +343,6 @@ def diagnose_friction(runs, *, bore: float | None = None) -> FrictionDiagnosis:
     out = FrictionDiagnosis(files=[str(m.get("source_path", "")) for _, m in runs])
     for seal, rs in groups.items():
         rs.sort(key=lambda r: r.pressure)
-        out.seals.append(diagnose_seal(rs))
+        out.seals.append(diagnose_seal(rs, jobs))
     out.seconds = _time.perf_counter() - t0
     return out
-
-
-def format_friction(d: dict, quiet: bool = False) -> str:
-    """Console summary of a friction diagnosis."""
-    lines = []
-    for s in d["seals"]:
-        lines.append(f"seal {s['seal']}: verdict {s['verdict']}" + (f" ({s['winner']})" if s["winner"] else ""))
-        if quiet:
-            continue
-        lines.append("  " + s["explanation"])
-        lines.append(f"  {'candidate':50s} {'k':>2s} {'chi2/N':>9s} {'dBIC':>9s}")
-        for e in s["effects"]:
-            lines.append(f"  {e['name']:50s} {e['k']:2d} {e['chi2_per_residual']:9.2f} {e['delta_bic']:9.1f}")
-        lines.append(f"  {'run':28s} {'p [bar g]':>9s} {'RMS before [N]':>15s} {'RMS after [N]':>14s}")
-        for run, b in s["fit_before"].items():
-            a = (s["fit_after"] or {}).get(run)
-            lines.append(f"  {run:28s} {b['pressure_gauge']/1e5:9.2f} {b['rms']:15.3f} {a['rms'] if a else float('nan'):14.3f}")
-    lines.append(f"{d['timing']['seconds']:.1f} s")
-    return "\n".join(lines)

@@ -17,12 +17,14 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from compliance.diagnosis.friction_models import bias_force, friction_force
+from compliance.diagnosis.friction_position import POSITION_FRICTION, reference_position
 from compliance.diagnosis.friction_runs import Run
 
 
 MAX_NFEV = 40  # least-squares evaluations per candidate law (besides the Jacobian's)
 PRESSURE_EFFECT = "pressure_dependent_friction"
 PRESLIDING = "presliding_hysteresis"
+POSITION_EFFECT = POSITION_FRICTION.name
 LAWS = {  # candidate -> (pressure dependent, pre-sliding)
     "baseline": (False, False),
     PRESSURE_EFFECT: (True, False),
@@ -59,20 +61,29 @@ _SPEC = {  # name -> (low, high, log)
     "viscous": (0.0, 1e4, False),
     "pressure_coefficient": (0.0, 1e-3, False),
     "bristle_stiffness": (1e2, 1e8, True),
+    **{q.name: (q.bounds[0], q.bounds[1], q.log_scale) for q in POSITION_FRICTION.params},
 }
 
 
-def _names(pressure: bool, presliding: bool) -> list[str]:
+def law_flags(name: str) -> tuple[bool, bool, bool]:
+    """(pressure dependent, pre-sliding, position dependent) of a law named by its effects joined by ``+``."""
+    parts = set(name.split("+"))
+    return PRESSURE_EFFECT in parts, PRESLIDING in parts, POSITION_EFFECT in parts
+
+
+def _names(pressure: bool, presliding: bool, position: bool = False) -> list[str]:
     names = ["bias", "bias_per_pressure", "coulomb", "excess", "stribeck_velocity", "viscous"]
     if pressure:
         names.append("pressure_coefficient")
     if presliding:
         names.append("bristle_stiffness")
+    if position:
+        names += [q.name for q in POSITION_FRICTION.params]
     return names
 
 
-def _to_params(names, x) -> dict:
-    p = {}
+def _to_params(names, x, fixed: dict | None = None) -> dict:
+    p = dict(fixed or {})
     for n, v in zip(names, x):
         lo, hi, log = _SPEC[n]
         p[n] = 10.0 ** v if log else float(v)
@@ -81,18 +92,17 @@ def _to_params(names, x) -> dict:
 
 
 def _residuals(runs: list[Run], params: dict, presliding: bool) -> list[np.ndarray]:
-    out = []
-    for r in runs:
-        model = bias_force(r.pressure_gauge, params) + friction_force(r.velocity, r.pressure_gauge, r.time, params, presliding=presliding)
-        out.append((r.friction - model)[r.valid])
-    return out
+    return [(r.friction - _force(r, params, presliding))[r.valid] for r in runs]
+
+
+def _force(run: Run, params: dict, presliding: bool) -> np.ndarray:
+    return bias_force(run.pressure_gauge, params) + friction_force(run.velocity, run.pressure_gauge, run.time, params,
+                                                                   presliding=presliding, position=run.position)
 
 
 def predict(run: Run, fit: LawFit) -> np.ndarray:
-    """The law's force (bias + friction) at every sample of a run [N]."""
-    presliding = LAWS[fit.name][1]
-    return bias_force(run.pressure_gauge, fit.params) + friction_force(run.velocity, run.pressure_gauge, run.time, fit.params,
-                                                                      presliding=presliding)
+    """The law's force (bias + friction) at every sample of a run [N] (a run it was not fitted on, too)."""
+    return _force(run, fit.params, law_flags(fit.name)[1])
 
 
 def _start(runs: list[Run]) -> dict:
@@ -105,14 +115,16 @@ def _start(runs: list[Run]) -> dict:
     fp = float(np.median(np.concatenate(pos))) if any(a.size for a in pos) else 1.0
     fn = float(np.median(np.concatenate(neg))) if any(a.size for a in neg) else -1.0
     return {"bias": 0.5 * (fp + fn), "bias_per_pressure": 0.0, "coulomb": max(0.5 * (fp - fn), 0.1), "excess": 0.1 * max(0.5 * (fp - fn), 0.1),
-            "stribeck_velocity": math.log10(2e-3), "viscous": 0.0, "pressure_coefficient": 0.0, "bristle_stiffness": 4.0}
+            "stribeck_velocity": math.log10(2e-3), "viscous": 0.0, "pressure_coefficient": 0.0, "bristle_stiffness": 4.0,
+            **{q.name: q.default for q in POSITION_FRICTION.params}}
 
 
 def fit_law(runs: list[Run], name: str, start: dict | None = None) -> LawFit:
     """Fit one candidate law (``LAWS[name]``) to all runs by bounded least squares."""
     t0 = time.perf_counter()
-    pressure, presliding = LAWS[name]
-    names = _names(pressure, presliding)
+    pressure, presliding, position = law_flags(name)
+    names = _names(pressure, presliding, position)
+    fixed = {"reference_position": reference_position(runs)} if position else {}
     floors = [r.floor for r in runs]
     s0 = dict(_start(runs))
     if start:
@@ -123,7 +135,7 @@ def fit_law(runs: list[Run], name: str, start: dict | None = None) -> LawFit:
 
     def fun(x):
         count[0] += 1
-        p = _to_params(names, x)
+        p = _to_params(names, x, fixed)
         return np.concatenate([res / fl for res, fl in zip(_residuals(runs, p, presliding), floors)])
 
     x_start = np.clip(np.array([s0[n] for n in names], dtype=float), lo + 1e-9, hi - 1e-9)
@@ -150,7 +162,7 @@ def fit_law(runs: list[Run], name: str, start: dict | None = None) -> LawFit:
     chi2 = float(r @ r)
     n = r.size
     k = len(names)
-    params = _to_params(names, best.x)
+    params = _to_params(names, best.x, fixed)
     stderr = _param_stderr(names, best, chi2, n)
     return LawFit(name, params, stderr, chi2, k, n, _residuals(runs, params, presliding), time.perf_counter() - t0, count[0])
 
@@ -176,3 +188,13 @@ def _param_stderr(names, res, chi2, n) -> dict:
             out["static" if nme == "excess" else nme] = float(s)
     out.setdefault("static", float("nan"))
     return {k2: out.get(k2, float("nan")) for k2 in x}
+
+
+def start_from(params: dict) -> dict:
+    """Starting values (in the fit's own coordinates) at a fitted law's parameters: a refit starts where it ended."""
+    out = {k: v for k, v in params.items() if k in _SPEC}
+    out["excess"] = max(params["static"] - params["coulomb"], 0.0)
+    for k, (_, _, log) in _SPEC.items():
+        if log and k in out:
+            out[k] = math.log10(out[k])
+    return out

@@ -11,7 +11,9 @@ F_f the seal friction. Three friction laws, nested:
 - pre-sliding hysteresis, LuGre bristles (Canudas de Wit et al. 1995):
   dz/dt = v - sigma0 |v| z / g(v, p),  F_f = sigma0 z + b v, whose steady state is the map
   and which makes the friction build up over a pre-sliding displacement g/sigma0 after each
-  reversal instead of jumping.
+  reversal instead of jumping;
+- position-dependent seal friction (``friction_position.POSITION_FRICTION``): both levels
+  scale with 1 + a1 (x - x_r) + a2 (x - x_r)^2 along the stroke.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ import numpy as np
 from numba import njit
 
 from compliance.physics.friction import stribeck_magnitude
+from compliance.diagnosis.friction_position import MIN_FACTOR
 
 
 @njit(cache=True)
@@ -71,7 +74,19 @@ def stribeck_level(speed, pressure_gauge, coulomb0, static0, stribeck_velocity, 
     return _stribeck_levels(v, fc, fs, float(stribeck_velocity)).reshape(np.shape(speed))
 
 
-def friction_force(velocity, pressure_gauge, time, params: dict, *, presliding: bool, n_sub: int = 2) -> np.ndarray:
+def position_factor(position, params: dict) -> np.ndarray | float:
+    """Relative friction level along the stroke, 1 + a1 (x - x_r) + a2 (x - x_r)^2 (``position_dependent_friction``).
+
+    1.0 when the law has no ``position_gradient``; never below ``friction_position.MIN_FACTOR``.
+    """
+    if "position_gradient" not in params or position is None:
+        return 1.0
+    d = np.asarray(position, dtype=float) - params["reference_position"]
+    return np.maximum(1.0 + params["position_gradient"] * d + params.get("position_curvature", 0.0) * d * d, MIN_FACTOR)
+
+
+def friction_force(velocity, pressure_gauge, time, params: dict, *, presliding: bool, n_sub: int = 2,
+                   position=None) -> np.ndarray:
     """Seal friction of one run [N] under the law the parameters name.
 
     Parameters
@@ -85,13 +100,16 @@ def friction_force(velocity, pressure_gauge, time, params: dict, *, presliding: 
     params : dict
         ``coulomb`` [N], ``static`` [N], ``stribeck_velocity`` [m/s], ``viscous`` [N*s/m],
         ``pressure_coefficient`` [N/Pa] (0: pressure-independent), ``bristle_stiffness``
-        sigma0 [N/m] (with ``presliding``).
+        sigma0 [N/m] (with ``presliding``); with ``position_dependent_friction``: ``position_gradient``
+        [1/m], ``position_curvature`` [1/m^2], ``reference_position`` [m].
     presliding : bool
         LuGre bristles (True) or the static map.
+    position : ndarray, optional
+        Piston position [m] (read only by a law with ``position_gradient``).
     """
     v = np.asarray(velocity, dtype=float)
     g = stribeck_level(v, pressure_gauge, params["coulomb"], params["static"], params["stribeck_velocity"],
-                       params.get("pressure_coefficient", 0.0))
+                       params.get("pressure_coefficient", 0.0)) * position_factor(position, params)
     if presliding:
         dt = np.concatenate(([0.0], np.diff(np.asarray(time, dtype=float))))
         return _lugre_force(np.ascontiguousarray(v), np.ascontiguousarray(g), dt, float(params["bristle_stiffness"]), n_sub) \

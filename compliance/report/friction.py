@@ -2,7 +2,8 @@
 
 Figures per seal (matplotlib, inline SVG): measured friction against position (hysteresis
 loops) with the baseline law and the winner, for the lowest and highest pressure; friction
-against time over two strokes; the RMS error per pressure before and after.
+against time over two strokes; the RMS error per pressure before and after; the held-out table
+(each pressure predicted by the law fitted on the others).
 """
 
 from __future__ import annotations
@@ -133,7 +134,24 @@ def _seal_context(seal, sd: dict) -> dict:
                            "Use the law within the pressures tested and treat the remainder as model uncertainty.")
     return {"seal": sd["seal"], "verdict": sd["verdict"], "winner": sd["winner"], "runner_up": sd.get("runner_up"),
             "explanation": sd["explanation"], "params": params, "ranked": ranked, "runs": runs, "remarks": remarks,
-            "figures": seal_figures(seal)}
+            "figures": seal_figures(seal), "holdout": _holdout_context(sd.get("holdout"))}
+
+
+def _holdout_context(h: dict | None) -> dict | None:
+    """The held-out table of a seal (friction_holdout.holdout_table), formatted."""
+    from compliance.units.formatting import fmt_num, fmt_value
+
+    if not h:
+        return None
+    rows = [{"run": r["run"], "p": fmt_value(r["pressure_gauge"] / 1e5, "bar", 3), "ins": fmt_value(r["in_sample_rms"], "N", 3),
+             "held": fmt_value(r["held_out_rms"], "N", 3), "ratio": fmt_num(r["ratio"], 3),
+             "offset": fmt_value(r["held_out_offset"], "N", 2), "ratio0": fmt_num(r["ratio_without_offset"], 3),
+             "noise": fmt_value(r["noise_floor"], "N", 2)} for r in h["runs"]]
+    note = (f"Law {h['law']}, refitted without the held-out run. Median held-out / in-sample: {h['median_ratio']:.2f} "
+            f"(target \u2264 {h['ratio_target']:g}); with each run's own offset removed: {h['median_ratio_without_offset']:.2f}. "
+            "The run offset is the held-out run's force zero against the other runs' bias line: a bench finding "
+            "(the sensor zero moves between runs), not friction physics.")
+    return {"rows": rows, "note": note}
 
 
 def write_friction_report(diag, html_path) -> Path:
