@@ -8,6 +8,7 @@ combines its rows. Values are also formatted in each metric's display unit for t
 
 from __future__ import annotations
 
+from compliance.campaign.basis import requirement_basis, row_basis
 from compliance.campaign.plan import Job
 from compliance.units.formatting import fmt_margin_pct, fmt_value
 from compliance.requirements.tightening import check_tightening
@@ -20,7 +21,8 @@ from compliance.requirements.verdict import DISABLED, NOT_EVALUATED, OPEN, Verdi
 __all__ = ["fmt", "judge", "sample_dict"]
 
 # keys of the worst row copied into a requirement's entry
-_WORST_KEYS = ("run", "procedure", "operating_point", "value", "margin", "margin_pct", "status", "which", "display")
+_WORST_KEYS = ("run", "procedure", "operating_point", "value", "margin", "margin_pct", "status", "which", "display",
+               "basis", "basis_reason")
 
 
 def fmt(value, metric: str, digits: int = 3) -> str:
@@ -106,6 +108,31 @@ def _rows(cfg, reqset: RequirementSet, req, limit, by_key: dict) -> list[dict]:
             for o in req.operating_points:
                 out = by_key[f"{p}@{o}"]
                 rows.append(_row(req, p, o, limit, out.samples.get(key), out.error))
+        rows.extend(_extended_rows(req, limit, by_key, key))
+    for r in rows:
+        r["basis"], r["basis_reason"] = row_basis(cfg, reqset, req, r)
+    return rows
+
+
+def _extended_rows(req, limit, by_key: dict, key: str) -> list[dict]:
+    """Rows at operating points the requirement does not list where another requirement's run computed its
+    metric with one of its procedures: a computed figure is judged by every limit that applies there.
+
+    A point the requirement names in ``not_applicable`` is left out (the coverage gives its reason), as is a
+    run without an eligible value (the coverage gives the samples' reasons).
+    """
+    rows = []
+    for run_key, out in by_key.items():
+        p, o = run_key.split("@", 1)
+        if p not in req.procedures or o in req.operating_points or o in req.not_applicable or out.error:
+            continue
+        samples = out.samples.get(key) or []
+        if not any(s.eligible and s.value is not None for s in samples):
+            continue
+        row = _row(req, p, o, limit, samples, None)
+        row["extended"] = (f"{req.metric} was computed at {o} (a run another requirement asked for); {req.id} applies "
+                           f"wherever its metric is computed unless its file says why not (not_applicable)")
+        rows.append(row)
     return rows
 
 
@@ -142,6 +169,7 @@ def judge(cfg, reqset: RequirementSet, jobs: list[Job], outcomes) -> tuple[list[
             "standard": req.standard,
             "clause": req.clause,
             "metric": req.metric,
+            "request_key": request_key(req.metric, req.options),
             "unit": METRICS[req.metric].si_unit,
             "display_unit": METRICS[req.metric].display_unit,
             "comparator": req.comparator,
@@ -154,6 +182,12 @@ def judge(cfg, reqset: RequirementSet, jobs: list[Job], outcomes) -> tuple[list[
             "status": status,
             "worst": None if worst is None else {k: worst[k] for k in _WORST_KEYS},
             "rows": rows,
+            "basis": requirement_basis(rows) if req.enabled and req.limit is not None else "not_evaluated",
+            "coverage": {"rows": len(rows), "evaluated": sum(1 for r in rows if r.get("status") in ("pass", "fail")),
+                         "extended": sum(1 for r in rows if r.get("extended"))},
+            "reading": req.reading,
+            "alternative": req.alternative,
+            "own_choice": req.own_choice,
             "note": req.note,
             "loosened": loosen,
         })

@@ -26,7 +26,8 @@ from compliance.campaign.judge import fmt, judge, sample_dict
 from compliance.errors import InputError
 from compliance.requirements.tightening import check_tightening
 from compliance.requirements.requirement_set import RequirementSet
-from compliance.requirements.verdict import DISABLED, FAIL, NOT_EVALUATED, OPEN, PASS, overall_status
+from compliance.campaign.coverage import unjudged
+from compliance.requirements.verdict import DISABLED, FAIL, NOT_EVALUATED, OPEN, PASS, UNCERTAIN, overall_status
 
 __all__ = [
     "RESULTS_SCHEMA",
@@ -51,6 +52,26 @@ def _versions() -> dict:
         except Exception:  # a missing optional package is reported as absent, not fatal
             out[mod] = None
     return out
+
+
+def _by_construction(e: dict) -> bool:
+    return e["status"] == PASS and e.get("basis") == "by_construction"
+
+
+def summary_counts(entries: list[dict]) -> dict:
+    """Requirement counts by status, with passes by construction and advisory failures counted apart."""
+    counts = {s: sum(1 for e in entries if e["status"] == s) for s in (PASS, FAIL, NOT_EVALUATED, OPEN, DISABLED, UNCERTAIN)}
+    counts["pass_by_construction"] = sum(1 for e in entries if _by_construction(e))
+    counts[PASS] -= counts["pass_by_construction"]  # a pass by construction is not evidence: never counted as a pass
+    counts["fail_mandatory"] = sum(1 for e in entries if e["status"] == FAIL and e["severity"] == "mandatory")
+    counts["fail_advisory"] = counts[FAIL] - counts["fail_mandatory"]
+    return counts
+
+
+def coverage_summary(entries: list[dict]) -> dict:
+    """Verdict rows evaluated out of all rows, over the requirements that have a limit."""
+    rows = [r for e in entries if e.get("limit") is not None for r in e["rows"]]
+    return {"rows": len(rows), "evaluated": sum(1 for r in rows if r.get("status") in (PASS, FAIL, UNCERTAIN))}
 
 
 def plant_section(cfg) -> dict:
@@ -126,9 +147,9 @@ def run_campaign(cfg, reqset: RequirementSet, *, workers: int | None = None, pro
         if o.error and o.error_kind == "InputError":
             raise InputError(f"{reqset.path}: run {j.key}: {o.error}")
     entries, notes = judge(cfg, reqset, jobs, outcomes)
-    judged = [(e["severity"], e["status"]) for e in entries if e["status"] not in (OPEN, DISABLED)]
+    judged = [(e["severity"], e["status"], e.get("basis")) for e in entries if e["status"] not in (OPEN, DISABLED)]
     overall = overall_status(judged)
-    counts = {s: sum(1 for e in entries if e["status"] == s) for s in (PASS, FAIL, NOT_EVALUATED, OPEN, DISABLED)}
+    counts = summary_counts(entries)
     runs = []
     for j, o in zip(jobs, outcomes):
         proc = reqset.procedures[j.procedure]
@@ -159,8 +180,12 @@ def run_campaign(cfg, reqset: RequirementSet, *, workers: int | None = None, pro
             "failed_mandatory": [e["id"] for e in entries if e["status"] == FAIL and e["severity"] == "mandatory"],
             "not_evaluated": [e["id"] for e in entries if e["status"] == NOT_EVALUATED],
             "open": [e["id"] for e in entries if e["status"] == OPEN],
+            "passed_by_construction": [e["id"] for e in entries if _by_construction(e)],
+            "uncertain": [e["id"] for e in entries if e["status"] == UNCERTAIN],
+            "coverage": coverage_summary(entries),
             "notes": notes,
         },
+        "coverage": {"unjudged": unjudged(reqset, jobs, outcomes, entries)},
         "requirements": entries,
         "runs": runs,
         "timing": {"wall": time.perf_counter() - t0, "runs": len(jobs), "workers": used,

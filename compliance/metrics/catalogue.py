@@ -53,6 +53,10 @@ METRICS: dict[str, MetricInfo] = {
         MetricInfo("opening_time", "s", "s", 1.0, ("full_stroke",), "2 x time from 25 % to 75 % of stroke, opening"),
         MetricInfo("closing_time", "s", "s", 1.0, ("full_stroke",), "2 x time from 75 % to 25 % of stroke, closing"),
         MetricInfo(
+            "stroke_speed", "m/s", "mm/s", 1e3, ("full_stroke",),
+            "mean speed from 25 % to 75 % of a full stroke (the rate the speed setting sets; stroke / full-stroke time)",
+        ),
+        MetricInfo(
             "max_speed", "m/s", "mm/s", 1e3, ("steps", "sine", "full_stroke", "hold", "dead_band"),
             "max |dx/dt| over a centred 20 ms difference",
         ),
