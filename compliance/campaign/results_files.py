@@ -104,8 +104,13 @@ def summary_lines(results: dict) -> list[str]:
         elif e["status"] == "uncertain":
             deciding = ", ".join(((e.get("worst") or {}).get("band") or {}).get("deciding") or [])
             out.append(f"  uncertain {e['id']}: its band straddles the limit; decided by {deciding or '-'}")
-    for f in results.get("findings") or []:
-        out.append(f"  requirement set {f['kind']}: {f['text'][:300]}")
+    findings = results.get("findings") or []
+    for f in findings:
+        if f.get("mandatory"):
+            out.append(f"  requirement set {f['kind']}: {f['text']}")
+    others = len(findings) - sum(1 for f in findings if f.get("mandatory"))
+    if others:
+        out.append(f"  requirement set: {others} more finding(s) involving advisory requirements (results JSON, 'findings')")
     top = (results.get("uncertainty") or {}).get("top_assumptions") or []
     if top:
         out.append("  assumptions that matter most: " + "; ".join(f"{a['parameter']} ({a['why']})" for a in top))

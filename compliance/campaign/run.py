@@ -24,6 +24,7 @@ from compliance.campaign.plan import Job, plan
 from compliance.campaign.executor import available_cores, execute
 from compliance.campaign.judge import fmt, judge, sample_dict
 from compliance.errors import InputError
+from compliance.requirements.consistency import consistency_findings
 from compliance.requirements.tightening import check_tightening
 from compliance.requirements.requirement_set import RequirementSet
 from compliance.campaign.coverage import unjudged
@@ -186,6 +187,7 @@ def run_campaign(cfg, reqset: RequirementSet, *, workers: int | None = None, pro
             "notes": notes,
         },
         "coverage": {"unjudged": unjudged(reqset, jobs, outcomes, entries)},
+        "findings": consistency_findings(reqset, stroke),
         "requirements": entries,
         "runs": runs,
         "timing": {"wall": time.perf_counter() - t0, "runs": len(jobs), "workers": used,

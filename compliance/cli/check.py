@@ -47,6 +47,9 @@ def register(subparsers):
     p.add_argument("--remedies", nargs="?", const="default", metavar="SWEEP.toml",
                    help="what would make it pass: sensitivities and the smallest verified change over the on-site settings "
                         "(or the adjustable space of a sweep file); added to the results as 'remedies'")
+    p.add_argument("--allow-conflicts", action="store_true",
+                   help="judge a requirement set even when two mandatory limits cannot hold together (without it such a set "
+                        "is refused with exit code 2 before any simulation; docs/requirements.md)")
     add_jobs(p)
     add_quiet(p, "no progress bar; print only the verdict line")
     add_reproducible(p)
@@ -69,9 +72,9 @@ def command_line(args, name: str = "check", outputs: bool = True) -> str:
         v = getattr(args, flag, None)
         if v is not None and outputs:
             parts += [f"--{flag}", str(v)]
-    for flag in ("linear", "quiet", "reproducible"):
+    for flag in ("linear", "quiet", "reproducible", "allow_conflicts"):
         if getattr(args, flag, False):
-            parts.append(f"--{flag}")
+            parts.append(f"--{flag.replace('_', '-')}")
     return shlex.join(parts)
 
 
@@ -103,6 +106,9 @@ def run(args) -> int:
         load_sweep(args.remedies)
     cfg = plant_from_args(args)
     reqset = load_requirements(args.requirements)
+    from compliance.requirements.consistency import check_consistency
+
+    check_consistency(reqset, cfg.p("cylinder.stroke"), args.allow_conflicts)  # before any simulation
     stages = 1 + bool(args.linear) + (render is not None)
     # the campaign reports its runs itself on a terminal; in a CI log these stage lines (and a heartbeat) show progress
     with progress(stages, "check", quiet=args.quiet or sys.stderr.isatty(), unit="stage", first="campaign") as bar:
