@@ -18,7 +18,7 @@ from compliance.requirements.requirement_set import RequirementSet
 from compliance.procedures.outcomes import Sample, request_key
 from compliance.requirements.verdict import DISABLED, NOT_EVALUATED, OPEN, Verdict, evaluate, requirement_status, worst_index
 
-__all__ = ["fmt", "judge", "sample_dict"]
+__all__ = ["fmt", "judge", "judge_row", "sample_dict"]
 
 # keys of the worst row copied into a requirement's entry
 _WORST_KEYS = ("run", "procedure", "operating_point", "value", "margin", "margin_pct", "status", "which", "display",
@@ -54,7 +54,8 @@ def _open_pick(comparator: str, samples: list[Sample]):
     return _least_favourable(comparator, vals, lambda s: s.value)
 
 
-def _row(req, proc: str, op: str, limit, samples, error: str | None) -> dict:
+def judge_row(req, proc: str, op: str, limit, samples, error: str | None) -> dict:
+    """One verdict row of ``req`` at ``proc@op`` from a run's candidate values (the worst eligible one decides)."""
     base = {"procedure": proc, "operating_point": op, "run": f"{proc}@{op}"}
     if error:
         v = Verdict(None, req.comparator, limit or (), None, None, NOT_EVALUATED, error)
@@ -101,13 +102,13 @@ def _rows(cfg, reqset: RequirementSet, req, limit, by_key: dict) -> list[dict]:
         for o in req.operating_points:
             val, why = linear_value(cfg, req.metric, reqset.operating_points[o])
             s = [Sample(val, "linearised model", why)]
-            rows.append(_row(req, "linear", o, limit, s, None))
+            rows.append(judge_row(req, "linear", o, limit, s, None))
     else:
         key = request_key(req.metric, req.options)
         for p in req.procedures:
             for o in req.operating_points:
                 out = by_key[f"{p}@{o}"]
-                rows.append(_row(req, p, o, limit, out.samples.get(key), out.error))
+                rows.append(judge_row(req, p, o, limit, out.samples.get(key), out.error))
         rows.extend(_extended_rows(req, limit, by_key, key))
     for r in rows:
         r["basis"], r["basis_reason"] = row_basis(cfg, reqset, req, r)
@@ -129,7 +130,7 @@ def _extended_rows(req, limit, by_key: dict, key: str) -> list[dict]:
         samples = out.samples.get(key) or []
         if not any(s.eligible and s.value is not None for s in samples):
             continue
-        row = _row(req, p, o, limit, samples, None)
+        row = judge_row(req, p, o, limit, samples, None)
         row["extended"] = (f"{req.metric} was computed at {o} (a run another requirement asked for); {req.id} applies "
                            f"wherever its metric is computed unless its file says why not (not_applicable)")
         rows.append(row)

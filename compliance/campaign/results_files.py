@@ -160,11 +160,14 @@ def junit_xml(results: dict) -> str:
             if st == "fail":
                 cnt["failures"] += 1
                 body = f"<failure message={quoteattr(msg)} type=\"requirement\">{escape(e['title'])}</failure>"
-            elif st == "not_evaluated":
-                reason = r.get("reason") or "not evaluated"
+            elif st in ("not_evaluated", "uncertain"):
+                band = r.get("band") or {}
+                reason = (r.get("reason") or "not evaluated") if st == "not_evaluated" else (
+                    f"uncertain: band {band.get('low')} .. {band.get('high')} straddles the limit; decided by "
+                    + ", ".join(band.get("deciding") or []))
                 if e["severity"] == "mandatory":
                     cnt["errors"] += 1
-                    body = f"<error message={quoteattr(reason)} type=\"not_evaluated\"/>"
+                    body = f"<error message={quoteattr(reason)} type=\"{st}\"/>"
                 else:
                     cnt["skipped"] += 1
                     body = f"<skipped message={quoteattr(reason)}/>"

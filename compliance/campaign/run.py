@@ -28,6 +28,7 @@ from compliance.requirements.consistency import consistency_findings
 from compliance.requirements.tightening import check_tightening
 from compliance.requirements.requirement_set import RequirementSet
 from compliance.campaign.coverage import unjudged
+from compliance.campaign.uncertainty import local_bands, ranged_parameters
 from compliance.requirements.verdict import DISABLED, FAIL, NOT_EVALUATED, OPEN, PASS, UNCERTAIN, overall_status
 
 __all__ = [
@@ -67,6 +68,23 @@ def summary_counts(entries: list[dict]) -> dict:
     counts["fail_mandatory"] = sum(1 for e in entries if e["status"] == FAIL and e["severity"] == "mandatory")
     counts["fail_advisory"] = counts[FAIL] - counts["fail_mandatory"]
     return counts
+
+
+def summary_section(entries: list[dict], notes: list[str]) -> dict:
+    """The results' ``summary``: overall verdict, counts, lists of ids by outcome, coverage."""
+    judged = [(e["severity"], e["status"], e.get("basis")) for e in entries if e["status"] not in (OPEN, DISABLED)]
+    return {
+        "status": overall_status(judged),
+        "counts": summary_counts(entries),
+        "failed": [e["id"] for e in entries if e["status"] == FAIL],
+        "failed_mandatory": [e["id"] for e in entries if e["status"] == FAIL and e["severity"] == "mandatory"],
+        "not_evaluated": [e["id"] for e in entries if e["status"] == NOT_EVALUATED],
+        "open": [e["id"] for e in entries if e["status"] == OPEN],
+        "passed_by_construction": [e["id"] for e in entries if _by_construction(e)],
+        "uncertain": [e["id"] for e in entries if e["status"] == UNCERTAIN],
+        "coverage": coverage_summary(entries),
+        "notes": notes,
+    }
 
 
 def coverage_summary(entries: list[dict]) -> dict:
@@ -113,7 +131,7 @@ def plant_section(cfg) -> dict:
 
 
 def run_campaign(cfg, reqset: RequirementSet, *, workers: int | None = None, progress: bool = True,
-                 command_line: str | None = None) -> dict:
+                 command_line: str | None = None, uncertainty: str | None = None) -> dict:
     """Check a plant against a requirement set.
 
     Parameters
@@ -126,6 +144,9 @@ def run_campaign(cfg, reqset: RequirementSet, *, workers: int | None = None, pro
         Show a progress bar on stderr when it is a terminal.
     command_line : str, optional
         Recorded in the results.
+    uncertainty : {"local", None}
+        Bands on the verdicts from the plant file's declared ranges by local sensitivities
+        (``compliance.campaign.uncertainty``); None (default): point values only.
 
     Returns
     -------
@@ -148,9 +169,9 @@ def run_campaign(cfg, reqset: RequirementSet, *, workers: int | None = None, pro
         if o.error and o.error_kind == "InputError":
             raise InputError(f"{reqset.path}: run {j.key}: {o.error}")
     entries, notes = judge(cfg, reqset, jobs, outcomes)
-    judged = [(e["severity"], e["status"], e.get("basis")) for e in entries if e["status"] not in (OPEN, DISABLED)]
-    overall = overall_status(judged)
-    counts = summary_counts(entries)
+    bands = None
+    if uncertainty == "local" and ranged_parameters(cfg):
+        bands = local_bands(cfg, reqset, jobs, entries, workers=workers, progress=progress)
     runs = []
     for j, o in zip(jobs, outcomes):
         proc = reqset.procedures[j.procedure]
@@ -174,20 +195,10 @@ def run_campaign(cfg, reqset: RequirementSet, *, workers: int | None = None, pro
         "versions": _versions(),
         "plant": plant_section(cfg),
         "requirement_set": reqset.as_dict(),
-        "summary": {
-            "status": overall,
-            "counts": counts,
-            "failed": [e["id"] for e in entries if e["status"] == FAIL],
-            "failed_mandatory": [e["id"] for e in entries if e["status"] == FAIL and e["severity"] == "mandatory"],
-            "not_evaluated": [e["id"] for e in entries if e["status"] == NOT_EVALUATED],
-            "open": [e["id"] for e in entries if e["status"] == OPEN],
-            "passed_by_construction": [e["id"] for e in entries if _by_construction(e)],
-            "uncertain": [e["id"] for e in entries if e["status"] == UNCERTAIN],
-            "coverage": coverage_summary(entries),
-            "notes": notes,
-        },
+        "summary": summary_section(entries, notes),
         "coverage": {"unjudged": unjudged(reqset, jobs, outcomes, entries)},
         "findings": consistency_findings(reqset, stroke),
+        "uncertainty": bands,
         "requirements": entries,
         "runs": runs,
         "timing": {"wall": time.perf_counter() - t0, "runs": len(jobs), "workers": used,

@@ -208,7 +208,7 @@ def test_plant_a_against_shpp_end_to_end(tmp_path, capsys):
     # (1.18 mm from the set-point) and 10 % steps saturate the valve: only 5 % steps decide
     for row in ent["IEC61362-TC"]["rows"]:
         assert row["procedure"] in ("steps-2", "steps-5", "steps-10")
-        if row["status"] in ("pass", "fail"):
+        if row["status"] in ("pass", "fail", "uncertain"):
             assert row["which"].startswith("step ") and row["procedure"] == "steps-5"
         else:
             assert row["reason"]
