@@ -61,6 +61,8 @@ def _derived(cfg, op, flow_control: bool, stroke_metric: str | None):
 
 def row_basis(cfg, reqset, req, row) -> tuple[str, str]:
     """(basis, basis_reason) of one verdict row (see the module docstring)."""
+    if row.get("non_responding") and row.get("status") == FAIL:
+        return "modelled", "the simulated step never responded: " + (row.get("reason") or "")
     if row.get("status") == NOT_EVALUATED or row.get("value") is None:
         return "not_evaluated", row.get("reason") or "no value"
     if req.source == "linear":

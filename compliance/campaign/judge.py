@@ -16,13 +16,13 @@ from compliance.linear.requirement_values import linear_value
 from compliance.metrics.catalogue import METRICS
 from compliance.requirements.requirement_set import RequirementSet
 from compliance.procedures.outcomes import Sample, request_key
-from compliance.requirements.verdict import DISABLED, NOT_EVALUATED, OPEN, Verdict, evaluate, requirement_status, worst_index
+from compliance.requirements.verdict import DISABLED, FAIL, NOT_EVALUATED, OPEN, Verdict, evaluate, requirement_status, worst_index
 
 __all__ = ["fmt", "judge", "judge_row", "sample_dict"]
 
 # keys of the worst row copied into a requirement's entry
 _WORST_KEYS = ("run", "procedure", "operating_point", "value", "margin", "margin_pct", "status", "which", "display",
-               "basis", "basis_reason")
+               "basis", "basis_reason", "non_responding")
 
 
 def fmt(value, metric: str, digits: int = 3) -> str:
@@ -63,6 +63,9 @@ def judge_row(req, proc: str, op: str, limit, samples, error: str | None) -> dic
     samples = samples or []
     shown = [sample_dict(s, req.metric) for s in samples]
     usable = [s for s in samples if s.eligible and s.value is not None]
+    silent = [s for s in samples if s.eligible and s.value is None and (s.detail or {}).get("non_responding")]
+    if silent:
+        return _non_responding_row(req, base, limit, silent, shown)
     if req.limit is None:
         pick = _open_pick(req.comparator, samples)
         return {**base, "value": pick.value if pick else None, "comparator": req.comparator, "limit": None,
@@ -75,6 +78,19 @@ def judge_row(req, proc: str, op: str, limit, samples, error: str | None) -> dic
     verdicts = [evaluate(s.value, req.comparator, limit) for s in usable]
     w = worst_index(verdicts)
     return {**base, **verdicts[w].as_dict(), "which": usable[w].label, "samples": shown}
+
+
+def _non_responding_row(req, base: dict, limit, silent, shown) -> dict:
+    """A step that never responded is the worst case: beyond any upper limit (a fail), the value shown as none."""
+    s = silent[0]
+    why = f"{s.label} did not respond ({s.reason}): the worst case"
+    labels = [x.label for x in silent]
+    if req.limit is None or req.comparator not in ("<=", "<", "within"):
+        return {**base, "value": None, "comparator": req.comparator, "limit": None if req.limit is None else list(limit),
+                "margin": None, "margin_pct": None, "status": OPEN if req.limit is None else NOT_EVALUATED,
+                "reason": why, "which": s.label, "samples": shown, "non_responding": labels}
+    v = Verdict(None, req.comparator, tuple(limit), None, None, FAIL, why + ", beyond any upper limit")
+    return {**base, **v.as_dict(), "which": s.label, "samples": shown, "non_responding": labels}
 
 
 def _why(samples) -> str:
@@ -162,7 +178,10 @@ def judge(cfg, reqset: RequirementSet, jobs: list[Job], outcomes) -> tuple[list[
             worst = None if wi is None else rows[wi]
         elif rows:
             vals = [r for r in rows if r["value"] is not None]
-            if vals:
+            silent = [r for r in rows if r.get("non_responding")]
+            if silent:  # an open limit still shows its worst case: a step that never responded
+                worst = silent[0]
+            elif vals:
                 worst = _least_favourable(req.comparator, vals, lambda r: r["value"])
         entries.append({
             "id": req.id,
@@ -181,7 +200,7 @@ def judge(cfg, reqset: RequirementSet, jobs: list[Job], outcomes) -> tuple[list[
             "severity": req.severity,
             "source": req.source,
             "status": status,
-            "worst": None if worst is None else {k: worst[k] for k in _WORST_KEYS},
+            "worst": None if worst is None else {k: worst.get(k) for k in _WORST_KEYS},
             "rows": rows,
             "basis": requirement_basis(rows) if req.enabled and req.limit is not None else "not_evaluated",
             "coverage": {"rows": len(rows), "evaluated": sum(1 for r in rows if r.get("status") in ("pass", "fail")),

@@ -78,7 +78,8 @@ def _table_row(e: dict) -> tuple:
         limit += f" ({e['limit_display'].split(' ', 1)[1]})"
     cov = e.get("coverage") or {}
     cases = f"{cov['evaluated']}/{cov['rows']}" if cov.get("rows") and e.get("limit") is not None else "-"
-    return (e["id"], e["metric"], limit, d.get("value", "-"), margin, cases, where, e["severity"],
+    value = "no response" if w.get("non_responding") else d.get("value", "-")
+    return (e["id"], e["metric"], limit, value, margin, cases, where, e["severity"],
             _BASIS_WORD.get(e.get("basis"), "-"), _status_cell(e))
 
 

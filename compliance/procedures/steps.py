@@ -145,6 +145,8 @@ def run_steps(cfg, proc, op, requests, out):
             val = getattr(sm, metric)
             reason = sm.reasons.get(metric)
             eligible = True
+            if metric == "dead_time" and val is None:
+                detail["non_responding"] = True  # the step never moved: its dead time is the worst case
             if metric == "time_constant":
                 eligible, reason = _tau_eligibility(k, len(events), ev, sm, reason, s["tau_from_rest"], stall, vmax, detail)
             out.add(key, Sample(val, lab, reason, eligible, detail))
@@ -166,19 +168,20 @@ def _tau_eligibility(k, n, ev, sm, reason, from_rest, stall, vmax, detail) -> tu
     val = sm.time_constant
     detail.update(tau_achieved=sm.time_constant_achieved, dead_time=sm.dead_time,
                   achieved_fraction=(sm.x_final - sm.x_start) / ev.size if ev.size else None)
-    if val is None:
-        return True, reason
-    detail["peak_speed"] = sm.max_speed
     side = 1 if ev.size > 0 else -1
     if k > 0 and from_rest:
         return False, (f"not from rest at the operating point: step {k + 1} of {n} starts where step {k} settled "
                        f"({sm.x_start * 1e3:.1f} mm); the standards' test steps from rest at the point")
-    if sm.rate_limited:
-        return False, reason
     if (1.0 - M.TAU_FRACTION) * abs(ev.size) < STALL_MARGIN * stall[side]:
         return False, (f"dead-zone dominated: the 63.2 % point lies {(1 - M.TAU_FRACTION) * abs(ev.size) * 1e3:.2f} mm "
                        f"from the set-point, inside {STALL_MARGIN:g} x the stall band {stall[side] * 1e3:.2f} mm "
                        "where the compensated valve shuts")
+    if val is None:  # a step beyond the dead zone that never reached 63.2 %: the worst case, not a gap
+        detail["non_responding"] = True
+        return True, reason
+    detail["peak_speed"] = sm.max_speed
+    if sm.rate_limited:
+        return False, reason
     if vmax is None:
         return True, reason
     peak, straight = vmax["opening" if ev.size > 0 else "closing"]

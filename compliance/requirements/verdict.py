@@ -94,7 +94,9 @@ def evaluate(value: float | None, comparator: str, limit, reason: str | None = N
 def _badness(v: Verdict) -> tuple:
     """Sort key: fails first, then the smallest margin (in % when known)."""
     m = v.margin_pct if v.margin_pct is not None else v.margin
-    return (0 if v.status == FAIL else 1, m if m is not None else math.inf)
+    if m is None:  # a fail without a margin is a step that never responded: the worst of all
+        m = -math.inf if v.status == FAIL else math.inf
+    return (0 if v.status == FAIL else 1, m)
 
 
 def worst_index(verdicts) -> int | None:
