@@ -90,14 +90,14 @@ def _time_vs_speed(reqset, stroke, t_req, v_req) -> list[dict]:
     for p in sorted(set(t_req.procedures) & set(v_req.procedures)):
         if reqset.procedures[p].kind != "full_stroke":
             continue
-        head = (f"{t_req.id} ({t_req.metric} {t_req.limit_text}) and {v_req.id} ({v_req.metric} <= {v * 1e3:.1f} mm/s) on {p}: "
-                f"a stroke of time T moves at L / T on its straight part, so T < {stroke * 1e3:.0f} mm / {v * 1e3:.1f} mm/s = "
-                f"{t_min:.3g} s fails the speed limit")
+        who = f"{t_req.id} ({t_req.metric} {t_req.limit_text}) and {v_req.id} ({v_req.metric} <= {v * 1e3:.1f} mm/s) on {p}"
+        why = (f": a stroke of time T moves at L / T on its straight part, so T < {stroke * 1e3:.0f} mm / {v * 1e3:.1f} mm/s = "
+               f"{t_min:.3g} s fails the speed limit")
         if hi is not None and hi < t_min:
-            out.append(_finding(CONFLICT, t_req, v_req, p, head + f"; the whole window ends at {hi:.3g} s: no stroke passes both"))
+            out.append(_finding(CONFLICT, t_req, v_req, p, who + f" cannot both pass: the window ends at {hi:.3g} s" + why))
         elif lo is not None and lo < t_min:
-            out.append(_finding(NARROWING, t_req, v_req, p, head + (
-                f"; together they admit only {t_min:.3g} s .. {hi:.3g} s" if hi is not None else f"; together they admit only >= {t_min:.3g} s")))
+            admit = f"{t_min:.3g} s .. {hi:.3g} s" if hi is not None else f">= {t_min:.3g} s"
+            out.append(_finding(NARROWING, t_req, v_req, p, who + f" together admit only {admit}" + why))
     return out
 
 
