@@ -112,7 +112,7 @@ def summary_lines(results: dict) -> list[str]:
     others = len(findings) - sum(1 for f in findings if f.get("mandatory"))
     if others:
         out.append(f"  requirement set: {others} more finding(s) involving advisory requirements (results JSON, 'findings')")
-    top = (results.get("uncertainty") or {}).get("top_assumptions") or []
+    top = s.get("top_assumptions") or (results.get("uncertainty") or {}).get("top_assumptions") or []
     if top:
         out.append("  assumptions that matter most: " + "; ".join(f"{a['parameter']} ({a['why']})" for a in top))
     for n in s.get("notes", []):

@@ -70,8 +70,8 @@ def summary_counts(entries: list[dict]) -> dict:
     return counts
 
 
-def summary_section(entries: list[dict], notes: list[str]) -> dict:
-    """The results' ``summary``: overall verdict, counts, lists of ids by outcome, coverage."""
+def summary_section(entries: list[dict], notes: list[str], uncertainty: dict | None = None) -> dict:
+    """The results' ``summary``: overall verdict, counts, lists of ids by outcome, coverage, the assumptions that matter most."""
     judged = [(e["severity"], e["status"], e.get("basis")) for e in entries if e["status"] not in (OPEN, DISABLED)]
     return {
         "status": overall_status(judged),
@@ -83,6 +83,7 @@ def summary_section(entries: list[dict], notes: list[str]) -> dict:
         "passed_by_construction": [e["id"] for e in entries if _by_construction(e)],
         "uncertain": [e["id"] for e in entries if e["status"] == UNCERTAIN],
         "coverage": coverage_summary(entries),
+        "top_assumptions": (uncertainty or {}).get("top_assumptions") or [],
         "notes": notes,
     }
 
@@ -195,7 +196,7 @@ def run_campaign(cfg, reqset: RequirementSet, *, workers: int | None = None, pro
         "versions": _versions(),
         "plant": plant_section(cfg),
         "requirement_set": reqset.as_dict(),
-        "summary": summary_section(entries, notes),
+        "summary": summary_section(entries, notes, bands),
         "coverage": {"unjudged": unjudged(reqset, jobs, outcomes, entries)},
         "findings": consistency_findings(reqset, stroke),
         "uncertainty": bands,

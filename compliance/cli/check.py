@@ -99,7 +99,7 @@ def monte_carlo(cfg, reqset, results: dict, args) -> None:
 
     results["uncertainty"] = monte_carlo_bands(cfg, reqset, results, args.uncertainty, workers=args.jobs,
                                                progress=not args.quiet)
-    results["summary"] = summary_section(results["requirements"], results["summary"]["notes"])
+    results["summary"] = summary_section(results["requirements"], results["summary"]["notes"], results["uncertainty"])
 
 
 def run(args) -> int:
