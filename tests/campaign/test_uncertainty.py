@@ -79,3 +79,21 @@ def test_a_band_across_the_limit_is_uncertain_and_names_its_parameters(case):
     assert e["band"]["deciding"] and set(e["band"]["deciding"]) <= {"valve.sonic_conductance", "friction.static_force"}
     assert local["summary"]["status"] == "incomplete"
     assert [a["parameter"] for a in local["uncertainty"]["top_assumptions"]][0] in e["band"]["deciding"]
+
+
+def test_check_uncertainty_option_runs_a_monte_carlo(tmp_path, capsys):
+    from compliance.cli import main
+
+    req = tmp_path / "closing.toml"
+    req.write_text(REQ)
+    out = tmp_path / "r.json"
+    assert main(["check", "plant-a", "-r", str(req), "--uncertainty", "1", "--json", str(out), "-q"]) == 2
+    assert "--uncertainty 1" in capsys.readouterr().err and not out.exists()
+    code = main(["check", "plant-a", "-r", str(req), "--uncertainty", "4", "--jobs", "1", "--json", str(out), "-q"])
+    import json
+
+    r = json.loads(out.read_text())
+    assert code in (0, 1) and r["uncertainty"]["method"] == "monte_carlo" and r["uncertainty"]["judged"] == 4
+    band = r["requirements"][0]["band"]
+    assert band["method"].startswith("monte carlo") and band["low"] <= r["requirements"][0]["worst"]["value"] <= band["high"]
+    assert r["summary"]["top_assumptions"]
