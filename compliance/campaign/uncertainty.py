@@ -42,10 +42,20 @@ def _perturbed_run(ctx, item):
     return out.samples, out.error
 
 
-def _targets(entries) -> list[dict]:
-    """Requirements whose deciding row is a modelled (or assumed) simulated value with a verdict."""
-    return [e for e in entries if e["source"] == "simulation" and e["status"] in (PASS, FAIL) and e.get("worst")
-            and e["worst"].get("basis") in ("modelled", "assumed") and e["worst"].get("value") is not None]
+# a verdict farther than this from its limit (margin in % of the limit) gets no local band: the declared
+# ranges move plant A's figures by tens of per cent at most, so it cannot reach the limit (govcheck's choice;
+# the Monte Carlo of --uncertainty N bands every verdict)
+FAR_MARGIN_PCT = 100.0
+
+
+def _targets(entries, far: float | None = None) -> list[dict]:
+    """Requirements whose deciding row is a modelled (or assumed) simulated value with a verdict
+    (and, with ``far``, a margin within ``far`` per cent of the limit)."""
+    out = [e for e in entries if e["source"] == "simulation" and e["status"] in (PASS, FAIL) and e.get("worst")
+           and e["worst"].get("basis") in ("modelled", "assumed") and e["worst"].get("value") is not None]
+    if far is None:
+        return out
+    return [e for e in out if e["worst"].get("margin_pct") is None or abs(e["worst"]["margin_pct"]) <= far]
 
 
 def _deciding(swings: dict, margin: float, toward_limit_sign: float) -> list[str]:
@@ -115,7 +125,7 @@ def local_bands(cfg, reqset, jobs, entries, *, workers=None, progress=False) -> 
         ``{"method": "local", "parameters": [...], "runs": N, "top_assumptions": [...]}``.
     """
     ranged = ranged_parameters(cfg)
-    targets = _targets(entries)
+    targets = _targets(entries, FAR_MARGIN_PCT)
     index = {j.key: i for i, j in enumerate(jobs)}
     need = sorted({index[e["worst"]["run"]] for e in targets})
     items = [(k, rng[end], j) for k, rng in ranged for end in ("low", "high") for j in need]
@@ -140,6 +150,7 @@ def local_bands(cfg, reqset, jobs, entries, *, workers=None, progress=False) -> 
         high = w["value"] + sum(max(0.0, *s) for s in swings.values())
         apply_band(e, low, high, swings, "local")
     return {"method": "local", "parameters": [{"parameter": k, **rng} for k, rng in ranged], "runs": len(items),
+            "far_margin_pct": FAR_MARGIN_PCT,
             "top_assumptions": top_assumptions(entries, cfg)}
 
 
