@@ -33,6 +33,7 @@ def register(subparsers):
             "govcheck check models/plant-a.toml -r shpp-400kw",
             "govcheck check plant-a -r iec61362 --json r.json --junit r.xml --report r.html --pdf r.pdf",
             "govcheck check models/plant-a.toml -r requirements/shpp-400kw.toml --linear -q --reproducible --json r.json",
+            "govcheck check plant-a -r shpp-400kw --uncertainty 32 --json r.json   # Monte Carlo bands over the declared ranges",
         ],
     )
     add_plant_argument(p)
