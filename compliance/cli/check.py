@@ -129,6 +129,13 @@ def run(args) -> int:
     from compliance.requirements.consistency import check_consistency
 
     check_consistency(reqset, cfg.p("cylinder.stroke"), args.allow_conflicts)  # before any simulation
+    if args.uncertainty:
+        from compliance.campaign.uncertainty import ranged_parameters
+        from compliance.errors import InputError
+
+        if not ranged_parameters(cfg):
+            raise InputError(f"{cfg.path or cfg.name}: --uncertainty {args.uncertainty}: the plant file gives no parameter "
+                             "a range (range = [low, high] with range_note, docs/requirements.md 'Uncertainty')")
     stages = 1 + bool(args.linear) + (render is not None)
     # the campaign reports its runs itself on a terminal; in a CI log these stage lines (and a heartbeat) show progress
     with progress(stages, "check", quiet=args.quiet or sys.stderr.isatty(), unit="stage", first="campaign") as bar:

@@ -195,6 +195,9 @@ def test_plant_a_against_shpp_end_to_end(tmp_path, capsys):
     assert {"IEC61362-TC", "IEC61362-POS", "IEC61362-TOPEN", "IEC61362-INDEP", "SHPP-TRACK"} <= set(ids)
     for i in ids:
         assert i in printed
+    # page-1 counts: passes by construction and advisory failures apart, cases evaluated
+    assert "pass by construction (not evidence)" in printed and "fail (advisory)" in printed
+    assert "cases evaluated" in printed and "assumptions that matter most" in printed
     # every computed value is judged or carries the reason it is not (issue 22)
     judged = {(row["run"], e["request_key"]) for e in r["requirements"] for row in e["rows"]}
     why = {(u["run"], u["metric"]): u["reason"] for u in r["coverage"]["unjudged"]}

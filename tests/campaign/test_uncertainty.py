@@ -8,6 +8,7 @@ plants reach most of the corners of a 2-D box).
 """
 
 import copy
+from pathlib import Path
 import dataclasses
 from types import MappingProxyType
 
@@ -97,3 +98,14 @@ def test_check_uncertainty_option_runs_a_monte_carlo(tmp_path, capsys):
     band = r["requirements"][0]["band"]
     assert band["method"].startswith("monte carlo") and band["low"] <= r["requirements"][0]["worst"]["value"] <= band["high"]
     assert r["summary"]["top_assumptions"]
+
+
+def test_uncertainty_needs_a_plant_with_ranges(tmp_path, capsys):
+    from compliance.cli import main
+
+    req = tmp_path / "closing.toml"
+    req.write_text(REQ)
+    out = tmp_path / "r.json"
+    plant = Path(__file__).resolve().parents[2] / "models" / "plant-a-calibrated.toml"
+    assert main(["check", str(plant), "-r", str(req), "--uncertainty", "4", "--json", str(out), "-q"]) == 2
+    assert "gives no parameter a range" in capsys.readouterr().err and not out.exists()
