@@ -34,7 +34,8 @@ METRICS: dict[str, MetricInfo] = {
         MetricInfo("dead_time", "s", "s", 1.0, ("steps",), "command step to first detectable motion", ("detect",)),
         MetricInfo(
             "time_constant", "s", "s", 1.0, ("steps",),
-            "end of dead time to 63.2 % of the commanded step, steps out of the rate limit only", ("detect",),
+            "end of dead time to 63.2 % of the commanded step, first step from rest, steps out of the rate limit only",
+            ("detect",),
         ),
         MetricInfo("rise_time", "s", "s", 1.0, ("steps",), "10 % to 90 % of the actual change", ("final_window",)),
         MetricInfo("settling_time", "s", "s", 1.0, ("steps",), "step to last exit from the settling band", _SETTLE_OPTS),
