@@ -8,6 +8,7 @@ combines its rows. Values are also formatted in each metric's display unit for t
 
 from __future__ import annotations
 
+from compliance.campaign.basis import requirement_basis, row_basis
 from compliance.campaign.plan import Job
 from compliance.units.formatting import fmt_margin_pct, fmt_value
 from compliance.requirements.tightening import check_tightening
@@ -15,12 +16,13 @@ from compliance.linear.requirement_values import linear_value
 from compliance.metrics.catalogue import METRICS
 from compliance.requirements.requirement_set import RequirementSet
 from compliance.procedures.outcomes import Sample, request_key
-from compliance.requirements.verdict import DISABLED, NOT_EVALUATED, OPEN, Verdict, evaluate, requirement_status, worst_index
+from compliance.requirements.verdict import DISABLED, FAIL, NOT_EVALUATED, OPEN, Verdict, evaluate, requirement_status, worst_index
 
-__all__ = ["fmt", "judge", "sample_dict"]
+__all__ = ["fmt", "judge", "judge_row", "sample_dict"]
 
 # keys of the worst row copied into a requirement's entry
-_WORST_KEYS = ("run", "procedure", "operating_point", "value", "margin", "margin_pct", "status", "which", "display")
+_WORST_KEYS = ("run", "procedure", "operating_point", "value", "margin", "margin_pct", "status", "which", "display",
+               "basis", "basis_reason", "non_responding")
 
 
 def fmt(value, metric: str, digits: int = 3) -> str:
@@ -52,7 +54,8 @@ def _open_pick(comparator: str, samples: list[Sample]):
     return _least_favourable(comparator, vals, lambda s: s.value)
 
 
-def _row(req, proc: str, op: str, limit, samples, error: str | None) -> dict:
+def judge_row(req, proc: str, op: str, limit, samples, error: str | None) -> dict:
+    """One verdict row of ``req`` at ``proc@op`` from a run's candidate values (the worst eligible one decides)."""
     base = {"procedure": proc, "operating_point": op, "run": f"{proc}@{op}"}
     if error:
         v = Verdict(None, req.comparator, limit or (), None, None, NOT_EVALUATED, error)
@@ -60,6 +63,9 @@ def _row(req, proc: str, op: str, limit, samples, error: str | None) -> dict:
     samples = samples or []
     shown = [sample_dict(s, req.metric) for s in samples]
     usable = [s for s in samples if s.eligible and s.value is not None]
+    silent = [s for s in samples if s.eligible and s.value is None and (s.detail or {}).get("non_responding")]
+    if silent:
+        return _non_responding_row(req, base, limit, silent, shown)
     if req.limit is None:
         pick = _open_pick(req.comparator, samples)
         return {**base, "value": pick.value if pick else None, "comparator": req.comparator, "limit": None,
@@ -72,6 +78,19 @@ def _row(req, proc: str, op: str, limit, samples, error: str | None) -> dict:
     verdicts = [evaluate(s.value, req.comparator, limit) for s in usable]
     w = worst_index(verdicts)
     return {**base, **verdicts[w].as_dict(), "which": usable[w].label, "samples": shown}
+
+
+def _non_responding_row(req, base: dict, limit, silent, shown) -> dict:
+    """A step that never responded is the worst case: beyond any upper limit (a fail), the value shown as none."""
+    s = silent[0]
+    why = f"{s.label} did not respond ({s.reason}): the worst case"
+    labels = [x.label for x in silent]
+    if req.limit is None or req.comparator not in ("<=", "<", "within"):
+        return {**base, "value": None, "comparator": req.comparator, "limit": None if req.limit is None else list(limit),
+                "margin": None, "margin_pct": None, "status": OPEN if req.limit is None else NOT_EVALUATED,
+                "reason": why, "which": s.label, "samples": shown, "non_responding": labels}
+    v = Verdict(None, req.comparator, tuple(limit), None, None, FAIL, why + ", beyond any upper limit")
+    return {**base, **v.as_dict(), "which": s.label, "samples": shown, "non_responding": labels}
 
 
 def _why(samples) -> str:
@@ -99,13 +118,38 @@ def _rows(cfg, reqset: RequirementSet, req, limit, by_key: dict) -> list[dict]:
         for o in req.operating_points:
             val, why = linear_value(cfg, req.metric, reqset.operating_points[o])
             s = [Sample(val, "linearised model", why)]
-            rows.append(_row(req, "linear", o, limit, s, None))
+            rows.append(judge_row(req, "linear", o, limit, s, None))
     else:
         key = request_key(req.metric, req.options)
         for p in req.procedures:
             for o in req.operating_points:
                 out = by_key[f"{p}@{o}"]
-                rows.append(_row(req, p, o, limit, out.samples.get(key), out.error))
+                rows.append(judge_row(req, p, o, limit, out.samples.get(key), out.error))
+        rows.extend(_extended_rows(req, limit, by_key, key))
+    for r in rows:
+        r["basis"], r["basis_reason"] = row_basis(cfg, reqset, req, r)
+    return rows
+
+
+def _extended_rows(req, limit, by_key: dict, key: str) -> list[dict]:
+    """Rows at operating points the requirement does not list where another requirement's run computed its
+    metric with one of its procedures: a computed figure is judged by every limit that applies there.
+
+    A point the requirement names in ``not_applicable`` is left out (the coverage gives its reason), as is a
+    run without an eligible value (the coverage gives the samples' reasons).
+    """
+    rows = []
+    for run_key, out in by_key.items():
+        p, o = run_key.split("@", 1)
+        if p not in req.procedures or o in req.operating_points or o in req.not_applicable or out.error:
+            continue
+        samples = out.samples.get(key) or []
+        if not any(s.eligible and s.value is not None for s in samples):
+            continue
+        row = judge_row(req, p, o, limit, samples, None)
+        row["extended"] = (f"{req.metric} was computed at {o} (a run another requirement asked for); {req.id} applies "
+                           f"wherever its metric is computed unless its file says why not (not_applicable)")
+        rows.append(row)
     return rows
 
 
@@ -134,7 +178,10 @@ def judge(cfg, reqset: RequirementSet, jobs: list[Job], outcomes) -> tuple[list[
             worst = None if wi is None else rows[wi]
         elif rows:
             vals = [r for r in rows if r["value"] is not None]
-            if vals:
+            silent = [r for r in rows if r.get("non_responding")]
+            if silent:  # an open limit still shows its worst case: a step that never responded
+                worst = silent[0]
+            elif vals:
                 worst = _least_favourable(req.comparator, vals, lambda r: r["value"])
         entries.append({
             "id": req.id,
@@ -142,6 +189,7 @@ def judge(cfg, reqset: RequirementSet, jobs: list[Job], outcomes) -> tuple[list[
             "standard": req.standard,
             "clause": req.clause,
             "metric": req.metric,
+            "request_key": request_key(req.metric, req.options),
             "unit": METRICS[req.metric].si_unit,
             "display_unit": METRICS[req.metric].display_unit,
             "comparator": req.comparator,
@@ -152,8 +200,14 @@ def judge(cfg, reqset: RequirementSet, jobs: list[Job], outcomes) -> tuple[list[
             "severity": req.severity,
             "source": req.source,
             "status": status,
-            "worst": None if worst is None else {k: worst[k] for k in _WORST_KEYS},
+            "worst": None if worst is None else {k: worst.get(k) for k in _WORST_KEYS},
             "rows": rows,
+            "basis": requirement_basis(rows) if req.enabled and req.limit is not None else "not_evaluated",
+            "coverage": {"rows": len(rows), "evaluated": sum(1 for r in rows if r.get("status") in ("pass", "fail")),
+                         "extended": sum(1 for r in rows if r.get("extended"))},
+            "reading": req.reading,
+            "alternative": req.alternative,
+            "own_choice": req.own_choice,
             "note": req.note,
             "loosened": loosen,
         })

@@ -49,50 +49,92 @@ def read_results(path) -> dict:
 
 
 # --------------------------------------------------------------------------- terminal
-def summary_table(results: dict) -> str:
-    """Fixed-width table: one line per requirement with its worst case, then the verdict."""
-    head = ("requirement", "metric", "limit", "worst value", "margin", "worst case", "severity", "status")
-    rows = []
-    for e in results["requirements"]:
-        w = e.get("worst") or {}
-        d = w.get("display") or {}
-        margin = "-"
-        if d.get("margin_pct"):
-            margin = d["margin_pct"]
-        elif w.get("margin") is not None:
-            margin = d.get("margin", "-")
-        where = w.get("run") or "-"
-        if w.get("which"):
-            where += f" ({w['which']})"
-        limit = e["limit_text"]
-        if "stroke" in limit and e.get("limit_display"):
-            limit += f" ({e['limit_display'].split(' ', 1)[1]})"
-        rows.append((e["id"], e["metric"], limit, d.get("value", "-"), margin, where, e["severity"],
-                     _STATUS_WORD.get(e["status"], e["status"])))
-    widths = [max(len(str(r[i])) for r in rows + [head]) for i in range(len(head))]
-    widths[5] = min(widths[5], 62)
+_BASIS_WORD = {"modelled": "modelled", "by_construction": "by constr.", "assumed": "assumed", "not_evaluated": "-"}
 
-    def line(r):
-        cells = [str(c) if i != 5 else (str(c) if len(str(c)) <= widths[5] else str(c)[: widths[5] - 1] + "~") for i, c in enumerate(r)]
-        return "  ".join(c.ljust(widths[i]) for i, c in enumerate(cells)).rstrip()
 
-    out = [line(head), line(tuple("-" * w for w in widths))] + [line(r) for r in rows]
+def _status_cell(e: dict) -> str:
+    word = _STATUS_WORD.get(e["status"], e["status"])
+    if e["status"] == "pass" and e.get("basis") == "by_construction":
+        return word + " (by construction)"
+    return word
+
+
+def _table_row(e: dict) -> tuple:
+    w = e.get("worst") or {}
+    d = w.get("display") or {}
+    margin = "-"
+    if d.get("margin_pct"):
+        margin = d["margin_pct"]
+    elif w.get("margin") is not None:
+        margin = d.get("margin", "-")
+    band = w.get("band")
+    if band and band.get("margin_low_pct") is not None:
+        margin += f" [{band['margin_low_pct']:+.0f}..{band['margin_high_pct']:+.0f} %]"
+    where = w.get("run") or "-"
+    if w.get("which"):
+        where += f" ({w['which']})"
+    limit = e["limit_text"]
+    if "stroke" in limit and e.get("limit_display"):
+        limit += f" ({e['limit_display'].split(' ', 1)[1]})"
+    cov = e.get("coverage") or {}
+    cases = f"{cov['evaluated']}/{cov['rows']}" if cov.get("rows") and e.get("limit") is not None else "-"
+    value = "no response" if w.get("non_responding") else d.get("value", "-")
+    return (e["id"], e["metric"], limit, value, margin, cases, where, e["severity"],
+            _BASIS_WORD.get(e.get("basis"), "-"), _status_cell(e))
+
+
+def summary_lines(results: dict) -> list[str]:
+    """The lines under the table: counts (passes by construction, advisory failures and coverage apart),
+    what was not evaluated and why, findings of the requirement set, the assumptions that matter most."""
     s = results["summary"]
-    out.append("")
-    out.append(f"plant {results['plant']['name']} ({results['plant'].get('path')}) against "
-               f"{results['requirement_set']['name']} ({results['requirement_set']['path']})")
     c = s["counts"]
-    out.append(f"{c['pass']} pass, {c['fail']} fail, {c['not_evaluated']} not evaluated, {c['open']} open (no limit set), "
-               f"{c['disabled']} disabled")
+    out = [f"plant {results['plant']['name']} ({results['plant'].get('path')}) against "
+           f"{results['requirement_set']['name']} ({results['requirement_set']['path']})"]
+    cov = s.get("coverage")
+    out.append(
+        f"{c['pass']} pass, {c.get('pass_by_construction', 0)} pass by construction (not evidence), "
+        f"{c.get('fail_mandatory', c['fail'])} fail (mandatory), {c.get('fail_advisory', 0)} fail (advisory), "
+        f"{c.get('uncertain', 0)} uncertain, {c['not_evaluated']} not evaluated, {c['open']} open (no limit set), "
+        f"{c['disabled']} disabled" + (f"; {cov['evaluated']}/{cov['rows']} cases evaluated" if cov else ""))
     for e in results["requirements"]:
         if e["status"] == "not_evaluated":
             reasons = sorted({r["reason"] for r in e["rows"] if r.get("reason")})
             out.append(f"  not evaluated {e['id']}: {'; '.join(reasons)[:200]}")
+        elif e["status"] == "pass" and e.get("basis") == "by_construction":
+            out.append(f"  by construction {e['id']}: {((e.get('worst') or {}).get('basis_reason') or '')[:200]}")
+        elif e["status"] == "uncertain":
+            deciding = ", ".join(((e.get("worst") or {}).get("band") or {}).get("deciding") or [])
+            out.append(f"  uncertain {e['id']}: its band straddles the limit; decided by {deciding or '-'}")
+    findings = results.get("findings") or []
+    for f in findings:
+        if f.get("mandatory"):
+            out.append(f"  requirement set {f['kind']}: {f['text']}")
+    others = len(findings) - sum(1 for f in findings if f.get("mandatory"))
+    if others:
+        out.append(f"  requirement set: {others} more finding(s) involving advisory requirements (results JSON, 'findings')")
+    top = s.get("top_assumptions") or (results.get("uncertainty") or {}).get("top_assumptions") or []
+    if top:
+        out.append("  assumptions that matter most: " + "; ".join(f"{a['parameter']} ({a['why']})" for a in top))
     for n in s.get("notes", []):
         out.append(f"  {n}")
     out.append(f"VERDICT: {s['status'].upper()}"
                + (f" (mandatory failures: {', '.join(s['failed_mandatory'])})" if s.get("failed_mandatory") else ""))
-    return "\n".join(out) + "\n"
+    return out
+
+
+def summary_table(results: dict) -> str:
+    """Fixed-width table: one line per requirement with its worst case, cases evaluated and basis, then the verdict."""
+    head = ("requirement", "metric", "limit", "worst value", "margin", "cases", "worst case", "severity", "basis", "status")
+    rows = [_table_row(e) for e in results["requirements"]]
+    widths = [max(len(str(r[i])) for r in rows + [head]) for i in range(len(head))]
+    widths[6] = min(widths[6], 62)
+
+    def line(r):
+        cells = [str(c) if i != 6 else (str(c) if len(str(c)) <= widths[6] else str(c)[: widths[6] - 1] + "~") for i, c in enumerate(r)]
+        return "  ".join(c.ljust(widths[i]) for i, c in enumerate(cells)).rstrip()
+
+    out = [line(head), line(tuple("-" * w for w in widths))] + [line(r) for r in rows]
+    return "\n".join(out + [""] + summary_lines(results)) + "\n"
 
 
 # --------------------------------------------------------------------------- JUnit
@@ -119,11 +161,14 @@ def junit_xml(results: dict) -> str:
             if st == "fail":
                 cnt["failures"] += 1
                 body = f"<failure message={quoteattr(msg)} type=\"requirement\">{escape(e['title'])}</failure>"
-            elif st == "not_evaluated":
-                reason = r.get("reason") or "not evaluated"
+            elif st in ("not_evaluated", "uncertain"):
+                band = r.get("band") or {}
+                reason = (r.get("reason") or "not evaluated") if st == "not_evaluated" else (
+                    f"uncertain: band {band.get('low')} .. {band.get('high')} straddles the limit; decided by "
+                    + ", ".join(band.get("deciding") or []))
                 if e["severity"] == "mandatory":
                     cnt["errors"] += 1
-                    body = f"<error message={quoteattr(reason)} type=\"not_evaluated\"/>"
+                    body = f"<error message={quoteattr(reason)} type=\"{st}\"/>"
                 else:
                     cnt["skipped"] += 1
                     body = f"<skipped message={quoteattr(reason)}/>"

@@ -24,9 +24,12 @@ from compliance.campaign.plan import Job, plan
 from compliance.campaign.executor import available_cores, execute
 from compliance.campaign.judge import fmt, judge, sample_dict
 from compliance.errors import InputError
+from compliance.requirements.consistency import consistency_findings
 from compliance.requirements.tightening import check_tightening
 from compliance.requirements.requirement_set import RequirementSet
-from compliance.requirements.verdict import DISABLED, FAIL, NOT_EVALUATED, OPEN, PASS, overall_status
+from compliance.campaign.coverage import unjudged
+from compliance.campaign.uncertainty import local_bands, ranged_parameters
+from compliance.requirements.verdict import DISABLED, FAIL, NOT_EVALUATED, OPEN, PASS, UNCERTAIN, overall_status
 
 __all__ = [
     "RESULTS_SCHEMA",
@@ -51,6 +54,44 @@ def _versions() -> dict:
         except Exception:  # a missing optional package is reported as absent, not fatal
             out[mod] = None
     return out
+
+
+def _by_construction(e: dict) -> bool:
+    return e["status"] == PASS and e.get("basis") == "by_construction"
+
+
+def summary_counts(entries: list[dict]) -> dict:
+    """Requirement counts by status, with passes by construction and advisory failures counted apart."""
+    counts = {s: sum(1 for e in entries if e["status"] == s) for s in (PASS, FAIL, NOT_EVALUATED, OPEN, DISABLED, UNCERTAIN)}
+    counts["pass_by_construction"] = sum(1 for e in entries if _by_construction(e))
+    counts[PASS] -= counts["pass_by_construction"]  # a pass by construction is not evidence: never counted as a pass
+    counts["fail_mandatory"] = sum(1 for e in entries if e["status"] == FAIL and e["severity"] == "mandatory")
+    counts["fail_advisory"] = counts[FAIL] - counts["fail_mandatory"]
+    return counts
+
+
+def summary_section(entries: list[dict], notes: list[str], uncertainty: dict | None = None) -> dict:
+    """The results' ``summary``: overall verdict, counts, lists of ids by outcome, coverage, the assumptions that matter most."""
+    judged = [(e["severity"], e["status"], e.get("basis")) for e in entries if e["status"] not in (OPEN, DISABLED)]
+    return {
+        "status": overall_status(judged),
+        "counts": summary_counts(entries),
+        "failed": [e["id"] for e in entries if e["status"] == FAIL],
+        "failed_mandatory": [e["id"] for e in entries if e["status"] == FAIL and e["severity"] == "mandatory"],
+        "not_evaluated": [e["id"] for e in entries if e["status"] == NOT_EVALUATED],
+        "open": [e["id"] for e in entries if e["status"] == OPEN],
+        "passed_by_construction": [e["id"] for e in entries if _by_construction(e)],
+        "uncertain": [e["id"] for e in entries if e["status"] == UNCERTAIN],
+        "coverage": coverage_summary(entries),
+        "top_assumptions": (uncertainty or {}).get("top_assumptions") or [],
+        "notes": notes,
+    }
+
+
+def coverage_summary(entries: list[dict]) -> dict:
+    """Verdict rows evaluated out of all rows, over the requirements that have a limit."""
+    rows = [r for e in entries if e.get("limit") is not None for r in e["rows"]]
+    return {"rows": len(rows), "evaluated": sum(1 for r in rows if r.get("status") in (PASS, FAIL, UNCERTAIN))}
 
 
 def plant_section(cfg) -> dict:
@@ -91,7 +132,7 @@ def plant_section(cfg) -> dict:
 
 
 def run_campaign(cfg, reqset: RequirementSet, *, workers: int | None = None, progress: bool = True,
-                 command_line: str | None = None) -> dict:
+                 command_line: str | None = None, uncertainty: str | None = None) -> dict:
     """Check a plant against a requirement set.
 
     Parameters
@@ -104,6 +145,9 @@ def run_campaign(cfg, reqset: RequirementSet, *, workers: int | None = None, pro
         Show a progress bar on stderr when it is a terminal.
     command_line : str, optional
         Recorded in the results.
+    uncertainty : {"local", None}
+        Bands on the verdicts from the plant file's declared ranges by local sensitivities
+        (``compliance.campaign.uncertainty``); None (default): point values only.
 
     Returns
     -------
@@ -126,9 +170,9 @@ def run_campaign(cfg, reqset: RequirementSet, *, workers: int | None = None, pro
         if o.error and o.error_kind == "InputError":
             raise InputError(f"{reqset.path}: run {j.key}: {o.error}")
     entries, notes = judge(cfg, reqset, jobs, outcomes)
-    judged = [(e["severity"], e["status"]) for e in entries if e["status"] not in (OPEN, DISABLED)]
-    overall = overall_status(judged)
-    counts = {s: sum(1 for e in entries if e["status"] == s) for s in (PASS, FAIL, NOT_EVALUATED, OPEN, DISABLED)}
+    bands = None
+    if uncertainty == "local" and ranged_parameters(cfg):
+        bands = local_bands(cfg, reqset, jobs, entries, workers=workers, progress=progress)
     runs = []
     for j, o in zip(jobs, outcomes):
         proc = reqset.procedures[j.procedure]
@@ -152,15 +196,10 @@ def run_campaign(cfg, reqset: RequirementSet, *, workers: int | None = None, pro
         "versions": _versions(),
         "plant": plant_section(cfg),
         "requirement_set": reqset.as_dict(),
-        "summary": {
-            "status": overall,
-            "counts": counts,
-            "failed": [e["id"] for e in entries if e["status"] == FAIL],
-            "failed_mandatory": [e["id"] for e in entries if e["status"] == FAIL and e["severity"] == "mandatory"],
-            "not_evaluated": [e["id"] for e in entries if e["status"] == NOT_EVALUATED],
-            "open": [e["id"] for e in entries if e["status"] == OPEN],
-            "notes": notes,
-        },
+        "summary": summary_section(entries, notes, bands),
+        "coverage": {"unjudged": unjudged(reqset, jobs, outcomes, entries)},
+        "findings": consistency_findings(reqset, stroke),
+        "uncertainty": bands,
         "requirements": entries,
         "runs": runs,
         "timing": {"wall": time.perf_counter() - t0, "runs": len(jobs), "workers": used,

@@ -33,6 +33,7 @@ def register(subparsers):
             "govcheck check models/plant-a.toml -r shpp-400kw",
             "govcheck check plant-a -r iec61362 --json r.json --junit r.xml --report r.html --pdf r.pdf",
             "govcheck check models/plant-a.toml -r requirements/shpp-400kw.toml --linear -q --reproducible --json r.json",
+            "govcheck check plant-a -r shpp-400kw --uncertainty 32 --json r.json   # Monte Carlo bands over the declared ranges",
         ],
     )
     add_plant_argument(p)
@@ -47,6 +48,12 @@ def register(subparsers):
     p.add_argument("--remedies", nargs="?", const="default", metavar="SWEEP.toml",
                    help="what would make it pass: sensitivities and the smallest verified change over the on-site settings "
                         "(or the adjustable space of a sweep file); added to the results as 'remedies'")
+    p.add_argument("--uncertainty", type=int, default=None, metavar="N",
+                   help="bands from a Latin-hypercube Monte Carlo of N plants over the plant file's declared ranges "
+                        "(instead of the local sensitivities); 0 = point values only")
+    p.add_argument("--allow-conflicts", action="store_true",
+                   help="judge a requirement set even when two mandatory limits cannot hold together (without it such a set "
+                        "is refused with exit code 2 before any simulation; docs/requirements.md)")
     add_jobs(p)
     add_quiet(p, "no progress bar; print only the verdict line")
     add_reproducible(p)
@@ -69,9 +76,11 @@ def command_line(args, name: str = "check", outputs: bool = True) -> str:
         v = getattr(args, flag, None)
         if v is not None and outputs:
             parts += [f"--{flag}", str(v)]
-    for flag in ("linear", "quiet", "reproducible"):
+    if getattr(args, "uncertainty", None) is not None:
+        parts += ["--uncertainty", str(args.uncertainty)]
+    for flag in ("linear", "quiet", "reproducible", "allow_conflicts"):
         if getattr(args, flag, False):
-            parts.append(f"--{flag}")
+            parts.append(f"--{flag.replace('_', '-')}")
     return shlex.join(parts)
 
 
@@ -84,6 +93,16 @@ def finish_results(results: dict, args, name: str = "check") -> dict:
     return make_reproducible(results, command_line(args, name, outputs=False))
 
 
+def monte_carlo(cfg, reqset, results: dict, args) -> None:
+    """Replace the verdicts' bands by a Monte Carlo of ``args.uncertainty`` plants and re-summarise."""
+    from compliance.campaign.run import summary_section
+    from compliance.sweep.uncertainty_mc import monte_carlo_bands
+
+    results["uncertainty"] = monte_carlo_bands(cfg, reqset, results, args.uncertainty, workers=args.jobs,
+                                               progress=not args.quiet)
+    results["summary"] = summary_section(results["requirements"], results["summary"]["notes"], results["uncertainty"])
+
+
 def run(args) -> int:
     """Check outputs and inputs, run the campaign, print the table, write the outputs; exit code from the verdict."""
     from compliance.campaign.results_files import summary_table, write_json, write_junit
@@ -94,6 +113,10 @@ def run(args) -> int:
     from compliance.requirements.loading import load_requirements
 
     check_args_outputs(args)
+    if args.uncertainty is not None and (args.uncertainty == 1 or args.uncertainty < 0):
+        from compliance.errors import InputError
+
+        raise InputError(f"--uncertainty {args.uncertainty}: expected at least 2 plants (or 0 for point values)")
     if is_reproducible(args.reproducible):
         fixed_created()  # a malformed SOURCE_DATE_EPOCH is refused before the work
     render = renderer(args)
@@ -103,10 +126,23 @@ def run(args) -> int:
         load_sweep(args.remedies)
     cfg = plant_from_args(args)
     reqset = load_requirements(args.requirements)
+    from compliance.requirements.consistency import check_consistency
+
+    check_consistency(reqset, cfg.p("cylinder.stroke"), args.allow_conflicts)  # before any simulation
+    if args.uncertainty:
+        from compliance.campaign.uncertainty import ranged_parameters
+        from compliance.errors import InputError
+
+        if not ranged_parameters(cfg):
+            raise InputError(f"{cfg.path or cfg.name}: --uncertainty {args.uncertainty}: the plant file gives no parameter "
+                             "a range (range = [low, high] with range_note, docs/requirements.md 'Uncertainty')")
     stages = 1 + bool(args.linear) + (render is not None)
     # the campaign reports its runs itself on a terminal; in a CI log these stage lines (and a heartbeat) show progress
     with progress(stages, "check", quiet=args.quiet or sys.stderr.isatty(), unit="stage", first="campaign") as bar:
-        results = run_campaign(cfg, reqset, workers=args.jobs, progress=not args.quiet, command_line=command_line(args))
+        results = run_campaign(cfg, reqset, workers=args.jobs, progress=not args.quiet, command_line=command_line(args),
+                               uncertainty="local" if args.uncertainty is None else None)
+        if args.uncertainty:
+            monte_carlo(cfg, reqset, results, args)
         bar.update(1)
         if args.linear:
             from compliance.linear.operating_points import linear_for_campaign

@@ -25,7 +25,7 @@ from compliance.metrics.catalogue import METRICS, STEP_OPTION_DEFAULTS, MetricIn
 from compliance.metrics.position_error import HoldMetrics, hold, tracking_errors
 from compliance.metrics.speed import saturation_fraction, speed, speed_extremes
 from compliance.metrics.step import DETECT_FRACTION, TAU_FRACTION, StepEvent, StepMetrics, find_steps, step_response
-from compliance.metrics.stroke import independent_adjustment, stroke_time
+from compliance.metrics.stroke import independent_adjustment, stroke_time, stroke_timing
 from compliance.metrics.trace_windows import frame_columns
 
 __all__ = [
@@ -48,5 +48,6 @@ __all__ = [
     "speed_extremes",
     "step_response",
     "stroke_time",
+    "stroke_timing",
     "tracking_errors",
 ]

@@ -34,7 +34,8 @@ METRICS: dict[str, MetricInfo] = {
         MetricInfo("dead_time", "s", "s", 1.0, ("steps",), "command step to first detectable motion", ("detect",)),
         MetricInfo(
             "time_constant", "s", "s", 1.0, ("steps",),
-            "end of dead time to 63.2 % of the commanded step, steps out of the rate limit only", ("detect",),
+            "end of dead time to 63.2 % of the commanded step, first step from rest, steps out of the rate limit only",
+            ("detect",),
         ),
         MetricInfo("rise_time", "s", "s", 1.0, ("steps",), "10 % to 90 % of the actual change", ("final_window",)),
         MetricInfo("settling_time", "s", "s", 1.0, ("steps",), "step to last exit from the settling band", _SETTLE_OPTS),
@@ -52,6 +53,10 @@ METRICS: dict[str, MetricInfo] = {
         MetricInfo("dead_band", "m", "mm", 1e3, ("dead_band",), "width of the position/reference hysteresis loop"),
         MetricInfo("opening_time", "s", "s", 1.0, ("full_stroke",), "2 x time from 25 % to 75 % of stroke, opening"),
         MetricInfo("closing_time", "s", "s", 1.0, ("full_stroke",), "2 x time from 75 % to 25 % of stroke, closing"),
+        MetricInfo(
+            "stroke_speed", "m/s", "mm/s", 1e3, ("full_stroke",),
+            "mean speed from 25 % to 75 % of a full stroke (the rate the speed setting sets; stroke / full-stroke time)",
+        ),
         MetricInfo(
             "max_speed", "m/s", "mm/s", 1e3, ("steps", "sine", "full_stroke", "hold", "dead_band"),
             "max |dx/dt| over a centred 20 ms difference",

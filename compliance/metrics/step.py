@@ -90,6 +90,7 @@ class StepMetrics:
     rate_limited: bool
     reasons: dict = field(default_factory=dict)
     marks: dict = field(default_factory=dict)
+    time_constant_achieved: float | None = None  # end of dead time to 63.2 % of the ACHIEVED travel x_final - x_start [s]
 
 
 def step_response(
@@ -146,8 +147,12 @@ def step_response(
     tau, rate_limited = _time_constant(time, tt, xx, event, x0, t_move, i_step, valve_command, command_saturation,
                                        reasons, marks)
     rise, settle, over = _step_info(tt, xx, event, x0, xf, thr, settling_band, settling_band_abs, reasons, marks)
+    tau_a = None
+    if t_move is not None and abs(xf - x0) > thr:  # the same definition on the travel the servo actually made
+        t63a = crossing(tt, xx, x0 + TAU_FRACTION * (xf - x0), 0, 1 if xf > x0 else -1)
+        tau_a = None if t63a is None else t63a - t_move
     return StepMetrics(
-        event, x0, xf, dead_time, tau, rise, settle, over, sse, mpe, vmax, rate_limited, reasons, marks
+        event, x0, xf, dead_time, tau, rise, settle, over, sse, mpe, vmax, rate_limited, reasons, marks, tau_a
     )
 
 

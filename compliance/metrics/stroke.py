@@ -11,7 +11,7 @@ import numpy as np
 
 from compliance.metrics.trace_windows import crossing
 
-__all__ = ["independent_adjustment", "stroke_time"]
+__all__ = ["START_FRACTION", "independent_adjustment", "stroke_timing", "stroke_time"]
 
 
 def stroke_time(time, position, stroke, direction, lower=0.25, upper=0.75):
@@ -48,6 +48,51 @@ def stroke_time(time, position, stroke, direction, lower=0.25, upper=0.75):
         reached = (np.max(position) if direction == "opening" else np.min(position)) / stroke
         return None, t1, t2, f"{direction}: did not pass {100*lower:.0f} % and {100*upper:.0f} % of stroke (reached {100*reached:.0f} %)"
     return (t2 - t1) / (upper - lower), t1, t2, None
+
+
+# travel that marks the start of motion and the entry into the end cushion (govcheck's choice; ASME PTC 29-2005
+# (R2020) asks for the servomotor timing and the cushioning time without fixing these fractions)
+START_FRACTION = 0.01
+CUSHION_FRACTION = 0.90
+END_FRACTION = 0.99
+
+
+def stroke_timing(time, position, stroke, direction, full_stroke_time):
+    """The timing figures of one full stroke beside its 25-75 % time [s].
+
+    Parameters
+    ----------
+    time, position : array [s], [m]
+        The stroke, command given at ``time[0]``, starting at the end the stroke leaves.
+    stroke : float
+        Servomotor stroke [m].
+    direction : {"opening", "closing"}
+    full_stroke_time : float or None
+        The 25-75 % extrapolated time (:func:`stroke_time`) [s].
+
+    Returns
+    -------
+    dict
+        ``start_delay`` (command to 1 % of the stroke travelled), ``time_to_end`` (command to
+        99 %: the end stop), ``cushion_time`` (90 % to 99 % of travel: the cushioning at the
+        end stop) and ``cushion_at_rate`` (the time the same 9 % takes at the straight-part rate,
+        0.09 x full-stroke time; a cushion makes ``cushion_time`` longer); None where not reached.
+    """
+    t = np.asarray(time, float)
+    x = np.asarray(position, float)
+    travel = (x - x[0]) if direction == "opening" else (x[0] - x)
+
+    def at(frac):
+        return crossing(t, travel, frac * stroke, 0, +1)
+
+    t_start, t_cushion, t_end = at(START_FRACTION), at(CUSHION_FRACTION), at(END_FRACTION)
+    rel = (lambda v: None if v is None else v - float(t[0]))
+    return {
+        "start_delay": rel(t_start),
+        "time_to_end": rel(t_end),
+        "cushion_time": None if t_cushion is None or t_end is None else t_end - t_cushion,
+        "cushion_at_rate": None if full_stroke_time is None else (END_FRACTION - CUSHION_FRACTION) * full_stroke_time,
+    }
 
 
 def independent_adjustment(base, modified, adjusted):

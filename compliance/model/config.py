@@ -19,7 +19,8 @@ import numpy as np
 from compliance.effects import EFFECTS
 from compliance.errors import InputError, did_you_mean
 from compliance.files.atomic import write_text_atomic
-from compliance.model.config_fields import SECTIONS, effect_values, load_curve_field, section_values
+from compliance.model.assumptions import read_assumptions
+from compliance.model.config_fields import SECTIONS, atmosphere_of, effect_values, load_curve_field, section_values
 from compliance.model.parameters import BASE_BY_KEY, BASE_PARAMS, OPTIONS
 from compliance.model.identity import parse_identity
 from compliance.model.toml_file import read_toml
@@ -66,6 +67,7 @@ class PlantConfig:
     effects: Mapping[str, Mapping[str, float]]
     provenance: Mapping[str, str] = field(default_factory=dict)
     identity: Mapping[str, Any] = field(default_factory=dict)  # optional [identity]: site, unit, equipment (model/identity.py)
+    assumptions: Mapping[str, Any] = field(default_factory=dict)  # key -> range / derived_for (model/assumptions.py)
 
     def p(self, key: str) -> float:
         """SI value of a base parameter."""
@@ -207,6 +209,7 @@ def plant_from_dict(data: dict[str, Any], where: str = "<configuration>", digest
         effects=MappingProxyType({k: MappingProxyType(v) for k, v in effects.items()}),
         provenance=MappingProxyType({str(k): str(v) for k, v in (data.get("provenance") or {}).items()}),
         identity=parse_identity(data.get("identity"), where),
+        assumptions=MappingProxyType(read_assumptions(data, where, params, atmosphere_of(data, where))),
     )
     _check_physical(cfg, where)
     return cfg

@@ -18,6 +18,7 @@ from compliance.model.parameters import BASE_BY_KEY, BASE_PARAMS, OPTION_DEFAULT
 
 CALIBRATED_PREFIX = "calibrated to "  # source of a value fitted by a calibration (papers/calibration_table.py)
 from compliance.model.toml_file import check_table
+from compliance.model.assumptions import ENTRY_FIELDS
 from compliance.units import ATMOSPHERE_PA, convert_array, parse_quantity
 
 SECTIONS = sorted({k.split(".")[0] for k in BASE_BY_KEY} | {k.split(".")[0] for k in OPTIONS})
@@ -42,10 +43,10 @@ def param_value(entry, key: str, where: str, atmosphere: float) -> tuple[float, 
     spec = BASE_BY_KEY[key]
     source = "user"
     if isinstance(entry, dict):
-        unknown = set(entry) - {"value", "source", "note"}
+        unknown = set(entry) - set(ENTRY_FIELDS)
         if unknown:
             u = sorted(unknown)[0]
-            raise InputError(f"{where}.{u}: unknown field{did_you_mean(u, ['value', 'source', 'note'])} (expected value, source, note)")
+            raise InputError(f"{where}.{u}: unknown field{did_you_mean(u, ENTRY_FIELDS)} (expected {', '.join(ENTRY_FIELDS)})")
         if "value" not in entry:
             raise InputError(f"{where}: missing 'value'")
         source = entry.get("source", "user")

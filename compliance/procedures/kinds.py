@@ -52,6 +52,9 @@ KINDS: dict[str, Kind] = {
             "pattern": Setting("pattern", ["up", "down"], "directions of the successive steps"),
             "lead": Setting("time", "1 s", "hold before the first step"),
             "dwell": Setting("time", "4 s", "time between steps"),
+            "tau_from_rest": Setting("bool", True, "count the time constant only on the first step, which starts from rest "
+                                     "at the operating point (the standards' test); later steps start from the previous "
+                                     "step's settled state and are reported, not judged"),
         }),
         Kind("sine", "sinusoidal set-point x0 + A sin(2 pi f t) in closed loop (seed 000: 8 mm at 0.05 Hz)", {
             "amplitude": Setting("length", None, "amplitude A"),

@@ -111,6 +111,8 @@ def run_steps(cfg, proc, op, requests, out):
     if used != s["pattern"]:
         out.notes.append(f"pattern reversed to {used} to stay inside the stroke from {x0*1e3:.1f} mm")
     label, tt, x, r, u = closed_loop_trace(cfg, proc, op, out, duration, x0, ref)
+    installed = cfg.flow_control_installed if op.flow_control is None else bool(op.flow_control)
+    circuit = "flow-control valves 2V2/2V3 " + ("in" if installed else "out (wide open)")
     events = M.find_steps(tt, r, min_size=min(5e-5, 0.5 * size))
     wants_tau = any(m == "time_constant" for m, _ in requests)
     vmax = _full_command_speeds(cfg, op) if wants_tau else None
@@ -134,39 +136,62 @@ def run_steps(cfg, proc, op, requests, out):
                               for ev in events]
         for k, (ev, sm) in enumerate(zip(events, per_opts[okey])):
             direction = "up" if ev.size > 0 else "down"
-            lab = f"step {k+1} {direction} {abs(ev.size)*1e3:.2f} mm at {ev.t_step:.2f} s"
-            detail = {"t_step": ev.t_step, "size": ev.size, "x_start": sm.x_start, "x_final": sm.x_final}
+            lab = f"step {k+1} of {len(events)} {direction} {abs(ev.size)*1e3:.2f} mm at {ev.t_step:.2f} s"
+            detail = {"t_step": ev.t_step, "size": ev.size, "x_start": sm.x_start, "x_final": sm.x_final,
+                      "step": k + 1, "steps": len(events), "circuit": circuit,
+                      "start": "rest at the operating point" if k == 0 else f"rest after step {k} at {sm.x_start * 1e3:.1f} mm"}
             if metric in ("max_speed", "max_opening_speed", "max_closing_speed", "saturation_fraction"):
                 continue
             val = getattr(sm, metric)
             reason = sm.reasons.get(metric)
             eligible = True
-            if metric == "time_constant" and val is not None:
-                if sm.rate_limited:
-                    eligible = False
-                elif (1.0 - M.TAU_FRACTION) * abs(ev.size) < STALL_MARGIN * stall[1 if ev.size > 0 else -1]:
-                    eligible = False
-                    reason = (f"dead-zone dominated: the 63.2 % point lies {(1 - M.TAU_FRACTION) * abs(ev.size) * 1e3:.2f} mm "
-                              f"from the set-point, inside {STALL_MARGIN:g} x the stall band "
-                              f"{stall[1 if ev.size > 0 else -1] * 1e3:.2f} mm "
-                              f"where the compensated valve shuts")
-                elif vmax is not None:
-                    peak, straight = vmax["opening" if ev.size > 0 else "closing"]
-                    mean_speed = M.TAU_FRACTION * abs(ev.size) / val if val > 0 else float("inf")
-                    if peak > 0 and sm.max_speed >= RATE_LIMIT_FRACTION * peak:
-                        eligible = False
-                        reason = (f"rate limited: peak speed {sm.max_speed*1e3:.0f} mm/s >= "
-                                  f"{RATE_LIMIT_FRACTION:.0%} of the full-command speed {peak*1e3:.0f} mm/s")
-                    elif straight > 0 and mean_speed >= RATE_LIMIT_FRACTION * straight:
-                        eligible = False
-                        reason = (f"rate limited: mean speed to 63.2 % {mean_speed*1e3:.0f} mm/s >= "
-                                  f"{RATE_LIMIT_FRACTION:.0%} of the flow-control speed {straight*1e3:.0f} mm/s "
-                                  f"(straight part of the full-command stroke)")
-                    detail["mean_speed_to_63"] = mean_speed
-                detail["peak_speed"] = sm.max_speed
+            if metric == "dead_time" and val is None:
+                detail["non_responding"] = True  # the step never moved: its dead time is the worst case
+            if metric == "time_constant":
+                eligible, reason = _tau_eligibility(k, len(events), ev, sm, reason, s["tau_from_rest"], stall, vmax, detail)
             out.add(key, Sample(val, lab, reason, eligible, detail))
     # marks for plots (default options)
     for k, (ev, sm) in enumerate(zip(events, per_opts[request_key("", {})])):
         for name, v in sm.marks.items():
             out.marks.append({"trace": label, "step": k + 1, "type": name, "value": v})
     add_drive_samples(cfg, out, tt, x, u, label)
+
+
+def _tau_eligibility(k, n, ev, sm, reason, from_rest, stall, vmax, detail) -> tuple[bool, str | None]:
+    """Whether step ``k`` (0-based, of ``n``) measures the time constant, and why not; fills ``detail``.
+
+    Beside the commanded-step figure the detail keeps the time constant to 63.2 % of the achieved
+    travel and the dead time apart. A step is not judged when it does not start from rest at the
+    operating point (``from_rest``), is rate limited (valve or throttle saturated, peak or mean speed
+    near the full-command figures) or dead-zone dominated (63.2 % point inside twice the stall band).
+    """
+    val = sm.time_constant
+    detail.update(tau_achieved=sm.time_constant_achieved, dead_time=sm.dead_time,
+                  achieved_fraction=(sm.x_final - sm.x_start) / ev.size if ev.size else None)
+    side = 1 if ev.size > 0 else -1
+    if k > 0 and from_rest:
+        return False, (f"not from rest at the operating point: step {k + 1} of {n} starts where step {k} settled "
+                       f"({sm.x_start * 1e3:.1f} mm); the standards' test steps from rest at the point")
+    if (1.0 - M.TAU_FRACTION) * abs(ev.size) < STALL_MARGIN * stall[side]:
+        return False, (f"dead-zone dominated: the 63.2 % point lies {(1 - M.TAU_FRACTION) * abs(ev.size) * 1e3:.2f} mm "
+                       f"from the set-point, inside {STALL_MARGIN:g} x the stall band {stall[side] * 1e3:.2f} mm "
+                       "where the compensated valve shuts")
+    if val is None:  # a step beyond the dead zone that never reached 63.2 %: the worst case, not a gap
+        detail["non_responding"] = True
+        return True, reason
+    detail["peak_speed"] = sm.max_speed
+    if sm.rate_limited:
+        return False, reason
+    if vmax is None:
+        return True, reason
+    peak, straight = vmax["opening" if ev.size > 0 else "closing"]
+    mean_speed = M.TAU_FRACTION * abs(ev.size) / val if val > 0 else float("inf")
+    detail["mean_speed_to_63"] = mean_speed
+    if peak > 0 and sm.max_speed >= RATE_LIMIT_FRACTION * peak:
+        return False, (f"rate limited: peak speed {sm.max_speed*1e3:.0f} mm/s >= "
+                       f"{RATE_LIMIT_FRACTION:.0%} of the full-command speed {peak*1e3:.0f} mm/s")
+    if straight > 0 and mean_speed >= RATE_LIMIT_FRACTION * straight:
+        return False, (f"rate limited: mean speed to 63.2 % {mean_speed*1e3:.0f} mm/s >= "
+                       f"{RATE_LIMIT_FRACTION:.0%} of the flow-control speed {straight*1e3:.0f} mm/s "
+                       "(straight part of the full-command stroke)")
+    return True, reason

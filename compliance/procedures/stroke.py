@@ -75,13 +75,14 @@ def run_full_stroke(cfg, proc, op, requests, out):
     s = proc.settings
     label = f"{proc.name}@{op.name}"
     times = stroke_runs(cfg, op, s["command"], s["flow_control"], s["timeout"].value, label, out, s["directions"], s["start"])
+    circuit = "flow-control valves 2V2/2V3 in" if s["flow_control"] else "flow-control valves 2V2/2V3 out"
+    L = stroke(cfg)
     for d, (T, why, df, t1, t2) in times.items():
         tt, x = M.frame_columns(df, "time", "position")
-        L = stroke(cfg)
-        # informative: time from the command to within 1 % of the other end (includes the cushion)
-        end = np.nonzero(x >= 0.99 * L)[0] if d == "opening" else np.nonzero(x <= 0.01 * L)[0]
-        detail = {"t25_75": [t1, t2], "time_to_end": float(tt[end[0]]) if end.size else None}
+        # ASME PTC 29-2005 (R2020) servomotor timing: start delay, 25-75 % time, time to the end stop, cushioning
+        detail = {"t25_75": [t1, t2], **M.stroke_timing(tt, x, L, d, T), "circuit": circuit, "load": op.load_text}
         out.add(f"{d}_time", Sample(T, f"{d} at full command", why, detail=detail))
+        out.add("stroke_speed", Sample(None if T is None else L / T, d, why, detail=detail))
         v, vo, vc = M.speed_extremes(tt, x)
         out.add("max_speed", Sample(v, d))
         out.add("max_opening_speed" if d == "opening" else "max_closing_speed", Sample(vo if d == "opening" else vc, d))

@@ -90,7 +90,7 @@ def setting_text(v) -> str:
 
 def status_class(status: str | None) -> str:
     """CSS class of a status badge."""
-    return {"pass": "pass", "fail": "fail", "incomplete": "warn", "not_evaluated": "warn"}.get(status or "", "neutral")
+    return {"pass": "pass", "fail": "fail", "incomplete": "warn", "not_evaluated": "warn", "uncertain": "warn"}.get(status or "", "neutral")
 
 
 # --------------------------------------------------------------------------- sections
@@ -127,6 +127,9 @@ def summary_rows(results: dict) -> list[dict]:
             "procedure": w.get("procedure"), "operating_point": w.get("operating_point"), "reason": reason,
             "anchor": "run-" + _slug(where) if where in run_ids else None,
             "note": e.get("note"), "loosened": e.get("loosened") or [],
+            # how the verdict is known and how sure it is (campaign.basis, campaign.uncertainty)
+            "basis": e.get("basis"), "basis_reason": w.get("basis_reason"), "band": e.get("band"),
+            "coverage": e.get("coverage"),
         })
     return out
 

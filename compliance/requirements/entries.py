@@ -154,6 +154,10 @@ def build_requirement(rid, e, origin, defined_in, ops, procs, hist) -> Requireme
     if source == "simulation":
         _check_procedures(where, metric, proc_names, op_names, ops, procs)
     options = _metric_options(where, metric, e.get("options") or {})
+    not_applicable = dict(e.get("not_applicable") or {})
+    for n in not_applicable:
+        if n not in ops:
+            raise InputError(f"{where.key('not_applicable')}: operating point '{n}' is not declared{did_you_mean(n, ops)}")
     history = _limit_history(rid, metric, comparator, limit, hist)
     return Requirement(
         id=rid,
@@ -172,6 +176,10 @@ def build_requirement(rid, e, origin, defined_in, ops, procs, hist) -> Requireme
         enabled=bool(e.get("enabled", True)),
         defined_in=defined_in,
         history=history,
+        reading=e.get("reading", ""),
+        alternative=e.get("alternative", ""),
+        own_choice=e.get("own_choice", ""),
+        not_applicable=not_applicable,
     )
 
 

@@ -109,6 +109,10 @@ class Requirement:
     enabled: bool
     defined_in: str
     history: tuple[LimitHistory, ...] = field(default=())
+    reading: str = ""  # how the clause is read (an assumption), docs/requirements.md "Readings"
+    alternative: str = ""  # the other reading a purchaser may mean
+    own_choice: str = ""  # what in this entry is govcheck's (or the file's) choice, not the standard's
+    not_applicable: dict = field(default_factory=dict)  # operating point -> why the limit does not apply there
 
     @property
     def limit_text(self) -> str:
@@ -144,6 +148,10 @@ class Requirement:
             "note": self.note,
             "enabled": self.enabled,
             "defined_in": self.defined_in,
+            "reading": self.reading,
+            "alternative": self.alternative,
+            "own_choice": self.own_choice,
+            "not_applicable": dict(self.not_applicable),
             "history": [
                 {
                     "file": h.file,

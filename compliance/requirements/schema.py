@@ -53,6 +53,10 @@ class _ReqModel(_Strict):
     note: str | None = None
     enabled: bool | None = None
     allow_loosen: bool | None = None
+    reading: str | None = None
+    alternative: str | None = None
+    own_choice: str | None = None
+    not_applicable: dict[str, str] | None = None
 
 
 class _FileModel(_Strict):

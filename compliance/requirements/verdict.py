@@ -19,6 +19,7 @@ COMPARATORS = ("<=", "<", ">=", ">", "within")
 EQUAL_REL_TOL = 1e-9  # round-off of unit conversions; far below any measurement resolution
 
 PASS, FAIL, NOT_EVALUATED, OPEN, DISABLED = "pass", "fail", "not_evaluated", "open", "disabled"
+UNCERTAIN = "uncertain"  # the value's uncertainty band straddles the limit (compliance.campaign.uncertainty)
 
 
 @dataclass(frozen=True)
@@ -93,7 +94,9 @@ def evaluate(value: float | None, comparator: str, limit, reason: str | None = N
 def _badness(v: Verdict) -> tuple:
     """Sort key: fails first, then the smallest margin (in % when known)."""
     m = v.margin_pct if v.margin_pct is not None else v.margin
-    return (0 if v.status == FAIL else 1, m if m is not None else math.inf)
+    if m is None:  # a fail without a margin is a step that never responded: the worst of all
+        m = -math.inf if v.status == FAIL else math.inf
+    return (0 if v.status == FAIL else 1, m)
 
 
 def worst_index(verdicts) -> int | None:
@@ -119,16 +122,19 @@ def requirement_status(verdicts) -> str:
 
 
 def overall_status(items) -> str:
-    """Overall verdict from (severity, status) pairs.
+    """Overall verdict from (severity, status) or (severity, status, basis) tuples.
 
     ``fail`` if a mandatory requirement fails; ``incomplete`` if none fails but a mandatory
-    requirement could not be evaluated; ``pass`` otherwise. Advisory requirements and
+    requirement could not be evaluated, is UNCERTAIN (its band straddles the limit), or passes
+    only by construction (the configuration was tuned to give the figure, or the model lacks the
+    physics that could make it fail: not evidence); ``pass`` otherwise. Advisory requirements and
     requirements whose limit is still open (a purchaser's data-sheet value nobody set) are
     reported but do not decide the verdict.
     """
-    mand = [s for sev, s in items if sev == "mandatory"]
-    if FAIL in mand:
+    mand = [(it[1], it[2] if len(it) > 2 else None) for it in items if it[0] == "mandatory"]
+    st = [s for s, _ in mand]
+    if FAIL in st:
         return "fail"
-    if NOT_EVALUATED in mand:
+    if NOT_EVALUATED in st or UNCERTAIN in st or any(s == PASS and b == "by_construction" for s, b in mand):
         return "incomplete"
     return "pass"

@@ -21,7 +21,7 @@ __all__ = ["STATUS_WORD", "status_word", "fmt_num", "fmt_value", "fmt_margin_pct
 
 # requirement / verdict states -> the word shown to a reader (one table for every output)
 STATUS_WORD = {"pass": "PASS", "fail": "FAIL", "not_evaluated": "NOT EVALUATED", "open": "OPEN",
-               "disabled": "DISABLED", "incomplete": "INCOMPLETE"}
+               "disabled": "DISABLED", "incomplete": "INCOMPLETE", "uncertain": "UNCERTAIN"}
 
 # display unit -> smallest value worth printing (below it: "< resolution"); the resolution of
 # the measurement chain a report claims, not of the float

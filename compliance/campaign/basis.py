@@ -1,0 +1,111 @@
+"""How each verdict is known: modelled, by construction, assumed, or not evaluated.
+
+A figure the model *predicts* is evidence; a figure the configuration was *tuned to give*, or
+one that missing physics makes trivially zero, is not. Each verdict row gets
+
+- ``basis``: ``"modelled"`` (the model predicts it from the plant's parameters),
+  ``"by_construction"`` (a parameter was derived to hit exactly this figure, or the model lacks the
+  physics that could make it non-zero), ``"assumed"`` (it rests on an assumed input, such as an
+  assumed load curve, more than on the servo), ``"not_evaluated"`` (no value);
+- ``basis_reason``: the parameter or the missing physics, in words.
+
+A mandatory requirement whose passing rows are all by construction does not count as a pass
+(``compliance.requirements.verdict.overall_status``). docs/requirements.md, "Basis of a verdict".
+"""
+
+from __future__ import annotations
+
+from compliance.requirements.verdict import FAIL, NOT_EVALUATED, PASS
+
+__all__ = ["BASES", "requirement_basis", "row_basis"]
+
+BASES = ("modelled", "by_construction", "assumed", "not_evaluated")
+
+# metric -> the throttle whose conductance sets it (meter-out flow-control valves 2V2/2V3, seed 000)
+_THROTTLE = {"opening_time": "flow_control.opening_conductance", "closing_time": "flow_control.closing_conductance"}
+# effects through which the two speed settings could act on each other or a held position could move
+_COUPLING_EFFECTS = ("supply_droop", "line_dynamics")
+_LEAK_EFFECTS = ("internal_leakage", "external_leakage", "valve_offset")
+
+
+def _load_of(op):
+    """The operating point's constant load [N], 0 for none, None for a curve or the nominal load."""
+    if op.load is None:
+        return 0.0
+    return op.load if isinstance(op.load, float) else None
+
+
+def _stroke_metric(req, row) -> str | None:
+    """Which stroke time a row's value is (opening_time / closing_time), for stroke_speed by its label."""
+    if req.metric in _THROTTLE:
+        return req.metric
+    if req.metric == "stroke_speed" and row.get("which") in ("opening", "closing"):
+        return f"{row['which']}_time"
+    return None
+
+
+def _derived(cfg, op, flow_control: bool, stroke_metric: str | None):
+    """The derivation behind a stroke figure at ``op``, or None when the figure is a prediction."""
+    if stroke_metric is None or not flow_control:
+        return None
+    key = _THROTTLE[stroke_metric]
+    der = (cfg.assumptions.get(key) or {}).get("derived_for")
+    if not der or der["metric"] != stroke_metric or cfg.sources.get(key) != "derived":
+        return None
+    load = _load_of(op)
+    target = der["load"] or 0.0
+    if load is None or abs(load - target) > 0.01 * max(abs(target), 1.0):
+        return None
+    return key, der
+
+
+def row_basis(cfg, reqset, req, row) -> tuple[str, str]:
+    """(basis, basis_reason) of one verdict row (see the module docstring)."""
+    if row.get("non_responding") and row.get("status") == FAIL:
+        return "modelled", "the simulated step never responded: " + (row.get("reason") or "")
+    if row.get("status") == NOT_EVALUATED or row.get("value") is None:
+        return "not_evaluated", row.get("reason") or "no value"
+    if req.source == "linear":
+        return "modelled", "linearised model at the operating point (compliance.linear)"
+    op = reqset.operating_points[row["operating_point"]]
+    proc = reqset.procedures.get(row["procedure"])
+    fc = proc.settings.get("flow_control", True) if proc is not None and proc.kind == "full_stroke" else op.flow_control
+    installed = cfg.flow_control_installed if fc is None else bool(fc)
+    found = _derived(cfg, op, installed, _stroke_metric(req, row))
+    if found:
+        key, der = found
+        return "by_construction", (
+            f"{key} ({cfg.sources[key]}) was derived so that the model gives {der['metric']} = {der['value']} at "
+            f"{der['load_text']}: at this load the figure is the derivation's target, not evidence; measure the stroke")
+    if req.metric == "cross_adjustment_change":
+        on = [e for e in _COUPLING_EFFECTS if e in cfg.effects]
+        if not on:
+            return "by_construction", (
+                "the model's supply is ideal (no supply_droop or line_dynamics effect) and each meter-out throttle sits on "
+                "its own exhaust path: nothing couples the two directions, so the cross change is zero by construction")
+    if req.metric in ("drift", "limit_cycle_amplitude"):
+        on = [e for e in _LEAK_EFFECTS if e in cfg.effects]
+        if not on:
+            return "by_construction", (
+                "no leakage or valve offset is modelled (internal_leakage, external_leakage, valve_offset off): nothing "
+                "moves a held position once stiction holds it, so drift and hunting are zero by construction")
+    if op.load == "curve" and cfg.sources.get("load.curve") == "assumed":
+        return "assumed", "the load at this point comes from the plant's assumed load curve (load.curve, source assumed)"
+    return "modelled", "simulated with the plant model at this operating point"
+
+
+def requirement_basis(rows: list[dict]) -> str:
+    """Basis of a requirement from its rows: that of its worst failure if it fails; for a pass, by
+    construction when every passing row is, else modelled (assumed when no row is modelled)."""
+    judged = [r for r in rows if r.get("status") in (PASS, FAIL)]
+    if not judged:
+        return "not_evaluated"
+    fails = [r for r in judged if r["status"] == FAIL]
+    if fails:
+        return "modelled" if any(r["basis"] == "modelled" for r in fails) else fails[0]["basis"]
+    bases = {r["basis"] for r in judged}
+    if bases == {"by_construction"}:
+        return "by_construction"
+    if "modelled" in bases:
+        return "modelled"
+    return "assumed" if "assumed" in bases else "by_construction"

@@ -1,0 +1,96 @@
+"""What a plant file says about how sure it is: plausible ranges of assumed values, and derived targets.
+
+A parameter entry may carry, beside ``value``, ``source`` and ``note``:
+
+- ``range = ["300 N", "540 N"]`` with ``range_note = "why"``: the plausible span of a value that
+  is assumed (or derived, or read off a figure); the verdicts' uncertainty bands propagate it
+  (``compliance.campaign.uncertainty``);
+- ``derived_for = { metric = "opening_time", value = "5.0 s", load = "5.7 kN" }``: the value was
+  derived (tuned) so that the model gives that figure under that load, so the figure at that load
+  is known by construction, not as evidence (``compliance.campaign.basis``).
+
+Both are read here with units, at the edge, and kept on the configuration as plain data.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from compliance.errors import InputError
+from compliance.model.parameters import BASE_BY_KEY
+from compliance.units import parse_quantity
+
+__all__ = ["ENTRY_FIELDS", "read_assumptions"]
+
+# the fields a parameter entry may hold (the loader refuses any other)
+ENTRY_FIELDS = ("value", "source", "note", "range", "range_note", "derived_for")
+
+
+def _range(entry: dict, key: str, where: str, value: float, atmosphere: float) -> dict:
+    spec = BASE_BY_KEY[key]
+    raw = entry["range"]
+    if not isinstance(raw, list) or len(raw) != 2:
+        raise InputError(f"{where}.range: expected [low, high] with units, e.g. [\"300 N\", \"540 N\"]")
+    if spec.unit == "number":
+        lo, hi = (float(v) for v in raw)
+    else:
+        lo, hi = (parse_quantity(v, spec.unit, f"{where}.range", pressure=spec.pressure, atmosphere=atmosphere) for v in raw)
+    if not lo <= value <= hi:
+        raise InputError(f"{where}.range: [{lo:g}, {hi:g}] {spec.unit} must contain the value {value:g}")
+    if lo == hi:
+        raise InputError(f"{where}.range: low and high are equal; leave the range out for an exact value")
+    note = entry.get("range_note")
+    if not isinstance(note, str) or not note.strip():
+        raise InputError(f"{where}.range_note: missing; say why the value may lie anywhere in the range")
+    return {"low": lo, "high": hi, "note": note.strip()}
+
+
+def _derived_for(entry: dict, where: str) -> dict:
+    raw = entry["derived_for"]
+    if not isinstance(raw, dict) or not isinstance(raw.get("metric"), str):
+        raise InputError(f"{where}.derived_for: expected {{ metric = \"opening_time\", value = \"5.0 s\", load = \"5.7 kN\" }}")
+    unknown = set(raw) - {"metric", "value", "load"}
+    if unknown:
+        raise InputError(f"{where}.derived_for.{sorted(unknown)[0]}: unknown field (expected metric, value, load)")
+    load = raw.get("load")
+    return {"metric": raw["metric"], "value": str(raw.get("value", "")),
+            "load": None if load in (None, "none") else parse_quantity(load, "N", f"{where}.derived_for.load"),
+            "load_text": str(load or "none")}
+
+
+def read_assumptions(data: dict[str, Any], where: str, params: dict, atmosphere: float) -> dict:
+    """Ranges and derivation targets of the base parameters a plant file gives (SI).
+
+    Parameters
+    ----------
+    data : dict
+        The parsed plant file.
+    where : str
+        The file, for messages.
+    params : dict
+        The parameters already read (dotted key -> SI value).
+    atmosphere : float
+        Atmospheric pressure [Pa], for gauge pressures in ranges.
+
+    Returns
+    -------
+    dict
+        Dotted key -> ``{"range": {"low", "high", "note"} or None, "derived_for": {...} or None}``,
+        only for parameters that give either.
+
+    Raises
+    ------
+    InputError
+        A range without units or reason, not containing the value, or a malformed ``derived_for``.
+    """
+    out: dict[str, dict] = {}
+    for key, spec in BASE_BY_KEY.items():
+        section, name = key.split(".", 1)
+        entry = (data.get(section) or {}).get(name) if isinstance(data.get(section), dict) else None
+        if not isinstance(entry, dict) or not ({"range", "derived_for"} & set(entry)):
+            continue
+        kw = f"{where}: {key}"
+        rng = _range(entry, key, kw, params[key], atmosphere) if "range" in entry else None
+        der = _derived_for(entry, kw) if "derived_for" in entry else None
+        out[key] = {"range": rng, "derived_for": der}
+    return out
