@@ -81,6 +81,12 @@ class PlantConfig:
         return self.options["flow_control.installed"] == "true"
 
     @property
+    def setpoint_rate_limited(self) -> bool:
+        """Whether the PID's set-point rate limiter acts (an opening or closing rate is set)."""
+        return max(self.params.get("controller.setpoint_opening_rate", 0.0),
+                   self.params.get("controller.setpoint_closing_rate", 0.0)) > 0.0
+
+    @property
     def piston_area(self) -> float:
         """Cap-side area A_cap [m^2]."""
         d = self.params["cylinder.piston_diameter"]

@@ -7,7 +7,7 @@ import math
 from numba import njit
 
 from compliance.model.vector_slots import (P_CDZN, P_CDZP, P_CSLN, P_CSLP, P_LC, P_RL_CLOSE, P_RL_END_RATE, P_RL_END_WIDTH,
-                                           P_RL_OPEN, P_STROKE)
+                                           P_RL_LEAD, P_RL_OPEN, P_STROKE)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -147,7 +147,20 @@ def _zone_travel(to_zone, travel, zone_travel):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def limiter_sample(P, target, previous, ts):
-    """:func:`rate_limited_setpoint` with the rates, end zone and stroke of the parameter vector ``P`` [m]."""
-    return rate_limited_setpoint(target, previous, P[P_RL_OPEN], P[P_RL_CLOSE], P[P_RL_END_RATE], P[P_RL_END_WIDTH],
-                                 P[P_STROKE], ts)
+def limiter_sample(P, target, previous, gate, ts):
+    """:func:`rate_limited_setpoint` with the rates, end zone and stroke of ``P``, held near the gate [m].
+
+    With a lead limit D (``controller.setpoint_lead_limit`` > 0) the limited set-point stops moving
+    while it leads the measured gate position ``gate`` by more than D in its direction of travel
+    (ramp hold, our own form): a gate held back at an end stop does not leave the set-point far
+    ahead to be caught up with a surge. It never moves away from the target.
+    """
+    r = rate_limited_setpoint(target, previous, P[P_RL_OPEN], P[P_RL_CLOSE], P[P_RL_END_RATE], P[P_RL_END_WIDTH],
+                              P[P_STROKE], ts)
+    lead = P[P_RL_LEAD]
+    if lead > 0.0:
+        if r > previous:
+            r = max(previous, min(r, gate + lead))
+        elif r < previous:
+            r = min(previous, max(r, gate - lead))
+    return r

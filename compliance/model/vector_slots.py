@@ -50,7 +50,7 @@ def _effect_entries(effects) -> list[str]:
 
 
 # set-point rate limiter of the PID loop (appended after every effect's entries: their indices predate it)
-_RATE_LIMITER = ("rl_on", "rl_open", "rl_close", "rl_end_rate", "rl_end_width")
+_RATE_LIMITER = ("rl_on", "rl_open", "rl_close", "rl_end_rate", "rl_end_width", "rl_lead")
 # effects declared after these 12 go after the rate limiter's entries (fixed count: no index may move)
 _EFFECTS_BEFORE_LIMITER = 12
 
@@ -124,6 +124,7 @@ P_RL_OPEN = PI["rl_open"]
 P_RL_CLOSE = PI["rl_close"]
 P_RL_END_RATE = PI["rl_end_rate"]
 P_RL_END_WIDTH = PI["rl_end_width"]
+P_RL_LEAD = PI["rl_lead"]
 
 # base parameter key -> index: what parameter_vector copies straight from the configuration
 BASE_SLOTS = {p.name: PI[p.slot] for p in BASE_PARAMS if p.slot is not None}

@@ -65,7 +65,7 @@ def simulate_core(P, y0, ref, cmd, closed_loop, pos_noise, pos_quantum, lx, ly, 
     x_sensor, xd_prev, v0 = sensor_lag_start(P, y[S_X], y[S_V], sensor)
     alpha = first_order_filter_gain(P[P_FILT], ts)
     x_filt, integral = 0.0, 0.0
-    limiter, r_lim = P[P_RL_ON] != 0.0, ref[0]  # the limiter starts at the set-point it is first given
+    limiter, r_lim = P[P_RL_ON] != 0.0, y0[S_X]  # the limiter starts at the gate (bumpless: a step at t = 0 ramps)
     valve_delay = P[P_VD_TD] if P[P_VD_ON] != 0.0 else 0.0
     sensor_delay = P[P_SL_TD] if sensor else 0.0
     if P[P_VD_ON] != 0.0:
@@ -79,7 +79,7 @@ def simulate_core(P, y0, ref, cmd, closed_loop, pos_noise, pos_quantum, lx, ly, 
             if k == 0:
                 x_filt = xm
             if limiter:
-                r_lim = limiter_sample(P, ref[k], r_lim, ts)
+                r_lim = limiter_sample(P, ref[k], r_lim, xm, ts)
             u_d, u_c, x_filt, integral = pid_sample(P, xm, r_lim if limiter else ref[k], x_filt, integral, alpha,
                                                     P[P_KP], P[P_KI], P[P_KD], ts)
             u = saturate(u_c, P[P_ULIM]) + P[P_UCEN]

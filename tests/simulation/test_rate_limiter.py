@@ -7,7 +7,8 @@ import pytest
 
 from compliance.errors import InputError
 from compliance.model.config import load_plant
-from compliance.model.pid_controller import rate_limited_setpoint
+from compliance.model.pid_controller import limiter_sample, rate_limited_setpoint
+from compliance.model.plant_vector import parameter_vector
 from compliance.simulation import Scenario, simulate
 from compliance.simulation.profiles import Profile, steps
 
@@ -113,3 +114,37 @@ def test_limiter_refused_on_state_feedback():
         data = tomllib.loads(open(b.path).read()) if b.path else None
         data["controller"]["setpoint_opening_rate"] = "10 mm/s"
         plant_from_dict(data, "plant-b.toml")
+
+
+def test_lead_limit_holds_the_set_point_near_a_stuck_gate(cfg):
+    """Ramp hold: a gate held at the closed end keeps the limited set-point within the lead limit."""
+    lead = 0.004
+    P = parameter_vector(limited(cfg, setpoint_opening_rate=RATE_OPEN, setpoint_lead_limit=lead))
+    r, gate = 0.0, 0.0
+    for _ in range(2000):  # 2 s stuck: without the hold the set-point would be 40 mm ahead
+        r = limiter_sample(P, STROKE, r, gate, TS)
+    assert r == pytest.approx(lead, abs=RATE_OPEN * TS)
+    for k in range(1, 501):  # the gate moves at 10 mm/s: the set-point follows it, never further ahead than the lead
+        gate = 0.01 * k * TS
+        r_new = limiter_sample(P, STROKE, r, gate, TS)
+        assert r <= r_new <= max(r, gate + lead) + 1e-15
+        r = r_new
+    assert r == pytest.approx(0.005 + lead, abs=RATE_OPEN * TS)
+    # closing (not rate-limited here): held while the gate lags 40 mm behind, never pushed back up past where it was
+    assert limiter_sample(P, 0.05, 0.06, 0.10, TS) == 0.06
+    assert limiter_sample(P, 0.05, 0.06, 0.058, TS) == pytest.approx(0.058 - lead)
+
+
+def test_full_stroke_goes_through_the_governor(cfg):
+    """With a limiter the full-stroke procedure steps the set-point: closing at 20 mm/s takes 8 s (25-75 % rule)."""
+    from compliance import metrics as M
+    from compliance.procedures.scenarios import full_command_stroke
+    from compliance.requirements.loading import load_requirements
+
+    op = load_requirements("shpp-400kw").operating_points["governor-setup"]
+    c = limited(cfg, setpoint_opening_rate=RATE_OPEN, setpoint_closing_rate=RATE_OPEN, setpoint_lead_limit=0.004)
+    df = full_command_stroke(c, op, "closing", "full", 12.0, True)
+    t, x = M.frame_columns(df, "time", "position")
+    T = M.stroke_time(t, x, STROKE, "closing")[0]
+    assert T == pytest.approx(STROKE / RATE_OPEN, rel=0.05)
+    assert M.speed_extremes(t, x)[0] < 1.25 * RATE_OPEN  # the start-of-stroke surge is gone (at full command: > 100 mm/s)
