@@ -47,6 +47,9 @@ def register(subparsers):
     p.add_argument("--remedies", nargs="?", const="default", metavar="SWEEP.toml",
                    help="what would make it pass: sensitivities and the smallest verified change over the on-site settings "
                         "(or the adjustable space of a sweep file); added to the results as 'remedies'")
+    from compliance.cli.remedies_options import add_remedies_options
+
+    add_remedies_options(p)
     add_jobs(p)
     add_quiet(p, "no progress bar; print only the verdict line")
     add_reproducible(p)
@@ -93,7 +96,10 @@ def run(args) -> int:
     from compliance.files.reproducible import fixed_created, is_reproducible
     from compliance.requirements.loading import load_requirements
 
-    check_args_outputs(args)
+    from compliance.cli.remedies_options import check_remedies_options
+
+    check_args_outputs(args, (getattr(args, "save_remedy", None), "--save-remedy", (".toml",)))
+    check_remedies_options(args)
     if is_reproducible(args.reproducible):
         fixed_created()  # a malformed SOURCE_DATE_EPOCH is refused before the work
     render = renderer(args)
@@ -117,7 +123,10 @@ def run(args) -> int:
         if args.remedies:
             from compliance.sweep.check_remedies import remedies_for_check
 
-            results["remedies"] = remedies_for_check(cfg, reqset, args.remedies, workers=args.jobs, progress=not args.quiet)
+            from compliance.cli.remedies_options import remedies_kwargs
+
+            results["remedies"] = remedies_for_check(cfg, reqset, args.remedies, workers=args.jobs, progress=not args.quiet,
+                                                     **remedies_kwargs(args))
         results = finish_results(results, args)
         table = summary_table(results)
         if render is not None:
@@ -132,6 +141,10 @@ def run(args) -> int:
             from compliance.sweep.summary_text import remedies_markdown
 
             sys.stdout.write("\n" + remedies_markdown(results["remedies"]))
+    if args.remedies:
+        from compliance.cli.remedies_options import save_remedy
+
+        save_remedy(args, cfg, results["remedies"])
     if args.json:
         write_json(results, args.json)
     if args.junit:
