@@ -14,11 +14,11 @@ from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, ConfigDict, Field
 
 from compliance.effects import EFFECTS
 from compliance.errors import InputError
-from compliance.model.toml_file import read_toml
+from compliance.sweep.data_file import read_validated
 from compliance.physics.valve_rating import NL_MIN, conductance_of_rating
 from compliance.sweep.parameter_paths import describe
 from compliance.units import parse_quantity
@@ -144,16 +144,7 @@ def load_catalogue(source=DEFAULT_CATALOGUE) -> Catalogue:
         path = Path(str(resources.files("compliance") / "data" / "hardware" / "catalogue.toml"))
     else:
         path = Path(source)
-        if not path.is_file():
-            raise InputError(f"{path}: hardware catalogue not found")
-    data, _ = read_toml(path)
-    try:
-        raw = _CatalogueIn.model_validate(data)
-    except ValidationError as exc:
-        err = exc.errors()[0]
-        raise InputError(f"{path}: {'.'.join(str(p) for p in err['loc'])}: {err['msg']}") from None
-    if raw.schema_ != "govcheck-hardware/1":
-        raise InputError(f"{path}: schema: expected \"govcheck-hardware/1\", got {raw.schema_!r}")
+    raw = read_validated(path, _CatalogueIn, "govcheck-hardware/1", "hardware catalogue")
     opts = tuple(_option(k, v, f"{path}: options.{k}") for k, v in raw.options.items())
     return Catalogue(str(path), raw.title, opts, tuple((k, v.title, v.how) for k, v in raw.settings.items()),
                      tuple((k, v.title, v.reason) for k, v in raw.not_modelled.items()))
