@@ -17,7 +17,7 @@ with the numbers of the configuration and the requirement file:
 
 from __future__ import annotations
 
-__all__ = ["choked_speed", "explain", "step_conflict"]
+__all__ = ["choked_speed", "conflict_text", "explain", "explain_closest", "step_conflict"]
 
 SPEED_METRICS = ("max_speed", "max_opening_speed", "max_closing_speed")
 
@@ -45,12 +45,37 @@ def step_conflict(reqset, stroke: float) -> list[dict]:
                     continue
                 s = size.resolve(stroke)
                 out.append({"time_constant": tc.id, "speed": sp.id, "procedure": proc, "step": s, "tau_max": tau_max,
+                            "same_points": sorted(set(tc.operating_points) & set(sp.operating_points)),
                             "v_max": v_max, "first_order_peak": s / tau_max, "ramp_tau_min": 0.632 * s / v_max,
                             "first_order_conflict": s / tau_max >= v_max, "any_servo_conflict": 0.632 * s / v_max > tau_max})
     return out
 
 
-def explain(rid: str | None, where: str | None, cfg, reqset, tried_limiter: bool, value=None) -> str:
+def conflict_text(c: dict) -> str:
+    """The arithmetic of a time-constant window that no rate-limited servo can meet under a speed limit."""
+    where = ("at the same operating points" if c["same_points"] else
+             "judged at different operating points, so only a servo at least "
+             f"{c['ramp_tau_min'] / c['tau_max']:.1f} times faster there than where the speed is judged escapes it")
+    return (f"the requirement set conflicts on {c['procedure']} ({c['step']*1e3:.1f} mm steps): {c['time_constant']} asks "
+            f"tau <= {c['tau_max']:.3f} s and {c['speed']} a peak speed <= {c['v_max']*1e3:.1f} mm/s; moving no faster than that, "
+            f"the gate reaches 63.2 % of the step after {c['ramp_tau_min']:.3f} s at the earliest "
+            f"(0.632 x {c['step']*1e3:.1f} mm / {c['v_max']*1e3:.1f} mm/s), and a first-order answer within the window "
+            f"starts at >= {c['first_order_peak']*1e3:.1f} mm/s ({where}).")
+
+
+def explain_closest(closest: dict, cfg, reqset, tried_limiter: bool) -> str:
+    """Why the closest candidate fails: a conflict of the requirement set it fails first, else its binding physics."""
+    failing = set(closest.get("failed_mandatory") or ())
+    L = cfg.params["cylinder.stroke"]
+    hard = [c for c in step_conflict(reqset, L) if c["any_servo_conflict"] and {c["time_constant"], c["speed"]} & failing]
+    text = explain(closest.get("binding"), closest.get("binding_where"), cfg, reqset, tried_limiter)
+    if hard:
+        lead = "No servo can pass both: " if hard[0]["same_points"] else "The requirement set works against any pass: "
+        return lead + conflict_text(hard[0]) + " Besides, " + text
+    return text
+
+
+def explain(rid: str | None, where: str | None, cfg, reqset, tried_limiter: bool) -> str:
     """One paragraph: why requirement ``rid`` (judged at run ``where``) binds, with the numbers."""
     if rid is None:
         return "no mandatory requirement could be judged on any candidate (every run failed or was not evaluated)."
@@ -68,8 +93,8 @@ def explain(rid: str | None, where: str | None, cfg, reqset, tried_limiter: bool
                     f"s/tau >= {c['first_order_peak']*1e3:.1f} mm/s against the {c['v_max']*1e3:.1f} mm/s of {rid}; "
                     f"only a rate-limited answer can meet both (it reaches 63.2 % after {c['ramp_tau_min']:.3f} s at best).")
         if proc and reqset.procedures.get(proc) is not None and reqset.procedures[proc].kind == "full_stroke":
-            lim = (" The set-point rate limiter with its ramp hold was in the space: the surge comes before the gate "
-                   "follows any set-point." if tried_limiter else "")
+            lim = (" The set-point rate limiter with its ramp hold was in the space too: it trades the surge against the "
+                   "stroke time (a small lead holds the gate back at breakaway and slows the stroke)." if tried_limiter else "")
             return (f"{rid} binds at the start of a full stroke from an end stop ({where}): the exhausting chamber starts at "
                     f"supply pressure ({cfg.params['air.supply_pressure']/1e5:.1f} bar abs) and the filling one near "
                     f"atmosphere; the gate is held until their forces cross and then breaks away with the stored pressure "

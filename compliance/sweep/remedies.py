@@ -142,7 +142,7 @@ def _clamped_base(adjust, base):
 
 
 def find_remedy(ctx, adjust, base: dict, *, verify, iterations: int = 4, seeds=(), run_kw=None, fixed=None,
-                cost: float = 0.0) -> dict:
+                cost: float = 0.0, report_base=None) -> dict:
     """Sensitivities and the smallest verified change that passes every mandatory requirement.
 
     Parameters
@@ -163,6 +163,8 @@ def find_remedy(ctx, adjust, base: dict, *, verify, iterations: int = 4, seeds=(
         path -> SI value set on every candidate (hardware options); ``verify`` receives them too.
     cost : float
         Cost of the fixed hardware (ranking).
+    report_base : dict
+        Values the reported changes are measured from (default: ``base``; a later stage gives the configuration's).
 
     Returns
     -------
@@ -205,7 +207,7 @@ def find_remedy(ctx, adjust, base: dict, *, verify, iterations: int = 4, seeds=(
         out["evaluated"] += 1
         judged.append((cand, row))
         if candidate_passes(row):
-            results = verify({**run_kw["fixed"], **cand})
+            results = verify({**cand, **run_kw["fixed"]})
             remedy = describe_candidate(adjust, start, cand, row)
             remedy["verified"] = {"status": results["summary"]["status"],
                                   "failed_mandatory": results["summary"]["failed_mandatory"]}
@@ -232,7 +234,7 @@ def _linearise(ctx, adjust, u0, row, run_kw, judged, out):
 
 def _judge(ctx, settings, *, fixed, **run_kw):
     """Judge settings with the fixed (hardware) values set on each -> (rows, RunStats)."""
-    return run_candidates(ctx, [{**fixed, **s} for s in settings], **run_kw)
+    return run_candidates(ctx, [{**s, **fixed} for s in settings], **run_kw)
 
 
 def _none_found(out, adjust, start, closest):

@@ -12,7 +12,7 @@
 
 from __future__ import annotations
 
-from compliance.sweep.binding_physics import explain
+from compliance.sweep.binding_physics import explain_closest
 from compliance.sweep.ranking import SETTINGS_COST, candidate_passes, rank_key
 from compliance.sweep.remedies import describe_candidate
 from compliance.sweep.runner import run_candidates
@@ -77,7 +77,7 @@ def finish(rem, given, ctx, cfg, reqset, uncertain, catalogue, *, run_kw, yield_
         _never_worse(rem, given)
         c = rem["closest"]
         tried_limiter = any(s["path"].startswith("controller.setpoint_") for s in rem["space"])
-        rem["explanation"] = explain(c.get("binding"), c.get("binding_where"), cfg, reqset, tried_limiter)
+        rem["explanation"] = explain_closest(c, cfg, reqset, tried_limiter)
         rem["note"] += " Why: " + rem["explanation"]
     elif rem["status"] == "found":
         r = rem["remedy"]

@@ -18,6 +18,7 @@ the remedy (a cheaper stage's pass is never passed over for hardware).
 
 from __future__ import annotations
 
+from compliance.sweep.limiter_space import limiter_stage_start
 from compliance.sweep.ranking import SETTINGS_COST, candidate_passes, failing_mandatory, rank_key
 from compliance.sweep.remedies import find_remedy
 from compliance.sweep.runner import run_candidates
@@ -25,9 +26,11 @@ from compliance.sweep.runner import run_candidates
 __all__ = ["staged_search"]
 
 
-def _stage(ctx, adjust, base, verify, run_kw, iterations, fixed=None, cost=0.0, label=""):
+def _stage(ctx, adjust, base, verify, run_kw, iterations, fixed=None, cost=0.0, label="", given=None):
+    adjust = tuple(a for a in adjust if a.param.path not in (fixed or {}))  # the hardware sets these
     rem = find_remedy(ctx, adjust, base, verify=verify, iterations=iterations, run_kw={**run_kw, "label": label},
                       fixed=fixed, cost=cost)
+    _report_from(rem, adjust, given or base)
     rem["hardware_cost"] = cost
     if rem["status"] == "already_passes" and fixed:  # the hardware alone, at these settings, passes: verify it
         results = verify({**fixed, **rem["closest"]["values"]})
@@ -38,6 +41,17 @@ def _stage(ctx, adjust, base, verify, run_kw, iterations, fixed=None, cost=0.0, 
         else:
             rem["status"] = "none_found"
     return rem
+
+
+def _report_from(rem, adjust, given) -> None:
+    """Measure the reported changes of the stage's remedy or closest candidate from the configuration as given."""
+    for key in ("remedy", "closest"):
+        pick = rem.get(key)
+        if pick:
+            pick["changes"] = [{"path": a.param.path, "unit": a.param.unit, "from": float(given.get(a.param.path, 0.0)),
+                                "to": float(pick["values"][a.param.path])} for a in adjust
+                               if a.param.path in pick["values"]
+                               and abs(pick["values"][a.param.path] - given.get(a.param.path, 0.0)) > 1e-6 * a.span]
 
 
 def _option_rows(ctx, cfg, options, settings, run_kw):
@@ -66,23 +80,25 @@ def staged_search(ctx, cfg, adjust, base, catalogue, *, verify, run_kw, iteratio
     rem = _stage(ctx, adjust, base, verify, run_kw, iterations, label="remedies: settings")
     rem["stages"] = [{"stage": "settings", "status": rem["status"], "evaluated": rem["evaluated"]}]
     rem["hardware_tried"] = []
+    adjust_all = tuple(adjust)
     if rem["status"] == "none_found" and limiter is not None:
         lim_adjust, lim_start = limiter
-        start = {**((rem["closest"] or {}).get("values") or base), **lim_start}
+        start = limiter_stage_start(adjust, (rem["closest"] or {}).get("values") or base, lim_start)
         rl = _stage(ctx, tuple(adjust) + tuple(lim_adjust), start, verify, run_kw, iterations,
-                    label="remedies: settings + rate limiter")
+                    label="remedies: settings + rate limiter", given=base)
         rl["stages"] = rem["stages"] + [{"stage": "settings + rate limiter", "status": rl["status"],
                                          "evaluated": rl["evaluated"]}]
         rl["evaluated"] += rem["evaluated"]
         rl["hardware_tried"] = []
         if rl["status"] == "found" or _better(rl.get("closest"), rem.get("closest"), 0.0):
             rl["settings_only"] = {k: rem[k] for k in ("closest", "sensitivities", "out_of_reach")}
-            rem = rl
+            rem, adjust_all = rl, tuple(adjust) + tuple(lim_adjust)
         else:
             rem["stages"], rem["evaluated"] = rl["stages"], rl["evaluated"]
     if rem["status"] != "none_found" or catalogue is None:
         return rem
-    best_settings = dict((rem["closest"] or {}).get("values") or base)
+    best_settings = {a.param.path: (rem["closest"] or {}).get("values", base).get(a.param.path, base.get(a.param.path))
+                     for a in adjust_all}
     options = [o for o in catalogue.options if o.applies_to(cfg) is None]
     ranked = _option_rows(ctx, cfg, options, best_settings, run_kw)
     rem["evaluated"] += len(ranked)
@@ -96,8 +112,8 @@ def staged_search(ctx, cfg, adjust, base, catalogue, *, verify, run_kw, iteratio
     for opts in tries:
         fixed = {k: v for o in opts for k, v in o.values(cfg).items()}
         cost = sum(o.cost for o in opts)
-        hw = _stage(ctx, adjust, best_settings, verify, run_kw, max(1, iterations - 1), fixed=fixed, cost=cost,
-                    label="remedies: " + " + ".join(o.name for o in opts))
+        hw = _stage(ctx, adjust_all, best_settings, verify, run_kw, max(1, iterations - 1), fixed=fixed, cost=cost,
+                    label="remedies: " + " + ".join(o.name for o in opts), given=base)
         rem["evaluated"] += hw["evaluated"]
         rem["stages"].append({"stage": "hardware", "options": [o.name for o in opts], "status": hw["status"],
                               "evaluated": hw["evaluated"]})

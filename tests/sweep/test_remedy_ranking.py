@@ -6,6 +6,8 @@ import json
 
 import pandas as pd
 
+import pytest
+
 from compliance.cli import main
 from compliance.sweep.ranking import candidate_passes, failing_mandatory, rank_key
 from compliance.sweep.remedy_finish import _never_worse
@@ -68,3 +70,18 @@ def test_hardware_remedy_is_saved_and_checks_clean(tmp_path, write_sweep, capsys
 def test_save_remedy_needs_remedies(tmp_path):
     assert main(["check", "plant-a", "-r", str(SMALL_TC), "--save-remedy", str(tmp_path / "x.toml")]) == 2
     assert not (tmp_path / "x.toml").exists()
+
+
+def test_requirement_set_conflict_arithmetic_of_the_shipped_file():
+    """shpp-400kw: tau <= 0.25 s on 16 mm steps needs >= 0.316 s at <= 32 mm/s: no rate-limited servo meets both."""
+    from compliance.model.config import load_plant
+    from compliance.requirements.loading import load_requirements
+    from compliance.sweep.binding_physics import explain_closest, step_conflict
+
+    reqset = load_requirements("shpp-400kw")
+    c = {x["procedure"]: x for x in step_conflict(reqset, 0.16)}
+    assert c["steps-10"]["ramp_tau_min"] == pytest.approx(0.632 * 0.016 / 0.032) and c["steps-10"]["any_servo_conflict"]
+    assert c["steps-5"]["first_order_peak"] == pytest.approx(0.032) and not c["steps-5"]["any_servo_conflict"]
+    text = explain_closest({"failed_mandatory": ["IEC61362-TC"], "binding": "IEC61362-TC", "binding_where": "steps-10@tc-mid"},
+                           load_plant("plant-a"), reqset, True)
+    assert "0.316 s" in text and "steps-10" in text
