@@ -78,7 +78,12 @@ def finish(rem, given, ctx, cfg, reqset, uncertain, catalogue, *, run_kw, yield_
         c = rem["closest"]
         tried_limiter = any(s["path"].startswith("controller.setpoint_") for s in rem["space"])
         rem["explanation"] = explain_closest(c, cfg, reqset, tried_limiter)
-        rem["note"] += " Why: " + rem["explanation"]
+        stages = ", ".join(s["stage"] + (f" ({' + '.join(s['options'])})" if s.get("options") else "") for s in rem.get("stages", []))
+        hw = " with " + " + ".join(h["title"] for h in c["hardware"]) if c.get("hardware") else ""
+        rem["note"] = (f"no candidate of the {rem['evaluated']} judged (stages: {stages}) passes every mandatory requirement; "
+                       f"the closest{hw} fails {len(c['failed_mandatory'])} ({', '.join(c['failed_mandatory'])}) where the "
+                       f"configuration as given fails {len(given['candidate']['failed_mandatory'])}. Why: {rem['explanation']} "
+                       "This is the evidence of a search, not a proof that no pass exists.")
     elif rem["status"] == "found":
         r = rem["remedy"]
         r.setdefault("cost", SETTINGS_COST * r["change"])
