@@ -71,7 +71,10 @@ def explain_closest(closest: dict, cfg, reqset, tried_limiter: bool) -> str:
     text = explain(closest.get("binding"), closest.get("binding_where"), cfg, reqset, tried_limiter)
     if hard:
         lead = "No servo can pass both: " if hard[0]["same_points"] else "The requirement set works against any pass: "
-        return lead + conflict_text(hard[0]) + " Besides, " + text
+        rest = set(closest.get("failed_mandatory") or ()) - {hard[0]["time_constant"], hard[0]["speed"]}
+        binding_in_conflict = closest.get("binding") in (hard[0]["time_constant"], hard[0]["speed"])
+        tail = "" if binding_in_conflict and not rest else " Besides, " + text
+        return lead + conflict_text(hard[0]) + tail
     return text
 
 
