@@ -56,7 +56,7 @@ def conflict_text(c: dict) -> str:
     where = ("at the same operating points" if c["same_points"] else
              "judged at different operating points, so only a servo at least "
              f"{c['ramp_tau_min'] / c['tau_max']:.1f} times faster there than where the speed is judged escapes it")
-    return (f"the requirement set conflicts on {c['procedure']} ({c['step']*1e3:.1f} mm steps): {c['time_constant']} asks "
+    return (f"on {c['procedure']} ({c['step']*1e3:.1f} mm steps) {c['time_constant']} asks "
             f"tau <= {c['tau_max']:.3f} s and {c['speed']} a peak speed <= {c['v_max']*1e3:.1f} mm/s; moving no faster than that, "
             f"the gate reaches 63.2 % of the step after {c['ramp_tau_min']:.3f} s at the earliest "
             f"(0.632 x {c['step']*1e3:.1f} mm / {c['v_max']*1e3:.1f} mm/s), and a first-order answer within the window "
