@@ -17,6 +17,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from compliance.physics.valve_rating import (  # noqa: F401  (the rating point, re-exported for this module's users)
+    NORMAL_DENSITY,
+    NORMAL_TEMPERATURE,
+    RATING_DROP,
+    RATING_INLET_GAUGE,
+    rated_mass_flow,
+    rating_point,
+    sonic_conductance,
+)
 from compliance.physics.valve_flow import (
     bobrow_mass_flow,
     iso6358_mass_flow,
@@ -24,29 +33,9 @@ from compliance.physics.valve_flow import (
     sanville_mass_flow,
 )
 
-NORMAL_DENSITY = 1.204  # kg/m^3, ANR standard air 20 degC, 1 atm (seed 000 footnote; ISO 8778)
-NORMAL_TEMPERATURE = 293.15  # K
-RATING_INLET_GAUGE = 6.0e5  # Pa, nominal-flow inlet pressure (6 bar gauge, VDI 3290)
-RATING_DROP = 1.0e5  # Pa, nominal-flow pressure drop (1 bar)
 DETAILED_B = 0.3  # critical ratio of the "detailed" valve (assumed, typical of spool valves)
 DETAILED_LAMINAR_SHARE = 0.05  # share of the laminar term in the rated flow (assumed)
 POWER_EXPONENT = 0.25  # lambda, seed 001 (the only part of eq. 7 that survived)
-
-
-def rated_mass_flow(nominal_flow_nl_min: float, rho0: float = NORMAL_DENSITY) -> float:
-    """Mass flow of a nominal flow rating [kg/s] from normal litres per minute [NL/min]."""
-    return nominal_flow_nl_min * 1e-3 / 60.0 * rho0
-
-
-def rating_point(atmosphere: float) -> tuple[float, float]:
-    """(p1, p2) absolute pressures of the nominal-flow test [Pa] for an atmosphere [Pa]."""
-    p1 = RATING_INLET_GAUGE + atmosphere
-    return p1, p1 - RATING_DROP
-
-
-def sonic_conductance(q_rated, p1, p2, t1=NORMAL_TEMPERATURE, b=0.528, rho0=NORMAL_DENSITY, t0=NORMAL_TEMPERATURE):
-    """ISO 6358 sonic conductance C passing through the rating point [m^3/(s*Pa)] (seed 000 eq. 1)."""
-    return q_rated / iso6358_mass_flow(1.0, 1.0, p1, p2, t1, b, rho0, t0)
 
 
 def sanville_area(q_rated, p1, p2, t1=NORMAL_TEMPERATURE, gamma=1.4, r_gas=287.0):

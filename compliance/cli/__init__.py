@@ -22,6 +22,7 @@ _COMMANDS = (
     ("check", "check"),
     ("gate", "gate"),
     ("sweep", "sweep"),
+    ("size", "size"),
     ("report", "report"),
     ("linear", "linear"),
     ("validate", "validate"),

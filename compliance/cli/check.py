@@ -54,6 +54,9 @@ def register(subparsers):
     p.add_argument("--allow-conflicts", action="store_true",
                    help="judge a requirement set even when two mandatory limits cannot hold together (without it such a set "
                         "is refused with exit code 2 before any simulation; docs/requirements.md)")
+    from compliance.cli.remedies_options import add_remedies_options
+
+    add_remedies_options(p)
     add_jobs(p)
     add_quiet(p, "no progress bar; print only the verdict line")
     add_reproducible(p)
@@ -112,11 +115,14 @@ def run(args) -> int:
     from compliance.files.reproducible import fixed_created, is_reproducible
     from compliance.requirements.loading import load_requirements
 
-    check_args_outputs(args)
     if args.uncertainty is not None and (args.uncertainty == 1 or args.uncertainty < 0):
         from compliance.errors import InputError
 
         raise InputError(f"--uncertainty {args.uncertainty}: expected at least 2 plants (or 0 for point values)")
+    from compliance.cli.remedies_options import check_remedies_options
+
+    check_args_outputs(args, (getattr(args, "save_remedy", None), "--save-remedy", (".toml",)))
+    check_remedies_options(args)
     if is_reproducible(args.reproducible):
         fixed_created()  # a malformed SOURCE_DATE_EPOCH is refused before the work
     render = renderer(args)
@@ -153,7 +159,10 @@ def run(args) -> int:
         if args.remedies:
             from compliance.sweep.check_remedies import remedies_for_check
 
-            results["remedies"] = remedies_for_check(cfg, reqset, args.remedies, workers=args.jobs, progress=not args.quiet)
+            from compliance.cli.remedies_options import remedies_kwargs
+
+            results["remedies"] = remedies_for_check(cfg, reqset, args.remedies, workers=args.jobs, progress=not args.quiet,
+                                                     **remedies_kwargs(args))
         results = finish_results(results, args)
         table = summary_table(results)
         if render is not None:
@@ -168,6 +177,10 @@ def run(args) -> int:
             from compliance.sweep.summary_text import remedies_markdown
 
             sys.stdout.write("\n" + remedies_markdown(results["remedies"]))
+    if args.remedies:
+        from compliance.cli.remedies_options import save_remedy
+
+        save_remedy(args, cfg, results["remedies"])
     if args.json:
         write_json(results, args.json)
     if args.junit:

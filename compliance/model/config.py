@@ -83,6 +83,12 @@ class PlantConfig:
         return self.options["flow_control.installed"] == "true"
 
     @property
+    def setpoint_rate_limited(self) -> bool:
+        """Whether the PID's set-point rate limiter acts (an opening or closing rate is set)."""
+        return max(self.params.get("controller.setpoint_opening_rate", 0.0),
+                   self.params.get("controller.setpoint_closing_rate", 0.0)) > 0.0
+
+    @property
     def piston_area(self) -> float:
         """Cap-side area A_cap [m^2]."""
         d = self.params["cylinder.piston_diameter"]
@@ -234,6 +240,14 @@ def _check_physical(cfg: PlantConfig, where: str) -> None:
     need = {"sanville": "valve.effective_area", "bobrow": "valve.bobrow_coefficient", "power_law": "valve.power_law_c1"}.get(law)
     if need and p[need] <= 0.0:
         raise InputError(f"{where}: valve.flow_law = '{law}' needs {need} > 0")
+    limiter = [k for k in ("controller.setpoint_opening_rate", "controller.setpoint_closing_rate", "controller.end_zone_rate")
+               if p[k] > 0.0]
+    if limiter and cfg.options["controller.type"] != "pid":
+        raise InputError(f"{where}: {limiter[0]}: the set-point rate limiter is an option of the PID controller "
+                         f"(controller.type = 'pid'), not of '{cfg.options['controller.type']}'")
+    if p["controller.end_zone_rate"] > 0.0 and not 0.0 < p["controller.end_zone_width"] < 0.5 * p["cylinder.stroke"]:
+        raise InputError(f"{where}: controller.end_zone_width must be > 0 and below half the stroke when "
+                         "controller.end_zone_rate is set")
     ts = p["controller.sample_time"]
     h = p["simulation.step"]
     if h > ts or abs(ts / h - round(ts / h)) > 1e-6:

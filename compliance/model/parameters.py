@@ -64,6 +64,12 @@ BASE_PARAMS: tuple[Param, ...] = (
     _P("controller.compensation_dead_zone_negative", "V", "compensator's |zme|", 0.0, 0.0, 10.0, slot="cdz_neg"),
     _P("controller.compensation_slope_positive", "", "compensator's md", 1.0, 0.0, 100.0, True, slot="cslope_pos"),
     _P("controller.compensation_slope_negative", "", "compensator's me", 1.0, 0.0, 100.0, True, slot="cslope_neg"),
+    # --- set-point rate limiter of the PID governor (IEEE PES TR 2013 gate rate limits; end zone: our form)
+    _P("controller.setpoint_opening_rate", "m/s", "set-point rate limit while opening (x rising); 0 = not limited", 0.0, 0.0, 100.0, slot="rl_open"),
+    _P("controller.setpoint_closing_rate", "m/s", "set-point rate limit while closing (x falling); 0 = not limited", 0.0, 0.0, 100.0, slot="rl_close"),
+    _P("controller.end_zone_rate", "m/s", "slower set-point rate inside the end zone toward the near end stop; 0 = none", 0.0, 0.0, 100.0, slot="rl_end_rate"),
+    _P("controller.end_zone_width", "m", "width of the end zone at each end of the stroke", 0.0, 0.0, 5.0, slot="rl_end_width"),
+    _P("controller.setpoint_lead_limit", "m", "the limited set-point holds while it leads the gate by more than this; 0 = never holds", 0.0, 0.0, 5.0, slot="rl_lead"),
     _P("simulation.step", "s", "fixed integration step (pinned for determinism)", 1e-4, 0.0, 0.01, True),
     # --- piecewise Stribeck friction, seed 001 eq. (8) (friction.model = "piecewise_stribeck")
     _P("friction.breakaway_force", "N", "seed 001 eq. (8) F_j: friction at rest (piecewise Stribeck model)", 0.0, 0.0, 1e6, slot="f_breakaway"),

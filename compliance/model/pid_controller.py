@@ -6,7 +6,8 @@ import math
 
 from numba import njit
 
-from compliance.model.vector_slots import P_CDZN, P_CDZP, P_CSLN, P_CSLP, P_LC
+from compliance.model.vector_slots import (P_CDZN, P_CDZP, P_CSLN, P_CSLP, P_LC, P_RL_CLOSE, P_RL_END_RATE, P_RL_END_WIDTH,
+                                           P_RL_LEAD, P_RL_OPEN, P_STROKE)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -97,3 +98,69 @@ def pid_sample(P, xm, ref_k, x_filt, integral, alpha, kp, ki, kd, ts):
     else:
         u_c = u_d
     return u_d, u_c, x_new, integral
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def rate_limited_setpoint(target, previous, opening_rate, closing_rate, end_rate, end_width, stroke, ts):
+    """One sample of the governor's set-point rate limiter [m] (docs/physics.md, controller section).
+
+    r[k] = r[k-1] + clip(r_in[k] - r[k-1], -R_c*T_s, +R_o*T_s): separate opening (x rising) and
+    closing rates, as the gate-rate limits of the IEEE PES TR 2013 hydro governor models. Within
+    ``end_width`` of the end stop being approached the rate is at most ``end_rate`` (a cushion
+    zone: our own form; a sample that enters the zone is split at its edge). The state moves only toward
+    ``target`` and never past it, so it cannot wind up.
+
+    Parameters
+    ----------
+    target, previous : float
+        Unlimited set-point now and the limited set-point of the previous sample [m].
+    opening_rate, closing_rate : float
+        Rate limits [m/s]; 0 = not limited in that direction.
+    end_rate, end_width : float
+        End-zone rate [m/s] (0 = no end zone) and zone width [m].
+    stroke, ts : float
+        Stroke [m] and controller sample time [s].
+    """
+    up = opening_rate * ts if opening_rate > 0.0 else math.inf
+    down = closing_rate * ts if closing_rate > 0.0 else math.inf
+    if end_rate > 0.0:
+        up = _zone_travel(stroke - end_width - previous, up, end_rate * ts)
+        down = _zone_travel(previous - end_width, down, end_rate * ts)
+    step = target - previous
+    if step > up:
+        return previous + up
+    if step < -down:
+        return previous - down
+    return target
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _zone_travel(to_zone, travel, zone_travel):
+    """Travel in one sample when the end zone starts ``to_zone`` ahead [m]: full rate to it, zone rate inside."""
+    if to_zone <= 0.0:
+        return min(travel, zone_travel)
+    if travel <= to_zone:
+        return travel
+    if travel == math.inf:
+        return math.inf
+    return to_zone + zone_travel * (1.0 - to_zone / travel)  # the rest of the sample at the zone rate
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def limiter_sample(P, target, previous, gate, ts):
+    """:func:`rate_limited_setpoint` with the rates, end zone and stroke of ``P``, held near the gate [m].
+
+    With a lead limit D (``controller.setpoint_lead_limit`` > 0) the limited set-point stops moving
+    while it leads the measured gate position ``gate`` by more than D in its direction of travel
+    (ramp hold, our own form): a gate held back at an end stop does not leave the set-point far
+    ahead to be caught up with a surge. It never moves away from the target.
+    """
+    r = rate_limited_setpoint(target, previous, P[P_RL_OPEN], P[P_RL_CLOSE], P[P_RL_END_RATE], P[P_RL_END_WIDTH],
+                              P[P_STROKE], ts)
+    lead = P[P_RL_LEAD]
+    if lead > 0.0:
+        if r > previous:
+            r = max(previous, min(r, gate + lead))
+        elif r < previous:
+            r = min(previous, max(r, gate - lead))
+    return r

@@ -28,6 +28,10 @@ from compliance.model.vector_slots import (
     P_LOAD,
     P_LOADMODE,
     P_NFR,
+    P_RL_CLOSE,
+    P_RL_END_RATE,
+    P_RL_ON,
+    P_RL_OPEN,
     P_VD,
     P_VD_STAGE,
 )
@@ -67,6 +71,8 @@ def parameter_vector(cfg: PlantConfig, *, load: float | str | None = None, flow_
     d, dr = p["cylinder.piston_diameter"], p["cylinder.rod_diameter"]
     P[P_AREA_CAP] = math.pi * d * d / 4.0
     P[P_AREA_ROD] = P[P_AREA_CAP] - math.pi * dr * dr / 4.0
+    # the set-point rate limiter costs one branch per sample when no rate is set
+    P[P_RL_ON] = 1.0 if max(P[P_RL_OPEN], P[P_RL_CLOSE], P[P_RL_END_RATE]) > 0.0 else 0.0
     # options (strings in the file) become numeric switches
     tandem = cfg.options["cylinder.arrangement"] == "tandem"
     P[P_ARR] = 0.0 if tandem else 1.0

@@ -49,8 +49,14 @@ def _effect_entries(effects) -> list[str]:
     return [n for e in effects for n in (f"{e.short}_on", *(f"{e.short}_{p.slot}" for p in e.params))]
 
 
+# set-point rate limiter of the PID loop (appended after every effect's entries: their indices predate it)
+_RATE_LIMITER = ("rl_on", "rl_open", "rl_close", "rl_end_rate", "rl_end_width", "rl_lead")
+# effects declared after these 12 go after the rate limiter's entries (fixed count: no index may move)
+_EFFECTS_BEFORE_LIMITER = 12
+
 PARAM_NAMES = (*_CORE_HEAD, *_effect_entries(ALL_EFFECTS[:_EFFECTS_BEFORE_TAIL]), *_CORE_TAIL,
-               *_effect_entries(ALL_EFFECTS[_EFFECTS_BEFORE_TAIL:]))
+               *_effect_entries(ALL_EFFECTS[_EFFECTS_BEFORE_TAIL:_EFFECTS_BEFORE_LIMITER]), *_RATE_LIMITER,
+               *_effect_entries(ALL_EFFECTS[_EFFECTS_BEFORE_LIMITER:]))
 N_PARAMS = len(PARAM_NAMES)
 PI = {n: i for i, n in enumerate(PARAM_NAMES)}
 
@@ -113,6 +119,12 @@ P_KV1 = PI["kv_low"]
 P_VD = PI["v_critical"]
 P_KV2 = PI["kv_high"]
 P_VD_STAGE = PI["vd_stage"]
+P_RL_ON = PI["rl_on"]
+P_RL_OPEN = PI["rl_open"]
+P_RL_CLOSE = PI["rl_close"]
+P_RL_END_RATE = PI["rl_end_rate"]
+P_RL_END_WIDTH = PI["rl_end_width"]
+P_RL_LEAD = PI["rl_lead"]
 
 # base parameter key -> index: what parameter_vector copies straight from the configuration
 BASE_SLOTS = {p.name: PI[p.slot] for p in BASE_PARAMS if p.slot is not None}

@@ -72,6 +72,9 @@ def simulate_run(cfg, duration, x0, *, reference=None, command=None, load=None, 
 def full_command_stroke(cfg, op, direction, command, duration, flow_control, start="end_stop"):
     """Open-loop run at full valve command from the end of the stroke a ``direction`` starts at.
 
+    With the governor's set-point rate limiter configured, the stroke is a full set-point step
+    through the governor instead (closed loop: the limiter, not the valve, sets the rate).
+
     Parameters
     ----------
     cfg : PlantConfig
@@ -96,6 +99,9 @@ def full_command_stroke(cfg, op, direction, command, duration, flow_control, sta
 
     u_open, u_close = full_command(cfg, command)
     x0, u = (0.0, u_open) if direction == "opening" else (stroke(cfg), u_close)
+    if cfg.setpoint_rate_limited:  # the governor's rate limiter is the limiting device: stroke through the governor
+        return simulate_run(cfg, duration, x0, reference=Profile.constant(stroke(cfg) - x0), load=scenario_load(cfg, op),
+                            flow_control=flow_control, pressures=stroke_start_pressures(cfg, direction, start))
     return simulate_run(cfg, duration, x0, command=Profile.constant(u), load=scenario_load(cfg, op), flow_control=flow_control,
                         pressures=stroke_start_pressures(cfg, direction, start))
 

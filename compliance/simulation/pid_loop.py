@@ -1,7 +1,7 @@
 """The compiled PID loop of plant A (seed 000): RK4 plant, controller on its own sample clock.
 
-The controller runs every ``controller.sample_time`` with a zero-order hold: PID, dead-zone
-compensation (seed 000 eq. 3), saturation; the same loop runs plant-only from a recorded or
+The controller runs every ``controller.sample_time`` with a zero-order hold: the set-point rate
+limiter (when a rate is set), PID, dead-zone compensation (seed 000 eq. 3), saturation; the same loop runs plant-only from a recorded or
 profiled valve command.
 """
 
@@ -17,8 +17,9 @@ from compliance.model.assembly import plant_rhs, valve_lag_input
 from compliance.model.plant_vector import load_curve_arrays, parameter_vector
 from compliance.model.rest_state import initial_state
 from compliance.model.config import PlantConfig
-from compliance.model.pid_controller import first_order_filter_gain, pid_sample, saturate
-from compliance.model.vector_slots import P_FILT, P_KD, P_KI, P_KP, P_SL_ON, P_SL_TD, P_TSAMP, P_UCEN, P_ULIM, P_VD_ON, P_VD_TD, S_SP, S_V, S_X
+from compliance.model.pid_controller import first_order_filter_gain, limiter_sample, pid_sample, saturate
+from compliance.model.vector_slots import (P_FILT, P_KD, P_KI, P_KP, P_RL_ON, P_SL_ON, P_SL_TD, P_TSAMP, P_UCEN, P_ULIM, P_VD_ON,
+                                           P_VD_TD, S_SP, S_V, S_X)
 from compliance.simulation.rk4 import N_OUT, OUTPUT_COLUMNS, measured_position, non_physical, record_sample, rk4_step, rk4_workspace
 from compliance.simulation.rk4 import sensor_lag_advance, sensor_lag_coefficients, sensor_lag_start, zoh_average
 from compliance.simulation.scenario import Scenario, sample_profile
@@ -38,10 +39,8 @@ def simulate_core(P, y0, ref, cmd, closed_loop, pos_noise, pos_quantum, lx, ly, 
         Reference [m] and open-loop command [V] per controller sample (length n_samples + 1).
     closed_loop : bool
         Run the PID (True) or apply ``cmd`` (False).
-    pos_noise : ndarray
-        Additive position noise per sample [m].
-    pos_quantum : float
-        Position quantisation [m].
+    pos_noise, pos_quantum : ndarray, float
+        Additive position noise per sample and position quantisation [m].
     lx, ly : ndarray
         Load curve.
     n_samples, n_sub : int
@@ -66,6 +65,7 @@ def simulate_core(P, y0, ref, cmd, closed_loop, pos_noise, pos_quantum, lx, ly, 
     x_sensor, xd_prev, v0 = sensor_lag_start(P, y[S_X], y[S_V], sensor)
     alpha = first_order_filter_gain(P[P_FILT], ts)
     x_filt, integral = 0.0, 0.0
+    limiter, r_lim = P[P_RL_ON] != 0.0, y0[S_X]  # the limiter starts at the gate (bumpless: a step at t = 0 ramps)
     valve_delay = P[P_VD_TD] if P[P_VD_ON] != 0.0 else 0.0
     sensor_delay = P[P_SL_TD] if sensor else 0.0
     if P[P_VD_ON] != 0.0:
@@ -78,7 +78,10 @@ def simulate_core(P, y0, ref, cmd, closed_loop, pos_noise, pos_quantum, lx, ly, 
         if closed_loop:
             if k == 0:
                 x_filt = xm
-            u_d, u_c, x_filt, integral = pid_sample(P, xm, ref[k], x_filt, integral, alpha, P[P_KP], P[P_KI], P[P_KD], ts)
+            if limiter:
+                r_lim = limiter_sample(P, ref[k], r_lim, xm, ts)
+            u_d, u_c, x_filt, integral = pid_sample(P, xm, r_lim if limiter else ref[k], x_filt, integral, alpha,
+                                                    P[P_KP], P[P_KI], P[P_KD], ts)
             u = saturate(u_c, P[P_ULIM]) + P[P_UCEN]
         else:
             u = cmd[k]

@@ -3,18 +3,22 @@
 The space is a sweep file's ``adjust`` table when one is named, else the settings that can be
 changed on site without new hardware, around the configuration's own values (DEFAULT_SPACE):
 controller gains and dead-zone compensation, the meter-out flow-control valves, the supply
-pressure regulator. Hardware (cylinder, valve size) is left to a sweep file that declares it.
+pressure regulator; for a PID governor also its set-point rate limiter (``limiter_space``).
+Then the options of a hardware catalogue (``sweep.hardware``; the shipped one by default).
+A remedy found is verified by a full campaign and its tolerance yield (DEFAULT_TOLERANCES:
+manufacturing and site tolerances of a delivered unit, our choice, the same as
+models/sweeps/plant-a-remedies.toml); when none is found the binding requirement is explained
+physically (``binding_physics``).
 """
 
 from __future__ import annotations
 
 from compliance.sweep.evaluate import make_context
 from compliance.sweep.parameter_paths import describe
-from compliance.sweep.remedies import find_remedy
-from compliance.sweep.spec import Adjustable
+from compliance.sweep.spec import Adjustable, Uncertain
 from compliance.sweep.yield_mc import nominal_values
 
-__all__ = ["DEFAULT_SPACE", "default_space", "remedies_for_check"]
+__all__ = ["DEFAULT_SPACE", "DEFAULT_TOLERANCES", "YIELD_UNITS", "default_space", "remedies_for_check"]
 
 # path -> (low factor, high factor, absolute floor of the high end [SI]) around the configured value;
 # factors are commissioning ranges (gains x0.5-x3, throttles x0.6-x1.5, regulator -20 %/+15 %)
@@ -37,6 +41,14 @@ DEFAULT_SPACE = {
         "air.supply_pressure": (0.8, 1.15, 0.0),
     },
 }
+# path -> (distribution, spread): relative spreads of a delivered unit around its nominal values
+DEFAULT_TOLERANCES = {
+    "friction.static_force": ("uniform", 0.20),
+    "friction.viscous_coefficient": ("uniform", 0.30),
+    "valve.sonic_conductance": ("normal", 0.05),
+    "air.supply_pressure": ("normal", 0.02),  # 0.16 bar of 8 bar abs: a regulator's repeatability
+}
+YIELD_UNITS = 59  # 59 of 59 passing is the fewest that shows >= 95 % yield at 95 % confidence (success-run rule)
 
 
 def default_space(cfg) -> tuple[Adjustable, ...]:
@@ -53,25 +65,66 @@ def default_space(cfg) -> tuple[Adjustable, ...]:
     return tuple(out)
 
 
-def remedies_for_check(cfg, reqset, sweep_file: str | None, *, workers=None, progress=True, iterations=4,
-                       linear=False, client=None, scheduler=None) -> dict:
-    """The ``remedies`` section for ``cfg`` against ``reqset`` (docs/results-schema.md)."""
-    from compliance.sweep.run import verify_settings
+def _space(cfg, reqset, sweep_file):
+    """(adjustables, start values, uncertain parameters) of the search."""
+    from compliance.sweep.limiter_space import limiter_space
 
+    uncertain = tuple(Uncertain(describe(p, "remedies tolerances"), d, s, True, None) for p, (d, s) in DEFAULT_TOLERANCES.items())
     if sweep_file and sweep_file != "default":
         from compliance.sweep.spec import load_sweep
 
-        adjust = load_sweep(sweep_file).adjust
+        spec = load_sweep(sweep_file)
+        adjust, uncertain = spec.adjust, spec.uncertain or uncertain
     else:
         adjust = default_space(cfg)
-    paths = {a.param.path: a.param for a in adjust}
-    ctx = make_context(cfg, reqset, paths, linear)
-    base = nominal_values(cfg, paths)
-    from compliance.campaign.executor import dask_session
+    base = nominal_values(cfg, {a.param.path: a.param for a in adjust})
+    limiter = None  # a sweep file's space is as declared; the default space adds the limiter to a PID governor
+    if cfg.options["controller.type"] == "pid" and not cfg.setpoint_rate_limited and not (sweep_file and sweep_file != "default"):
+        lim, start = limiter_space(cfg, reqset)
+        adjust = tuple(a for a in adjust if a.param.path not in start)
+        limiter = (lim, start)
+    return adjust, base, uncertain, limiter
 
+
+def remedies_for_check(cfg, reqset, sweep_file: str | None, *, workers=None, progress=True, iterations=1,
+                       linear=False, client=None, scheduler=None, catalogue="default", yield_units=YIELD_UNITS,
+                       store=None) -> dict:
+    """The ``remedies`` section for ``cfg`` against ``reqset`` (docs/results-schema.md).
+
+    Parameters
+    ----------
+    catalogue : str or None
+        Hardware catalogue file, ``"default"`` (shipped) or None (settings only).
+    yield_units : int
+        Units of the tolerance yield of a remedy found (0: no yield run).
+    store : str or None
+        Folder keeping every judged candidate, so an interrupted search resumes (``candidate_store``).
+    """
+    from compliance.campaign.executor import dask_session
+    from compliance.sweep.hardware import load_catalogue
+    from compliance.sweep.remedy_finish import as_given, finish
+    from compliance.sweep.remedy_search import staged_search
+    from compliance.sweep.run import verify_settings
+
+    if isinstance(store, str):
+        from compliance.sweep.candidate_store import CandidateStore
+
+        store = CandidateStore(store)
+    cat = load_catalogue(catalogue) if catalogue else None
+    adjust, base, uncertain, limiter = _space(cfg, reqset, sweep_file)
+    paths = {a.param.path: a.param for a in adjust + (limiter[0] if limiter else ())}
+    paths.update({u.param.path: u.param for u in uncertain})
+    for o in (cat.options if cat else ()):
+        paths.update({p: describe(p, o.where) for p in o.values(cfg)} if o.applies_to(cfg) is None else {})
+    ctx = make_context(cfg, reqset, paths, linear)
     with dask_session(scheduler, client) as session:
-        run_kw = {"workers": workers, "progress": progress, "client": session, "scheduler": scheduler}
-        rem = find_remedy(ctx, adjust, base, iterations=iterations,
-                          verify=lambda v: verify_settings(cfg, reqset, paths, v, workers=workers), run_kw=run_kw)
+        run_kw = {"workers": workers, "progress": progress, "client": session, "scheduler": scheduler, "store": store}
+        given = as_given(ctx, run_kw)
+        if given["status"] == "already_passes":
+            return given
+        rem = staged_search(ctx, cfg, adjust, base, cat, iterations=iterations, run_kw=run_kw, limiter=limiter,
+                            verify=lambda v: verify_settings(cfg, reqset, paths, v, workers=workers))
+        rem = finish(rem, given, ctx, cfg, reqset, uncertain, cat, run_kw=run_kw, yield_units=yield_units)
     rem["space_source"] = sweep_file if sweep_file and sweep_file != "default" else "default on-site settings"
+    rem["catalogue"] = cat.path if cat else None
     return rem

@@ -70,7 +70,8 @@ def evaluate_one(ctx: Context, values: dict) -> dict:
     for e in entries:
         w = e["worst"] or {}
         reqs[e["id"]] = {"severity": e["severity"], "status": e["status"], "value": w.get("value"),
-                         "margin": w.get("margin"), "margin_pct": w.get("margin_pct"), "where": w.get("run")}
+                         "margin": w.get("margin"), "margin_pct": w.get("margin_pct"), "where": w.get("run"),
+                     "basis": e.get("basis")}
     judged = [(e["severity"], e["status"]) for e in entries if e["status"] not in (OPEN, DISABLED)]
     return {"status": overall_status(judged), "error": None, "requirements": reqs}
 

@@ -14,9 +14,12 @@
    hardly moves with any parameter) is set aside for the step, so the search still fixes
    the others; it is named in the result as out of reach.
 4. If nothing passes, the closest candidate judged and the requirement that binds it are
-   reported: evidence, not a proof, that the declared space holds no pass. Closest = the
-   smallest worst shortfall (to 10 % of its limit), then the smallest sum of shortfalls,
-   then the smallest change.
+   reported: evidence, not a proof, that the declared space holds no pass. Closest =
+   ``sweep.ranking``: fewest failing mandatory requirements, then the smallest sum of
+   shortfalls, then the smallest change; the configuration as given is among the judged, so
+   the closest never fails more mandatory requirements than it.
+
+Values in ``fixed`` (hardware options of the catalogue) are set on every candidate judged.
 """
 
 from __future__ import annotations
@@ -26,10 +29,11 @@ import math
 import numpy as np
 
 from compliance.sweep.results import change
-from compliance.sweep.runner import run_candidates, shortfall, total_shortfall
+from compliance.sweep.ranking import SETTINGS_COST, candidate_passes, failing_mandatory, rank_key
+from compliance.sweep.runner import run_candidates, shortfall
 from compliance.sweep.sampling import from_normalised, to_normalised
 
-__all__ = ["STEP", "TARGET", "binding", "closeness", "find_remedy", "mandatory_margins", "unreachable"]
+__all__ = ["STEP", "TARGET", "binding", "closeness", "describe_candidate", "find_remedy", "mandatory_margins", "unreachable"]
 
 STEP = 0.1  # finite-difference step, fraction of each declared range
 TARGET = 0.02  # margin (fraction of the limit) the linear step aims for, against the model's curvature
@@ -97,12 +101,9 @@ def _least_change(ubase, u0, m0, J, radius):
     return np.clip(u0 + radius * np.sign(g), lo, hi)
 
 
-def closeness(row: dict, values: dict, adjust, start: dict) -> tuple:
-    """Ranking key of a failing candidate (smaller is closer to passing)."""
-    worst = shortfall(row)
-    if not math.isfinite(worst):
-        return (math.inf, math.inf, math.inf)
-    return (round(worst, 1), total_shortfall(row), change(adjust, start, values))
+def closeness(row: dict, values: dict, adjust, start: dict, cost: float = 0.0) -> tuple:
+    """Ranking key of a candidate (smaller is closer to passing; ``sweep.ranking.rank_key``)."""
+    return rank_key(row, cost + SETTINGS_COST * change(adjust, start, values))
 
 
 def _sensitivity_table(adjust, ids, m0, J, failed):
@@ -117,7 +118,8 @@ def _sensitivity_table(adjust, ids, m0, J, failed):
     return out
 
 
-def _describe(adjust, base, values, row, index=None) -> dict:
+def describe_candidate(adjust, base, values, row) -> dict:
+    """A judged candidate as the remedies section reports it: values, changes from ``base``, binding, failing."""
     rid, marg = binding(row)
     return {
         "values": {k: float(v) for k, v in values.items()},
@@ -129,8 +131,9 @@ def _describe(adjust, base, values, row, index=None) -> dict:
         "shortfall_pct": 100.0 * shortfall(row) if math.isfinite(shortfall(row)) else None,
         "binding": rid,
         "binding_margin_pct": marg,
-        "failed_mandatory": sorted(k for k, r in row["requirements"].items()
-                                   if r["severity"] == "mandatory" and r["status"] == "fail"),
+        "binding_where": row["requirements"][rid].get("where") if rid else None,
+        "failed_mandatory": failing_mandatory(row),
+        "total_shortfall": rank_key(row, 0.0)[1],
     }
 
 
@@ -138,7 +141,8 @@ def _clamped_base(adjust, base):
     return {a.param.path: float(min(max(base[a.param.path], a.low), a.high)) for a in adjust}
 
 
-def find_remedy(ctx, adjust, base: dict, *, verify, iterations: int = 4, seeds=(), run_kw=None) -> dict:
+def find_remedy(ctx, adjust, base: dict, *, verify, iterations: int = 4, seeds=(), run_kw=None, fixed=None,
+                cost: float = 0.0, report_base=None) -> dict:
     """Sensitivities and the smallest verified change that passes every mandatory requirement.
 
     Parameters
@@ -155,6 +159,12 @@ def find_remedy(ctx, adjust, base: dict, *, verify, iterations: int = 4, seeds=(
         Candidates already judged (a sweep's samples): the search may start from the closest.
     run_kw : dict
         Passed to :func:`~compliance.sweep.runner.run_candidates` (scheduler, workers, progress, client).
+    fixed : dict
+        path -> SI value set on every candidate (hardware options); ``verify`` receives them too.
+    cost : float
+        Cost of the fixed hardware (ranking).
+    report_base : dict
+        Values the reported changes are measured from (default: ``base``; a later stage gives the configuration's).
 
     Returns
     -------
@@ -163,22 +173,23 @@ def find_remedy(ctx, adjust, base: dict, *, verify, iterations: int = 4, seeds=(
     """
     run_kw = dict(run_kw or {})
     run_kw.setdefault("label", "remedies")
+    run_kw["fixed"] = dict(fixed or {})
     start = _clamped_base(adjust, base)
     ubase = to_normalised(adjust, start)
-    (row0,), _ = run_candidates(ctx, [start], **run_kw)
+    (row0,), _ = _judge(ctx, [start], **run_kw)
     judged = [(start, row0)] + list(seeds)
     space = [{"path": a.param.path, "unit": a.param.unit, "low": a.low, "high": a.high, "base": float(base[a.param.path])}
              for a in adjust]
     out = {"status": "already_passes", "space": space, "failed": [], "sensitivities": [], "out_of_reach": [],
            "remedy": None, "closest": None, "evaluated": 1 + len(seeds), "note": ""}
-    if row0["status"] == "pass":
+    if candidate_passes(row0):
         out["note"] = "every mandatory requirement passes as configured: nothing to change"
+        out["closest"] = describe_candidate(adjust, start, start, row0)
         return out
-    out["failed"] = sorted(k for k, r in row0["requirements"].items() if r["severity"] == "mandatory" and r["status"] != "pass"
-                           and r["status"] not in ("open", "disabled"))
+    out["failed"] = failing_mandatory(row0)
 
     def key(t):
-        return closeness(t[1], t[0], adjust, start)
+        return closeness(t[1], t[0], adjust, start, cost)
 
     u0 = ubase
     ids, m0, J = _linearise(ctx, adjust, u0, row0, run_kw, judged, out)
@@ -192,12 +203,12 @@ def find_remedy(ctx, adjust, base: dict, *, verify, iterations: int = 4, seeds=(
             ids, m0, J = _linearise(ctx, adjust, u0, cur_row, run_kw, judged, out)
         u_new = _least_change(ubase, u0, m0, J, radius) if ids else u0
         cand = from_normalised(adjust, u_new)
-        (row,), _ = run_candidates(ctx, [cand], **run_kw)
+        (row,), _ = _judge(ctx, [cand], **run_kw)
         out["evaluated"] += 1
         judged.append((cand, row))
-        if row["status"] == "pass":
-            results = verify(cand)
-            remedy = _describe(adjust, start, cand, row)
+        if candidate_passes(row):
+            results = verify({**cand, **run_kw["fixed"]})
+            remedy = describe_candidate(adjust, start, cand, row)
             remedy["verified"] = {"status": results["summary"]["status"],
                                   "failed_mandatory": results["summary"]["failed_mandatory"]}
             if results["summary"]["status"] == "pass":
@@ -215,14 +226,19 @@ def _linearise(ctx, adjust, u0, row, run_kw, judged, out):
     """Judge the probes around ``u0``; finite-difference margins (ids, m0, J). Appends to ``judged``."""
     us, steps = _probes(adjust, u0)
     settings = [from_normalised(adjust, u) for u in us]
-    probe_rows, _ = run_candidates(ctx, settings, **run_kw)
+    probe_rows, _ = _judge(ctx, settings, **run_kw)
     out["evaluated"] += len(us)
     judged += list(zip(settings, probe_rows))
     return _sensitivities(adjust, u0, row, probe_rows, steps)
 
 
+def _judge(ctx, settings, *, fixed, **run_kw):
+    """Judge settings with the fixed (hardware) values set on each -> (rows, RunStats)."""
+    return run_candidates(ctx, [{**s, **fixed} for s in settings], **run_kw)
+
+
 def _none_found(out, adjust, start, closest):
-    out.update(status="none_found", closest=_describe(adjust, start, *closest))
+    out.update(status="none_found", closest=describe_candidate(adjust, start, *closest))
     rid = out["closest"]["binding"]
     reach = (f" Out of reach of every declared parameter by the local sensitivities: {', '.join(out['out_of_reach'])}."
              if out["out_of_reach"] else "")

@@ -2,7 +2,8 @@
 
 Table columns (Parquet and CSV): ``candidate``; one column per adjusted (or drawn) parameter
 path in SI; per requirement ``ID.value``, ``ID.margin``, ``ID.margin_pct``, ``ID.status``;
-``status`` (pass / fail / incomplete / invalid / failed), ``shortfall`` (worst mandatory
+``status`` (pass / fail / incomplete / invalid / failed), ``failing`` (mandatory requirements
+not passing, ``sweep.ranking``), ``shortfall`` (worst mandatory
 margin short of passing, in fractions of its limit; 0 passes), ``total_shortfall`` (their
 sum), ``change`` (distance from the
 base settings in normalised units) and ``error``.
@@ -17,6 +18,7 @@ import numpy as np
 import pandas as pd
 
 from compliance.files.atomic import write_bytes_atomic, write_text_atomic
+from compliance.sweep.ranking import rank_key
 from compliance.sweep.runner import shortfall, total_shortfall
 
 __all__ = ["best_index", "change", "pareto_front", "table", "tightest", "write_table"]
@@ -46,6 +48,7 @@ def table(candidates: list[dict], rows: list[dict], req_ids: list[str], adjust=(
         rec["status"] = row["status"]
         rec["shortfall"] = shortfall(row)
         rec["total_shortfall"] = total_shortfall(row)
+        rec["failing"] = float(rank_key(row, 0.0)[0])
         rec["change"] = change(adjust, base, values) if base is not None else float("nan")
         rec["error"] = row.get("error")
         recs.append(rec)
@@ -86,15 +89,14 @@ def pareto_front(df: pd.DataFrame, a: str, b: str) -> list[int]:
 def best_index(df: pd.DataFrame) -> int | None:
     """A passing candidate with the smallest change, else the closest to passing.
 
-    Closest (as the remedies search ranks it): the smallest worst shortfall to 10 % of its limit,
-    then the smallest sum of shortfalls, then the smallest change.
+    Ranked as the remedies search ranks (``sweep.ranking``): fewest failing mandatory
+    requirements, then the smallest sum of shortfalls, then the smallest change.
     """
     if df.empty:
         return None
-    ranked = df.assign(_pass=(df["status"] != "pass"), _worst=df["shortfall"].round(1)).sort_values(
-        ["_pass", "_worst", "total_shortfall", "change", "candidate"])
+    ranked = df.sort_values(["failing", "total_shortfall", "change", "candidate"])
     top = ranked.iloc[0]
-    return None if not math.isfinite(top["shortfall"]) else int(top["candidate"])
+    return None if not math.isfinite(top["failing"]) else int(top["candidate"])
 
 
 def write_table(df: pd.DataFrame, folder) -> dict:

@@ -22,12 +22,23 @@ def batch_size(n: int, workers: int) -> int:
 
 
 def run_candidates(ctx: Context, candidates: list[dict], *, scheduler=None, workers=None, progress=True,
-                   label="candidates", client=None):
+                   label="candidates", client=None, store=None):
     """Judge every candidate (settings dicts) -> (rows in candidate order, RunStats).
 
     A candidate whose task failed every retry gets a row with status ``failed`` so that the
-    table still has one row per candidate and the summary counts it.
+    table still has one row per candidate and the summary counts it. With a ``store``
+    (:class:`~compliance.sweep.candidate_store.CandidateStore`) candidates judged before are
+    not judged again and the new ones are kept.
     """
+    if store is not None:
+        rows = [store.get(ctx, c) for c in candidates]
+        todo = [i for i, r in enumerate(rows) if r is None]
+        new, stats = run_candidates(ctx, [candidates[i] for i in todo], scheduler=scheduler, workers=workers,
+                                    progress=progress, label=label, client=client)
+        store.add(ctx, [(candidates[i], r) for i, r in zip(todo, new)])
+        for i, r in zip(todo, new):
+            rows[i] = r
+        return rows, stats
     from compliance.campaign.executor import available_cores
 
     if not candidates:

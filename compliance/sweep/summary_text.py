@@ -27,9 +27,31 @@ def remedies_markdown(rem: dict) -> str:
                       f"{_pct(pick['binding_margin_pct'])}):", ""]
         lines += ["| parameter | from | to | unit |", "|---|---|---|---|"]
         lines += [f"| {c['path']} | {_g(c['from'])} | {_g(c['to'])} | {c['unit']} |" for c in pick["changes"]]
+        if pick.get("hardware"):
+            lines.append("\nHardware: " + "; ".join(f"{h['title']} (cost {h['cost']:g})" for h in pick["hardware"]))
         if pick.get("failed_mandatory"):
             lines.append(f"\nStill failing: {', '.join(pick['failed_mandatory'])}")
+    lines += _yield_lines(rem.get("tolerance_yield"))
+    if rem.get("hardware_tried"):
+        lines += ["", "Hardware options judged alone at the best settings:", ""]
+        lines += [f"- {h['title']} (cost {h['cost']:g}): {h['status']}"
+                  + (f", failing {', '.join(h['failed_mandatory'])}" if h["failed_mandatory"] else "") for h in rem["hardware_tried"]]
+    if rem.get("not_modelled"):
+        lines += ["", "Not in the search (the model cannot represent them): "
+                  + "; ".join(f"{n['title']} ({n['reason']})" for n in rem["not_modelled"])]
     return "\n".join(lines) + "\n"
+
+
+def _yield_lines(y) -> list[str]:
+    if not y:
+        return []
+    verdict = "meets" if y["meets"] else "does not show"
+    return ["", f"**Tolerance yield**: {y['pass']} of {y['valid']} units pass every mandatory requirement "
+                f"({100 * (y['fraction'] or 0):.1f} %; one-sided {int(100 * y['confidence'])} % lower bound "
+                f"{100 * y['lower_bound']:.1f} %): {verdict} >= {100 * y['target']:.0f} % of units at "
+                f"{100 * y['confidence']:.0f} % confidence."
+                + (" Weakest: " + ", ".join(f"{r['requirement']} {100 * r['fraction']:.0f} %" for r in y["worst_requirements"])
+                   if not y["meets"] else "")]
 
 
 def summary_markdown(s: dict) -> str:

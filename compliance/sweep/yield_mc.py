@@ -16,10 +16,11 @@ import math
 
 import numpy as np
 
+from compliance.sweep.ranking import candidate_passes
 from compliance.sweep.runner import run_candidates, shortfall
 from compliance.sweep.sampling import draw_units
 
-__all__ = ["nominal_values", "run_yield", "wilson"]
+__all__ = ["lower_bound", "nominal_values", "run_yield", "wilson"]
 
 HIST_BINS = 20
 
@@ -36,6 +37,20 @@ def wilson(k: int, n: int, confidence: float) -> tuple[float, float]:
     mid = (p + z * z / (2 * n)) / den
     half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / den
     return max(0.0, mid - half), min(1.0, mid + half)
+
+
+def lower_bound(k: int, n: int, confidence: float) -> float:
+    """One-sided exact (Clopper-Pearson) lower confidence bound of a pass fraction k/n.
+
+    ``lower_bound(59, 59, 0.95)`` = 0.9505: 59 passing units of 59 show >= 95 % yield at 95 %
+    confidence (the success-run rule); the two-sided Wilson interval of :func:`wilson` is the
+    table's, this is the acceptance statement's.
+    """
+    from scipy.stats import beta
+
+    if n == 0 or k == 0:
+        return 0.0
+    return float(beta.ppf(1.0 - confidence, k, n - k + 1))
 
 
 def nominal_values(cfg, paths: dict) -> dict:
@@ -109,7 +124,7 @@ def run_yield(ctx, cfg, candidate: dict, uncertain, *, units: int, seed: int, co
     valid = [r for r in rows if r["status"] not in ("invalid", "failed")]
     vunits = [d for d, r in zip(draws, rows) if r["status"] not in ("invalid", "failed")]
     ids = sorted({rid for r in valid for rid, e in r["requirements"].items() if e["status"] not in ("open", "disabled")})
-    k_all = sum(1 for r in valid if r["status"] == "pass")
+    k_all = sum(1 for r in valid if candidate_passes(r))
     lo, hi = wilson(k_all, len(valid), confidence)
     out = {
         "candidate": {k: float(v) for k, v in candidate.items()},
@@ -118,7 +133,8 @@ def run_yield(ctx, cfg, candidate: dict, uncertain, *, units: int, seed: int, co
         "failed_tasks": sum(1 for r in rows if r["status"] == "failed"),
         "uncertain": [{"path": u.param.path, "unit": u.param.unit, "distribution": u.distribution,
                        "spread": u.spread, "relative": u.relative, "nominal": nominal[u.param.path]} for u in uncertain],
-        "all_mandatory": {"pass": k_all, "fraction": k_all / len(valid) if valid else None, "ci": [lo, hi]},
+        "all_mandatory": {"pass": k_all, "fraction": k_all / len(valid) if valid else None, "ci": [lo, hi],
+                          "lower_bound": lower_bound(k_all, len(valid), confidence)},
         "requirements": [_requirement_yield(valid, rid, confidence) for rid in ids] if valid else [],
         "drivers": _drivers(vunits, valid, uncertain, ids) if valid else [],
     }

@@ -391,3 +391,25 @@ case("sweep-missing-file", "sweep nothere-sweep.toml --out out", "nothere-sweep.
 case("sweep-jobs-zero", ["sweep", "bad-sweep.toml", "-j", "0", "--out", "out"], "--jobs", {"bad-sweep.toml": SWEEP})
 case("sweep-bad-scheduler", ["sweep", "bad-sweep.toml", "--scheduler", "ftp://x", "--out", "out"], "scheduler", {"bad-sweep.toml": SWEEP})
 case("sweep-samples-zero", ["sweep", "bad-sweep.toml", "--samples", "0", "--out", "out"], "--samples", {"bad-sweep.toml": SWEEP})
+
+# ------------------------------------------------------------------------- remedies options, duties, catalogues
+DUTY = '''schema = "govcheck-duty/1"
+name = "sized"
+stroke = "160 mm"
+supply_pressure = "8 bar abs"
+[load.curve]
+position = { values = [0, 100], unit = "percent" }
+force = { values = [2.0, 12.0], unit = "kN" }
+'''
+file_cases("size req.toml --duty duty.toml --out out/sized.toml", "duty.toml", [
+    ("duty-wrong-schema", DUTY.replace("govcheck-duty/1", "govcheck-duty/9"), "schema"),
+    ("duty-pressure-without-abs", DUTY.replace('"8 bar abs"', '"8 bar"'), "supply_pressure"),
+    ("duty-unknown-field", DUTY + 'strokes = "1 m"\n', "strokes"),
+    ("duty-decreasing-positions", DUTY.replace("[0, 100]", "[100, 0]"), "increasing"),
+])
+case("size-missing-duty", "size req.toml --duty nothere-duty.toml", "nothere-duty.toml")
+case("check-save-remedy-without-remedies", "check plant.toml -r req.toml --save-remedy out/r.toml", "--remedies")
+case("check-remedies-bad-catalogue", "check plant.toml -r req.toml --remedies --catalogue cat.toml", "gearbox",
+     {"cat.toml": 'schema = "govcheck-hardware/1"\n[options.x]\ngroup = "gearbox"\ntitle = "t"\ncost = 1\n'
+                  'sets = { "cylinder.stroke" = "1 m" }\n'})
+case("check-remedies-negative-yield", ["check", "plant.toml", "-r", "req.toml", "--remedies", "--yield-units", "-1"], "--yield-units")

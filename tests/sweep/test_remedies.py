@@ -48,7 +48,7 @@ def test_no_remedy_in_the_space_names_the_binding_requirement(write_sweep, reqse
     # the time constant only grows (0.31 s at 250 V/m, 0.48 s at 200 V/m)
     adjust = '[adjust."controller.kp"]\nrange = ["150 V/m", "260 V/m"]\n'
     rem = remedies_for_check(load_plant("plant-a"), reqset, str(write_sweep(sweep_text(adjust=adjust))),
-                             workers=1, progress=False, iterations=1)
+                             workers=1, progress=False, iterations=1, catalogue=None)
     assert rem["status"] == "none_found" and rem["remedy"] is None
     assert rem["closest"]["binding"] == "TC" and rem["closest"]["binding_margin_pct"] < 0
     assert "not a proof" in rem["note"]
