@@ -236,7 +236,9 @@ def sidecar_plant(meta: dict, recording) -> str | None:
     if looks_like_config(src) and src.lower().endswith(".toml"):
         p = Path(src)
         if not p.is_absolute():
-            beside = Path(recording).parent / p
+            from compliance.recordings.metadata import sidecar_path
+
+            beside = sidecar_path(recording).parent / p
             if beside.is_file() or not p.is_file():
                 return str(beside)
     return src

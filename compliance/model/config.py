@@ -174,7 +174,7 @@ def load_plant(source: str | os.PathLike) -> PlantConfig:
         With the file and key path of the first problem found.
     """
     path = resolve_plant_path(source)
-    data, digest = read_toml(path)
+    data, digest = read_toml(path, "plant configuration")
     return plant_from_dict(data, str(path), digest)
 
 

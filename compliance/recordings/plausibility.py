@@ -14,7 +14,7 @@ import pandas as pd
 
 from compliance.errors import InputError
 
-__all__ = ["RANGES", "check_ranges", "check_time_base"]
+__all__ = ["RANGES", "check_ranges", "check_time_base", "relative_time"]
 
 # canonical column -> (low, high, unit, why); generous bounds of what any servo bench can log (SI)
 RANGES = {
@@ -29,6 +29,37 @@ RANGES = {
 }
 RATE_MISMATCH = 100.0  # sample interval vs the sidecar's rate: beyond this factor the time unit is wrong
 SLOW_SAMPLE = 0.5  # [s] a servo test sampled this slowly cannot resolve a 0.1 s time constant
+
+
+UNIX_START = (1e8, 4.2e9)  # [s] Unix time of 1973 .. 2103: a time column that starts here is a clock, not a test time
+
+
+def relative_time(path, time: np.ndarray) -> tuple[np.ndarray, dict | None]:
+    """A clock time column (Unix seconds, or dates read as such) made relative to its first sample.
+
+    Returns
+    -------
+    (numpy.ndarray, dict or None)
+        Time [s] from the first sample, and ``{"unix": t0, "utc": "2024-03-05T14:22:01.125Z"}`` when the
+        column was a clock (else the column unchanged and None).
+
+    Raises
+    ------
+    InputError
+        A start that looks like Unix time in milliseconds or microseconds read as seconds.
+    """
+    import datetime as dt
+
+    t0 = float(time[0])
+    if UNIX_START[0] <= t0 <= UNIX_START[1]:
+        utc = dt.datetime.fromtimestamp(t0, dt.timezone.utc).isoformat(timespec="milliseconds").replace("+00:00", "Z")
+        return time - t0, {"unix": t0, "utc": utc}
+    for factor, unit in ((1e3, "milliseconds"), (1e6, "microseconds")):
+        if UNIX_START[0] * factor <= t0 <= UNIX_START[1] * factor:
+            raise InputError(
+                f"{path}: column 'time' starts at {t0:.6g}, which is Unix time in {unit} read as seconds; give a "
+                f"column map with the time unit (time = {{ column = ..., unit = \"{'ms' if factor == 1e3 else 'us'}\" }})")
+    return time, None
 
 
 def check_ranges(path, frame: pd.DataFrame, row) -> None:
