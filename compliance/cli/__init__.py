@@ -68,7 +68,8 @@ def main(argv: list[str] | None = None) -> int:
     except SystemExit as exc:  # argparse: usage error (2) or --help/--version (0)
         return int(exc.code or 0) if not isinstance(exc.code, str) else 2
     if not getattr(args, "command", None):
-        parser.print_help()
+        parser.print_help(sys.stderr)
+        print("govcheck: error: no COMMAND given; choose one of the commands above (govcheck COMMAND --help)", file=sys.stderr)
         return 2
     try:
         code = args._run(args)

@@ -208,6 +208,9 @@ def _from_dict(data: dict, where: str) -> ColumnMap:
     metadata = data.get("metadata", {})
     if not isinstance(metadata, dict):
         raise InputError(f"{where}: [metadata] must be a table")
+    from compliance.recordings.sidecar_schema import check_sidecar
+
+    check_sidecar(metadata, where, keys="metadata")  # the same keys as a sidecar: they end in the same metadata
     cols = data.get("columns")
     if not isinstance(cols, dict) or not cols:
         raise InputError(f"{where}: needs a [columns] table mapping canonical names to {{column = ..., unit = ...}}")

@@ -12,6 +12,7 @@ from compliance.model.toml_file import read_toml
 from pathlib import Path
 
 from compliance.errors import InputError
+from compliance.recordings.sidecar_schema import check_sidecar
 from compliance.units import parse_quantity, registry
 
 __all__ = ["read_sidecar", "si_metadata", "sidecar_path"]
@@ -53,6 +54,7 @@ def read_sidecar(path) -> dict:
     if not side.is_file():
         return {}
     data, _ = read_toml(side, "recording sidecar")
+    check_sidecar(data, str(side))
     return si_metadata(data, str(side))
 
 
