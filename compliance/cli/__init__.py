@@ -92,12 +92,13 @@ def main(argv: list[str] | None = None) -> int:
         parser.print_help(sys.stderr)
         print("govcheck: error: no COMMAND given; choose one of the commands above (govcheck COMMAND --help)", file=sys.stderr)
         return 2
-    from compliance.processes import stop_on_sigterm
+    from compliance.processes import raise_if_stopping, stop_on_signals
 
-    stop_on_sigterm()  # SIGTERM unwinds like Ctrl-C: workers killed, temporary files removed, exit 143
+    stop_on_signals()  # SIGTERM unwinds like Ctrl-C: workers killed, temporary files removed, exit 143 (Ctrl-C 130)
     try:
         code = args._run(args)
         sys.stdout.flush()  # inside the try: a reader that went away is met here, not at the interpreter's exit
+        raise_if_stopping()  # a signal whose exception Python swallowed (in a fork hook) still ends as interrupted
     except GovcheckError as exc:
         print(f"govcheck {args.command}: error: {exc}", file=sys.stderr)
         return exc.exit_code

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import time
 
+from compliance.processes import raise_if_stopping
 from compliance.campaign.results_files import write_json
 from compliance.files.atomic import write_json_atomic, write_text_atomic
 from compliance.sweep.evaluate import make_context
@@ -106,6 +107,7 @@ def run_sweep(spec, out_dir, *, scheduler=None, workers=None, progress=True, cli
                      "shortfall": float(df.loc[best, "shortfall"]), "change": float(df.loc[best, "change"]),
                      "verified_status": res["summary"]["status"],
                      "failed_mandatory": res["summary"]["failed_mandatory"], "results_file": str(out / "best-results.json")}
+    raise_if_stopping()
     out.mkdir(parents=True, exist_ok=True)
     files = write_table(df, out)
     if res is not None:
@@ -150,6 +152,7 @@ def run_yield_file(spec, out_dir, candidate: dict, label: str, *, scheduler=None
     y.update(name=spec.name, label=label, executor=stats.as_dict() if stats else None)
     df = table(draws, rows, [r.id for r in ctx.reqset.requirements])
     res = verify_settings(cfg, reqset, spec.paths, candidate, workers=workers)
+    raise_if_stopping()
     out.mkdir(parents=True, exist_ok=True)
     buf_files = write_table(df, out)
     res["tolerance_yield"] = y

@@ -69,21 +69,27 @@ def test_signal_stops_command_and_workers(tmp_path, command, sig):
     W.build(tmp_path)
     (tmp_path / "s.toml").write_text(SWEEP_400, encoding="utf-8")
     before = {p.relative_to(tmp_path) for p in tmp_path.rglob("*")}
-    env = dict(os.environ, PYTHONPATH=str(REPO))
+    env = dict(os.environ, PYTHONPATH=str(REPO), PYTHONFAULTHANDLER="1")  # SIGABRT on a hang dumps every thread
     env.pop("SOURCE_DATE_EPOCH", None)
+    log = tmp_path.parent / f"{tmp_path.name}.stderr"  # a file, not a pipe: a full pipe would stall the command
     proc = subprocess.Popen([sys.executable, "-m", "compliance", *COMMANDS[command]], cwd=tmp_path, env=env,
-                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True,
+                            stdout=subprocess.DEVNULL, stderr=log.open("wb"), start_new_session=True,
                             preexec_fn=_as_from_a_terminal)
     try:
         t0 = time.monotonic()
         time.sleep(2.0)
         while not _children(proc.pid) and time.monotonic() - t0 < 10.0 and proc.poll() is None:
             time.sleep(0.1)
-        assert proc.poll() is None, f"{command} ended before the signal: {proc.stderr.read().decode()[-400:]}"
+        assert proc.poll() is None, f"{command} ended before the signal: {log.read_text()[-400:]}"
         workers = _children(proc.pid)
         proc.send_signal(sig)
         sent = time.monotonic()
-        code = proc.wait(timeout=STOP_WITHIN + 5)
+        try:
+            code = proc.wait(timeout=STOP_WITHIN + 5)
+        except subprocess.TimeoutExpired:
+            proc.send_signal(signal.SIGABRT)
+            proc.wait(timeout=10)
+            pytest.fail(f"{command} still running {STOP_WITHIN + 5:g} s after the signal; its threads:\n{log.read_text()[-6000:]}")
         stopped = time.monotonic() - sent
         deadline = sent + STOP_WITHIN
         while _session(proc.pid) and time.monotonic() < deadline:
@@ -94,7 +100,7 @@ def test_signal_stops_command_and_workers(tmp_path, command, sig):
             os.kill(p, signal.SIGKILL)
         if proc.poll() is None:
             proc.kill()
-    err = proc.stderr.read().decode()
+    err = log.read_text()
     assert stopped < STOP_WITHIN, f"{command} took {stopped:.1f} s to stop"
     assert not left, f"processes left behind after {command}: {left} (workers were {workers})"
     assert code == (130 if sig == signal.SIGINT else 143), f"exit {code}: {err[-400:]}"
