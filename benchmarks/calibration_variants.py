@@ -16,8 +16,11 @@ from __future__ import annotations
 
 import sys
 import time
+from pathlib import Path
 
-from compliance.model.config import load_plant
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # runnable as documented from a checkout
+
+from compliance.model.config import load_plant  # noqa: E402
 from compliance.papers.calibration import calibrate
 from compliance.papers.calibration_objective import within
 from compliance.papers.calibration_reach import PHYSICAL, PRINTED

@@ -157,15 +157,16 @@ def _run_serial(fn, context, items, results, bar, stats, retries):
 
 
 def _run_pool(fn, context, items, results, bar, stats, retries):
-    import multiprocessing as mp
-    from concurrent.futures import ProcessPoolExecutor, as_completed
+    from concurrent.futures import as_completed
     from concurrent.futures.process import BrokenProcessPool
+
+    from compliance.processes import worker_pool
 
     pending, attempts = set(range(len(items))), {}
     _CTX.update(fn=fn, context=context, items=items)
     try:
         while pending:  # a dead worker breaks the pool: start a new one for what is left
-            with ProcessPoolExecutor(max_workers=stats.workers, mp_context=mp.get_context("fork")) as pool:
+            with worker_pool(stats.workers) as pool:
                 futures = {pool.submit(_call, i): i for i in sorted(pending)}
                 for fut in as_completed(futures):
                     i = futures[fut]

@@ -17,6 +17,8 @@ import importlib
 import platform
 import time
 
+from compliance.model.force_limit import check_load_force
+from compliance.simulation.scenario import scenario_load
 from compliance.files.display import display_path
 from compliance.model.identity import identity_dict
 from compliance import __version__
@@ -164,6 +166,8 @@ def run_campaign(cfg, reqset: RequirementSet, *, workers: int | None = None, pro
     stroke = cfg.p("cylinder.stroke")
     for req in reqset.requirements:  # fail fast on loosening, before any simulation
         check_tightening(req, stroke)
+    for op in reqset.operating_points.values():  # a load no cylinder of this plant can hold is a typo, not a test
+        check_load_force(cfg, scenario_load(cfg, op), f"{reqset.path}: operating_points.{op.name}.load = {op.load_text!r}")
     jobs = plan(reqset)
     outcomes, used = execute(cfg, reqset, jobs, workers=workers, progress=progress)
     for j, o in zip(jobs, outcomes):

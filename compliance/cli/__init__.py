@@ -44,7 +44,8 @@ def build_parser() -> argparse.ArgumentParser:
             "governors: simulate, check against IEC 61362 / IEEE 125 requirement files, "
             "linearise, validate against recordings and diagnose missing physics."
         ),
-        epilog="Exit codes: 0 all pass, 1 a requirement failed (or a gate tripped), 2 invalid input, 3 an internal error.",
+        epilog=_EXAMPLES,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--version", action="version", version=f"govcheck {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
@@ -62,6 +63,26 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _silence_stdout() -> None:
+    """Point stdout at /dev/null so the interpreter's last flush does not fail on the closed pipe again."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):  # no real stdout (captured in tests): nothing to redirect
+        pass
+
+
+_EXAMPLES = """examples:
+  govcheck check models/plant-a.toml -r requirements/shpp-400kw.toml --json r.json --report r.html
+  govcheck simulate plant-a --steps '2%@1s,-2%@4s' -o run.csv --plot run.png
+  govcheck validate run.csv --report v.html        (the sidecar run.toml names the plant)
+  govcheck diagnose rec.csv.gz --json d.json --save-model fitted.toml
+  govcheck gate models/candidate.toml --baseline r.json --markdown pr-comment.md
+  govcheck COMMAND --help                          (each command's options and examples)
+
+Exit codes: 0 all pass, 1 a requirement failed (or a gate tripped), 2 invalid input, 3 an internal error."""
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``govcheck`` console script."""
     parser = build_parser()
@@ -70,16 +91,28 @@ def main(argv: list[str] | None = None) -> int:
     except SystemExit as exc:  # argparse: usage error (2) or --help/--version (0)
         return int(exc.code or 0) if not isinstance(exc.code, str) else 2
     if not getattr(args, "command", None):
-        parser.print_help()
+        parser.print_help(sys.stderr)
+        print("govcheck: error: no COMMAND given; choose one of the commands above (govcheck COMMAND --help)", file=sys.stderr)
         return 2
+    from compliance.processes import raise_if_stopping, stop_on_signals
+
+    stop_on_signals()  # SIGTERM unwinds like Ctrl-C: workers killed, temporary files removed, exit 143 (Ctrl-C 130)
     try:
         code = args._run(args)
+        sys.stdout.flush()  # inside the try: a reader that went away is met here, not at the interpreter's exit
+        raise_if_stopping()  # a signal whose exception Python swallowed (in a fork hook) still ends as interrupted
     except GovcheckError as exc:
         print(f"govcheck {args.command}: error: {exc}", file=sys.stderr)
         return exc.exit_code
-    except KeyboardInterrupt:
-        print("govcheck: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:
+        from compliance.processes import Terminated
+
+        term = isinstance(exc, Terminated)
+        print(f"govcheck {args.command}: {'terminated' if term else 'interrupted'}; nothing more written", file=sys.stderr)
+        return 143 if term else 130
+    except BrokenPipeError:  # the reader went away (govcheck linear ... | head -n 1): stop quietly, as cat does
+        _silence_stdout()
+        return 141
     except OSError as exc:  # a file the checks could not foresee (disk full, removed meanwhile)
         where = f"{exc.filename}: " if exc.filename else ""
         print(f"govcheck {args.command}: error: {where}{exc.strerror or exc}", file=sys.stderr)

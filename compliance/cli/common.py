@@ -16,6 +16,7 @@ import os
 import re
 
 from compliance.errors import InputError
+from compliance.model.force_limit import check_load_force  # noqa: F401 - simulate's --load check
 from compliance.units import parse_quantity
 
 OUTPUT_SUFFIXES = {"json": (".json",), "junit": (".xml",), "report": (".html", ".htm"), "pdf": (".pdf",)}
@@ -144,11 +145,35 @@ def standard_outputs(args, *extra) -> list:
 
 
 def check_args_outputs(args, *extra) -> None:
-    """Check ``--jobs`` and every output path before any work (nothing written on failure)."""
+    """Check ``--jobs`` and every output path before any work (nothing written on failure).
+
+    Every other argument that names an existing file is an input, and no output may be one of them.
+    """
     from compliance.files.outputs import check_outputs
 
+    from compliance.files.reproducible import fixed_created, is_reproducible
+
     check_jobs(args)
-    check_outputs(*standard_outputs(args, *extra))
+    if is_reproducible(getattr(args, "reproducible", False)):
+        fixed_created()  # a bad SOURCE_DATE_EPOCH is refused now, not after the work
+    outputs = standard_outputs(args, *extra)
+    check_outputs(*outputs, inputs=input_files(args, {o[1].split("/")[-1].lstrip("-").replace("-", "_") for o in outputs}))
+
+
+_POSITIONAL = {"config": "CONFIG", "inputs": "[CONFIG] RECORDING", "recordings": "RECORDING", "sweep": "SWEEP",
+               "results": "RESULTS", "candidate_pos": "CANDIDATE"}
+
+
+def input_files(args, output_names: set) -> dict:
+    """``{path: "--flag"}`` of every argument (not an output option) that names an existing file."""
+    found = {}
+    for name, value in vars(args).items():
+        if name.startswith("_") or name in output_names or name in OUTPUT_SUFFIXES:
+            continue
+        for item in value if isinstance(value, list) else [value]:
+            if isinstance(item, str) and item and os.path.isfile(item):
+                found.setdefault(item, _POSITIONAL.get(name, f"--{name.replace('_', '-')}"))
+    return found
 
 
 def quantity(text: str | None, si_unit: str, option: str, default: float | None = None) -> float | None:
@@ -162,30 +187,6 @@ def quantity(text: str | None, si_unit: str, option: str, default: float | None 
     if value != value or value in (float("inf"), float("-inf")):
         raise InputError(f"{option} {text!r}: expected a finite number")
     return value
-
-
-def cylinder_force_limit(cfg) -> float:
-    """Largest force the cylinder can produce: (p_s - p_atm) x the pressurised area [N] (docs/reference-plant.md)."""
-    import math
-
-    cap = math.pi / 4.0 * cfg.p("cylinder.piston_diameter") ** 2
-    rod = cap - math.pi / 4.0 * cfg.p("cylinder.rod_diameter") ** 2
-    area = cap + rod if cfg.options.get("cylinder.arrangement") == "tandem" else cap  # tandem: A_cap + A_rod per side
-    return (cfg.p("air.supply_pressure") - cfg.p("air.atmospheric_pressure")) * area
-
-
-def check_load_force(cfg, load, where: str) -> None:
-    """Refuse a constant load the cylinder cannot possibly hold (more than twice its force at supply).
-
-    Such a load is not a test condition but a typo (1e9 N for 11.4 kN); the solver would only
-    report a non-physical state much later.
-    """
-    if load is None or isinstance(load, str):
-        return
-    limit = cylinder_force_limit(cfg)
-    if not abs(load) <= 2.0 * limit:
-        raise InputError(f"{where}: load {load:.4g} N is more than twice the largest force the cylinder of {cfg.name} "
-                         f"can produce ({limit:.4g} N = (p_s - p_atm) x piston area); expected a load in N such as 11400")
 
 
 def parse_param_overrides(items, option: str = "--param") -> dict:
@@ -251,16 +252,16 @@ def sidecar_plant(meta: dict, recording) -> str | None:
     if looks_like_config(src) and src.lower().endswith(".toml"):
         p = Path(src)
         if not p.is_absolute():
-            beside = Path(recording).parent / p
+            from compliance.recordings.metadata import sidecar_path
+
+            beside = sidecar_path(recording).parent / p
             if beside.is_file() or not p.is_file():
                 return str(beside)
     return src
 
 
-def check_sidecar_conditions(cfg, meta: dict, recording) -> None:
-    """The sidecar's load must be one the plant could hold (a 1e9 N typo is named, not simulated)."""
-    from compliance.recordings.metadata import sidecar_path
+def check_sidecar_conditions(cfg, frame, meta: dict, recording) -> None:
+    """The recording and its sidecar are possible for this plant (``recordings.against_plant``), before any replay."""
+    from compliance.recordings.against_plant import check_against_plant
 
-    cond = meta.get("conditions")
-    if isinstance(cond, dict) and isinstance(cond.get("load_force"), (int, float)) and not isinstance(cond.get("load_force"), bool):
-        check_load_force(cfg, float(cond["load_force"]), f"{sidecar_path(recording)}: conditions.load_force")
+    check_against_plant(cfg, frame, meta, recording)

@@ -76,10 +76,10 @@ def run(args) -> int:
     if args.save_model and Path(args.save_model).exists():
         raise InputError(f"--save-model {args.save_model}: exists already; choose another name (nothing is overwritten)")
     effects = None
-    if args.effects:
+    if args.effects is not None:  # given but empty ("") is a mistake, not "every effect"
         effects = [e.strip() for e in args.effects.split(",") if e.strip()]
         if not effects:
-            raise InputError("--effects: expected a comma-separated list of effect names")
+            raise InputError("--effects '': expected a comma-separated list of effect names (leave --effects out for every effect)")
     first, meta = read_recording(args.recordings[0], args.column_map, required=("time",))
     if _is_friction(first):
         return _run_friction(args, first, meta)
@@ -93,7 +93,7 @@ def run(args) -> int:
     if not plant:
         raise InputError(f"{args.recordings[0]}: no CONFIG given and the sidecar names no 'plant'")
     cfg = load_plant(plant)
-    check_sidecar_conditions(cfg, meta, args.recordings[0])
+    check_sidecar_conditions(cfg, frame, meta, args.recordings[0])
     from compliance.cli.progress import progress
 
     with progress(1, "diagnose", quiet=args.quiet, unit="stage", first="replay, locate, fit every candidate") as bar:

@@ -82,6 +82,8 @@ def run(args) -> int:
     check_args_outputs(args)
     if args.cases < 1:
         raise InputError(f"--cases {args.cases}: expected at least 1")
+    if not 0 <= args.seed < 2**32:
+        raise InputError(f"--seed {args.seed}: expected a whole number from 0 to {2**32 - 1} (a random generator seed)")
     jobs = default_jobs() if args.jobs is None else args.jobs
     if jobs < 1:
         raise InputError(f"--jobs {jobs}: expected a positive number of worker processes")

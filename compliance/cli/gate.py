@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from compliance.cli.common import add_jobs, add_outputs, add_parser, add_quiet, add_reproducible, check_args_outputs
-from compliance.errors import InputError
+from compliance.errors import InputError, did_you_mean
 
 
 def register(subparsers):
@@ -72,6 +72,18 @@ def _requirements_for(args, baseline_results):
     raise InputError(f"{args.baseline}: requirement_set.path: '{path}' is not readable here; give --requirements")
 
 
+def _check_allowed_ids(allowed, reqset, *results) -> None:
+    """Every ``--allow-not-evaluated`` ID names a requirement of the comparison (a typo would allow nothing)."""
+    known = {r.id for r in reqset.requirements} if reqset is not None else set()
+    for res in results:
+        if res is not None:
+            known |= {str(e.get("id")) for e in res.get("requirements", []) if isinstance(e, dict)}
+    for rid in allowed:
+        if rid not in known:
+            raise InputError(f"--allow-not-evaluated {rid}: no requirement with this ID in the comparison"
+                             f"{did_you_mean(rid, known)} (IDs: {', '.join(sorted(known)) or 'none'})")
+
+
 def _candidate(args) -> str:
     pos, old = args.candidate_pos, args.candidate
     if pos and old and pos != old:
@@ -104,6 +116,7 @@ def run(args) -> int:
         if base is not None and reqset.digest != base["requirement_set"].get("digest"):
             print(f"govcheck gate: note: {reqset.path} changed since the baseline was made "
                   f"(digest {str(base['requirement_set'].get('digest'))[:12]} -> {reqset.digest[:12]})", file=sys.stderr)
+    _check_allowed_ids(args.allow_not_evaluated, reqset, base, cand)
     for name, cfg in configs.items():
         results = run_campaign(cfg, reqset, workers=args.jobs, progress=not args.quiet,
                                command_line=f"govcheck gate ({name} {sources[name]})")

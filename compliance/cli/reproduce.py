@@ -32,7 +32,7 @@ def run(args) -> int:
     """Compare with the paper; print the table, write the JSON."""
     from compliance.papers.plant_a import compare, format_table
 
-    check_args_outputs(args)
+    check_args_outputs(args, (args.calibrate, "--calibrate", (".toml",)))
     cfg = plant_from_args(args)
     if cfg.options["cylinder.arrangement"] != "tandem":
         from compliance.files.display import display_path

@@ -99,6 +99,26 @@ def _check_within(profile: Profile | None, duration: float, option: str) -> None
                          "lengthen --duration or drop the event")
 
 
+def _check_sine(cfg, x0: float, spec: str) -> None:
+    """A sine set-point inside the stroke and resolved by the controller's clock (below Nyquist)."""
+    from compliance.simulation.profiles import _SINE_RE
+    from compliance.units import parse_quantity
+
+    m = _SINE_RE.match(spec)
+    if not m:
+        return  # parse_sine names the syntax
+    stroke, ts = cfg.p("cylinder.stroke"), cfg.p("controller.sample_time")
+    amp = abs(parse_quantity(m.group(1), "m", "--sine"))
+    if x0 - amp < -1e-12 or x0 + amp > stroke + 1e-12:
+        raise InputError(f"--sine {spec}: the set-point swings {(x0-amp)*1e3:.1f}..{(x0+amp)*1e3:.1f} mm about "
+                         f"--x0 {x0*1e3:.1f} mm, outside the stroke 0..{stroke*1e3:.0f} mm; lower the amplitude or move --x0")
+    freq = parse_quantity(m.group(2), "Hz", "--sine")
+    nyquist = 0.5 / ts
+    if freq >= nyquist:
+        raise InputError(f"--sine {spec}: {freq:g} Hz is at or above the Nyquist frequency {nyquist:g} Hz of the "
+                         f"{ts*1e3:g} ms controller clock: the controller would see an alias, not the sine")
+
+
 def build_scenario(cfg, args):
     """The :class:`~compliance.simulation.Scenario` the arguments describe (every guard before any work)."""
     from compliance.simulation import Scenario, SensorNoise
@@ -115,6 +135,7 @@ def build_scenario(cfg, args):
         ref = steps(args.steps, x0, stroke)
         _check_within(ref, duration, "--steps")
     elif args.sine:
+        _check_sine(cfg, x0, args.sine)  # before the profile is built: a 1 MHz sine would never finish sampling
         ref = parse_sine(args.sine, x0, duration)
         _check_within(ref, duration, "--sine (its START)")  # a sine starting after the end would be dropped
     elif args.open_loop_command:

@@ -53,11 +53,15 @@ def _check_scheme(kind: str, address) -> None:
 
 
 def _out_dir(args, spec) -> Path:
+    """The output folder, checked before any work; it is created (with its parents) only when the sweep has finished."""
+    import os
+
     out = Path(args.out) if args.out else Path("reports") / "sweeps" / spec.name
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise InputError(f"--out {out}: cannot create the output folder ({exc.strerror})") from None
+    if out.exists() and not out.is_dir():
+        raise InputError(f"--out {out}: is a file; expected a folder for the sweep's outputs")
+    existing = next(p for p in (out, *out.parents) if p.exists())  # the folder that will hold the new ones
+    if not os.access(existing, os.W_OK | os.X_OK):
+        raise InputError(f"--out {out}: folder '{existing}' is not writable")
     return out
 
 

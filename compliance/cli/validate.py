@@ -162,7 +162,7 @@ def run(args) -> int:
     cfg = load_plant(plant_src)
     if params:
         cfg = cfg.replace(params=params)
-    check_sidecar_conditions(cfg, meta, recording)
+    check_sidecar_conditions(cfg, df, meta, recording)
     result = validate(cfg, df, meta, settings)
     summary = format_summary(result, args.max_windows)
     print(summary.rstrip().splitlines()[-1] if args.quiet else summary)

@@ -16,7 +16,6 @@ plant and scores:
 from __future__ import annotations
 
 import time
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -232,9 +231,9 @@ def run_benchmark(cfg: PlantConfig, *, effects=None, cases: int = 3, seed: int =
             if progress:
                 progress(r)
     else:
-        import multiprocessing as mp
+        from compliance.processes import worker_pool
 
-        with ProcessPoolExecutor(max_workers=jobs, mp_context=mp.get_context("fork"), initializer=_init, initargs=payload) as ex:
+        with worker_pool(jobs, initializer=_init, initargs=payload) as ex:
             for r in ex.map(_run_one, plan):
                 results.append(r)
                 if progress:

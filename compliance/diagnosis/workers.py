@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import os
 import tomllib
-from concurrent.futures import ProcessPoolExecutor
 
 from compliance.model.config import plant_from_dict
 from compliance.diagnosis.fit import FitContext, fit_candidate, least_squares_fit
@@ -61,7 +60,9 @@ def map_tasks(tasks, jobs: int, payload):
         ctx = mp.get_context("fork")
     except ValueError:  # pragma: no cover - platforms without fork
         ctx = mp.get_context()
-    with ProcessPoolExecutor(max_workers=min(jobs, len(tasks)), mp_context=ctx, initializer=_init_worker, initargs=payload) as ex:
+    from compliance.processes import worker_pool
+
+    with worker_pool(min(jobs, len(tasks)), ctx, initializer=_init_worker, initargs=payload) as ex:
         return list(ex.map(_run_task, tasks))
 
 

@@ -12,6 +12,7 @@ import tempfile
 from pathlib import Path
 from typing import Callable
 
+from compliance.processes import raise_if_stopping
 from compliance.files.jsonable import json_text
 
 __all__ = ["write_atomic_with", "write_bytes_atomic", "write_json_atomic", "write_text_atomic"]
@@ -44,6 +45,7 @@ def write_atomic_with(path, write: Callable[[str], None]) -> None:
     try:
         write(tmp)
         os.chmod(tmp, _usual_mode())  # mkstemp makes 0600; give the file the usual permissions
+        raise_if_stopping()  # a stop whose exception was swallowed still writes nothing
         os.replace(tmp, path)
     except BaseException:
         try:

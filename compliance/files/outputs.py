@@ -51,18 +51,24 @@ def check_output(path, flag: str, suffixes: tuple[str, ...] | None = None) -> No
         raise InputError(f"{flag} {path}: the file exists and is read-only; govcheck does not replace it")
 
 
-def check_outputs(*outputs) -> None:
+def check_outputs(*outputs, inputs: dict | None = None) -> None:
     """Check several ``(path, flag[, suffixes])`` outputs; ``None`` paths are skipped.
 
-    Two options naming the same file are an error too (one would overwrite the other).
+    Two options naming the same file are an error too (one would overwrite the other), and so
+    is an output that is one of the run's ``inputs`` (``{path: what it is}``): a run never
+    writes over what it reads (``reproduce plant.toml --calibrate plant.toml``).
     """
-    seen: dict[Path, str] = {}
+    seen: dict[Path, str] = {Path(p).resolve(): what for p, what in (inputs or {}).items()}
+    own = set(seen)
     for item in outputs:
         path, flag = item[0], item[1]
         if path is None:
             continue
         check_output(path, flag, item[2] if len(item) > 2 else None)
         key = Path(path).resolve()
+        if key in own:
+            raise InputError(f"{flag} {path}: is an input of this run ({seen[key]}); govcheck never writes over its "
+                             "inputs: give the output another name")
         if key in seen:
             raise InputError(f"{flag} {path}: the same file as {seen[key]}; give each output its own file")
         seen[key] = flag

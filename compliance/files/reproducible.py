@@ -17,6 +17,9 @@ __all__ = ["fixed_created", "is_reproducible", "make_reproducible"]
 _TIMING_KEYS = ("timing", "wall_time", "seconds", "timings")
 
 
+LAST_SECOND = 253402300799  # 9999-12-31T23:59:59Z
+
+
 def is_reproducible(flag: bool = False) -> bool:
     """True with ``--reproducible`` or when ``SOURCE_DATE_EPOCH`` is set."""
     return bool(flag) or bool(os.environ.get("SOURCE_DATE_EPOCH", "").strip())
@@ -35,8 +38,9 @@ def fixed_created() -> str:
         seconds = int(text) if text else 0
     except ValueError:
         raise InputError(f"SOURCE_DATE_EPOCH={text!r}: expected a whole number of seconds since 1970-01-01 UTC") from None
-    if seconds < 0:
-        raise InputError(f"SOURCE_DATE_EPOCH={text!r}: expected seconds >= 0")
+    if not 0 <= seconds <= LAST_SECOND:
+        raise InputError(f"SOURCE_DATE_EPOCH={text!r}: expected seconds from 0 to {LAST_SECOND} "
+                         "(1970-01-01 .. 9999-12-31 UTC, the dates an ISO timestamp can write)")
     return _dt.datetime.fromtimestamp(seconds, _dt.timezone.utc).isoformat(timespec="seconds")
 
 

@@ -216,6 +216,12 @@ def analyse(cfg: PlantConfig, position: float, load: float | str | None = None, 
     A, B, C, names, info = linearise_plant(op, cfg, gain)
     plant = control.ss(A, B, C, [[0.0]], states=names, inputs=["u_d"], outputs=["position"])
     Am, Bm, Cm = minimal_realisation(A, B, C, np.array(info["state_scales"]))
+    if Am.size == 0:  # nothing of the valve command reaches the position at the numerical precision of the scales
+        raise InputError(
+            f"{cfg.path or cfg.name}: the linearised plant at {op.position * 1e3:.1f} mm has no mode from the valve command "
+            f"to the position left (every mode is numerically uncontrollable or unobservable); the states differ in "
+            f"speed beyond what double precision resolves - check cylinder.moving_mass = {cfg.p('cylinder.moving_mass'):g} kg "
+            "and the other scales of the configuration")
     gmin = control.ss(Am, Bm, Cm, [[0.0]], inputs=["u_d"], outputs=["position"])
     T, Lc = close_loop(cfg, gmin)
     Td, Ld = close_loop(cfg, gmin, discrete=True)

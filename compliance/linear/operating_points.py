@@ -134,12 +134,12 @@ def _run_tasks(cfg: PlantConfig, tasks: list, workers: int | None) -> list:
     workers = len(os.sched_getaffinity(0)) if workers is None else workers
     if workers <= 1 or len(tasks) < 4 or "fork" not in mp.get_all_start_methods():
         return [_task(cfg, t) for t in tasks]
-    from concurrent.futures import ProcessPoolExecutor
+    from compliance.processes import worker_pool
 
     out: list = [None] * len(tasks)
     _CTX.update(cfg=cfg, tasks=tasks)
     try:
-        with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("fork")) as pool:
+        with worker_pool(workers) as pool:
             for i, res in pool.map(_work, range(len(tasks))):
                 out[i] = res
     finally:

@@ -182,7 +182,7 @@ def load_plant(source: str | os.PathLike) -> PlantConfig:
         With the file and key path of the first problem found.
     """
     path = resolve_plant_path(source)
-    data, digest = read_toml(path)
+    data, digest = read_toml(path, "plant configuration")
     return plant_from_dict(data, str(path), digest)
 
 
@@ -234,6 +234,11 @@ def _check_physical(cfg: PlantConfig, where: str) -> None:
     for side in ("positive", "negative"):
         if p["valve.saturation_voltage"] <= p[f"valve.dead_zone_{side}"]:
             raise InputError(f"{where}: valve.saturation_voltage must exceed valve.dead_zone_{side}")
+    if p["valve.command_limit"] < p["valve.saturation_voltage"]:
+        raise InputError(
+            f"{where}: valve.command_limit ({p['valve.command_limit']:g} V) is below valve.saturation_voltage "
+            f"({p['valve.saturation_voltage']:g} V): the command could never open the valve fully, so no full-stroke "
+            "speed would be the valve's; raise the limit or lower the saturation voltage")
     if p["friction.static_force"] < p["friction.coulomb_force"]:
         raise InputError(f"{where}: friction.static_force must be >= friction.coulomb_force")
     law = cfg.options["valve.flow_law"]
@@ -320,6 +325,5 @@ def save_plant(cfg: PlantConfig, path: str | os.PathLike, *, overwrite: bool = F
         raise InputError(f"{path}: exists already; choose another name (nothing was overwritten)")
     text = plant_to_toml(cfg)
     plant_from_dict(tomllib.loads(text), str(path))  # prove it round-trips before writing
-    path.parent.mkdir(parents=True, exist_ok=True)
     write_text_atomic(path, text)
     return path

@@ -15,8 +15,46 @@ from typing import Any, Iterable
 from compliance.errors import InputError
 
 
-def read_toml(path: Path) -> tuple[dict[str, Any], str]:
-    """Parse a TOML file.
+# file kind -> how to recognise it from its parsed top level (for "this is a requirement file, not a plant")
+FILE_KINDS = {
+    "requirement file": lambda d: str(d.get("schema", "")).startswith("govcheck-requirements"),
+    "sweep file": lambda d: str(d.get("schema", "")).startswith("govcheck-sweep"),
+    "plant configuration": lambda d: isinstance(d.get("cylinder"), dict) and isinstance(d.get("name"), str),
+    "column map": lambda d: isinstance(d.get("columns"), dict),
+    "recording sidecar": lambda d: isinstance(d.get("conditions"), dict) or (
+        isinstance(d.get("plant"), str) and "cylinder" not in d and "schema" not in d),
+    "validation settings file": lambda d: bool({"replay", "locate", "limits", "windows", "overlays"} & set(d))
+    and not ({"cylinder", "schema", "columns", "conditions"} & set(d)),
+}
+
+
+def file_kind(data: Any) -> str | None:
+    """What kind of govcheck file a parsed TOML mapping looks like (a key of ``FILE_KINDS``), or None."""
+    if not isinstance(data, dict):
+        return None
+    return next((kind for kind, looks in FILE_KINDS.items() if looks(data)), None)
+
+
+def toml_text(raw: bytes, path) -> dict[str, Any]:
+    """Parse TOML bytes as exported by any editor: UTF-8 with or without a byte-order mark (Excel, Notepad).
+
+    Raises
+    ------
+    InputError
+        Bytes that are not UTF-8, or malformed TOML (naming the file).
+    """
+    try:
+        text = raw.decode("utf-8-sig")  # a leading BOM is an encoding mark, not content
+    except UnicodeDecodeError:
+        raise InputError(f"{path}: not a UTF-8 text file") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{path}: malformed TOML ({exc})") from None
+
+
+def read_toml(path: Path, kind: str | None = None) -> tuple[dict[str, Any], str]:
+    """Parse a TOML file (BOM tolerated); with ``kind``, refuse a file that is plainly another kind.
 
     Returns
     -------
@@ -26,19 +64,25 @@ def read_toml(path: Path) -> tuple[dict[str, Any], str]:
     Raises
     ------
     InputError
-        Unreadable file, bytes that are not UTF-8, or malformed TOML (naming the file).
+        Unreadable file, bytes that are not UTF-8, malformed TOML, or a file of another kind
+        (a requirement file given where a plant configuration is expected), naming the file.
     """
     try:
         raw = path.read_bytes()
+    except FileNotFoundError:
+        raise InputError(f"{path}: file not found") from None
     except OSError as exc:
         raise InputError(f"{path}: cannot read ({exc.strerror})") from None
-    try:
-        data = tomllib.loads(raw.decode("utf-8"))
-    except UnicodeDecodeError:
-        raise InputError(f"{path}: not a UTF-8 text file") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{path}: malformed TOML ({exc})") from None
+    data = toml_text(raw, path)
+    check_kind(data, path, kind)
     return data, hashlib.sha256(raw).hexdigest()
+
+
+def check_kind(data: Any, path, kind: str | None) -> None:
+    """Refuse a parsed file that is recognisably another kind than ``kind`` (a key of ``FILE_KINDS``)."""
+    seen = file_kind(data)
+    if kind is not None and seen is not None and seen != kind:
+        raise InputError(f"{path}: this is a {seen}, not a {kind}; check the order and the names of the arguments")
 
 
 def check_table(table: Any, where: str, allowed: Iterable[str], *, word: str = "key", expected: str) -> dict:

@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import itertools
 import math
-import multiprocessing as mp
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -125,9 +124,9 @@ def _map(tasks: list, workers: int) -> list[tuple[float, int, tuple[float, ...]]
     """Score tasks on a forked pool (workers read the configuration from ``_CTX``, nothing large pickled)."""
     if workers <= 1 or len(tasks) < 4:
         return [_point_cost(t) for t in tasks]
-    from concurrent.futures import ProcessPoolExecutor
+    from compliance.processes import worker_pool
 
-    with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("fork")) as pool:
+    with worker_pool(workers) as pool:
         return list(pool.map(_point_cost, tasks, chunksize=max(1, len(tasks) // (4 * workers))))
 
 

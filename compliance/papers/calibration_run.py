@@ -4,9 +4,7 @@ from __future__ import annotations
 
 import resource
 import time
-from pathlib import Path
 
-from compliance.errors import InputError
 from compliance.model.config import PlantConfig
 
 
@@ -16,18 +14,10 @@ SECOND_STAGE_SEEDS = 2  # best effect-search points that seed the second stage
 
 
 def _check_writable(path: str) -> None:
-    """Refuse an output path that cannot be written, before any work starts (a probe file is created and removed)."""
-    import tempfile
+    """Refuse an output path that cannot be written, before any work starts (no folder is created)."""
+    from compliance.files.outputs import check_output
 
-    if Path(path).is_dir():
-        raise InputError(f"{path}: is a folder; give a .toml file name")
-    folder = Path(path).resolve().parent
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-        with tempfile.NamedTemporaryFile(dir=folder, prefix=".govcheck-probe-"):
-            pass
-    except OSError as exc:
-        raise InputError(f"{path}: cannot write there ({exc.strerror or exc})") from None
+    check_output(path, "--calibrate", (".toml",))
 
 
 def _cpu_seconds() -> float:

@@ -163,6 +163,9 @@ def parse_setting(setting: Setting, value, where: str):
             raise InputError(f"{where}: must not be negative")
         if t == "frequency" and a.value == 0:
             raise InputError(f"{where}: a frequency must be positive")
+        if a.value == 0 and setting.default is None:  # the size of the test itself: zero leaves nothing to measure
+            raise InputError(f"{where}: {value!r} is zero: a test of {setting.meaning.split(',')[0]} zero measures nothing; "
+                             "give a positive amount")
         return a
     if t in ("number", "count"):
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:

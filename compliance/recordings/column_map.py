@@ -3,7 +3,8 @@
 A column map is a TOML file (or the equivalent dict) such as::
 
     description = "Zillen friction bench, whitespace separated, no header"
-    delimiter = "whitespace"        # "," (default), ";", "tab", "whitespace"
+    delimiter = "whitespace"        # "auto" (default: sniffed), ",", ";", "tab", "whitespace"
+    decimal = "."                   # "auto" (default: "," when cells read 1,25 in a ; or tab file), ".", ","
     header = false                  # then columns are 0-based indexes
     skip_rows = 0                   # raw lines skipped before the header / data
     drop_first = 15                 # data rows dropped after reading (settling samples)
@@ -30,7 +31,7 @@ selected by name (``"zillen-friction"``).
 
 from __future__ import annotations
 
-import tomllib
+from compliance.model.toml_file import read_toml
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
@@ -66,11 +67,13 @@ CANONICAL_UNITS = MappingProxyType(
     }
 )
 
-_DELIMITERS = {",": ",", ";": ";", "tab": "\t", "\t": "\t", "whitespace": None, " ": None}
+_DELIMITERS = {"auto": "auto", ",": ",", ";": ";", "tab": "\t", "\t": "\t", "whitespace": None, " ": None}
+_DECIMALS = ("auto", ".", ",")
 _TOP_KEYS = (
     "description",
     "format",
     "delimiter",
+    "decimal",
     "header",
     "skip_rows",
     "drop_first",
@@ -108,7 +111,8 @@ class ColumnMap:
 
     source: str
     columns: tuple[ColumnSpec, ...]
-    delimiter: str | None = ","
+    delimiter: str | None = "auto"  # "auto": sniffed from the header line (recordings/delimited.py)
+    decimal: str = "auto"
     header: bool = True
     skip_rows: int = 0
     drop_first: int = 0
@@ -169,10 +173,7 @@ def load_column_map(source) -> ColumnMap:
             f"column map {str(source)!r}: no such file, and not a shipped map "
             f"(shipped: {', '.join(known) or 'none'}){_suggest(source, known)}"
         )
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise InputError(f"{path}: not a valid TOML column map ({exc})") from None
+    data, _ = read_toml(path, "column map")
     return _from_dict(data, str(path))
 
 
@@ -187,11 +188,14 @@ def _from_dict(data: dict, where: str) -> ColumnMap:
     for key in data:
         if key not in _TOP_KEYS:
             raise InputError(f"{where}: unknown key '{key}'{_suggest(key, _TOP_KEYS)} (known: {', '.join(_TOP_KEYS)})")
-    delim_text = data.get("delimiter", ",")
+    delim_text = data.get("delimiter", "auto")
     if delim_text not in _DELIMITERS:
         raise InputError(
-            f"{where}: delimiter {delim_text!r} not known; use one of ',', ';', 'tab', 'whitespace'"
+            f"{where}: delimiter {delim_text!r} not known; use one of 'auto', ',', ';', 'tab', 'whitespace'"
         )
+    decimal = data.get("decimal", "auto")
+    if decimal not in _DECIMALS:
+        raise InputError(f"{where}: decimal {decimal!r} not known; use one of 'auto', '.', ','")
     header = data.get("header", True)
     if not isinstance(header, bool):
         raise InputError(f"{where}: 'header' must be true or false, got {header!r}")
@@ -204,6 +208,9 @@ def _from_dict(data: dict, where: str) -> ColumnMap:
     metadata = data.get("metadata", {})
     if not isinstance(metadata, dict):
         raise InputError(f"{where}: [metadata] must be a table")
+    from compliance.recordings.sidecar_schema import check_sidecar
+
+    check_sidecar(metadata, where, keys="metadata")  # the same keys as a sidecar: they end in the same metadata
     cols = data.get("columns")
     if not isinstance(cols, dict) or not cols:
         raise InputError(f"{where}: needs a [columns] table mapping canonical names to {{column = ..., unit = ...}}")
@@ -215,6 +222,7 @@ def _from_dict(data: dict, where: str) -> ColumnMap:
         source=where,
         columns=tuple(specs),
         delimiter=_DELIMITERS[delim_text],
+        decimal=decimal,
         header=header,
         skip_rows=_int_option(data, "skip_rows", where, 0),
         drop_first=_int_option(data, "drop_first", where, 0),
@@ -266,6 +274,9 @@ def _spec(name: str, entry, where: str, header: bool, time_unit) -> ColumnSpec:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise InputError(f"{where}: '{key}' must be a number, got {value!r}")
         numbers[key] = float(value)
+    if numbers["gain"] == 0.0 or numbers["gain"] != numbers["gain"]:
+        raise InputError(f"{where}: gain = {entry.get('gain')!r} would turn every sample into the offset; "
+                         "expected the non-zero factor from the logger's raw value to the unit (value = gain * raw + offset)")
     index = entry.get("index")
     if index is not None and (isinstance(index, bool) or not isinstance(index, int) or index < 0):
         raise InputError(f"{where}: 'index' must be a 0-based column index of a matrix, got {index!r}")

@@ -8,6 +8,7 @@ then map those columns to canonical names and convert their units, the same for 
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from typing import Callable
 
@@ -87,12 +88,42 @@ def numeric_column(col: pd.Series, where_row: Callable[[int], str]) -> np.ndarra
         A boolean column or a cell that is not a number (an empty cell is NaN, left to the
         finiteness check).
     """
+    if col.dtype.kind == "M" or _looks_like_dates(col):
+        return date_seconds(col, where_row)
     values = pd.to_numeric(col, errors="coerce") if col.dtype.kind not in "fiu" else col
     bad = values.isna() & col.notna()
     if col.dtype.kind == "b" or bad.any():
         i = int(np.argmax(bad.to_numpy())) if bad.any() else 0
         raise InputError(f"{where_row(i)}: {str(col.iloc[i])!r} is not a number")
     return values.to_numpy(dtype=float)
+
+
+_DATE = re.compile(r"^\s*(\d{4}-\d{1,2}-\d{1,2}|\d{1,2}[./]\d{1,2}[./]\d{2,4})[ T]\d{1,2}:\d{2}")
+
+
+def _looks_like_dates(col: pd.Series) -> bool:
+    return col.dtype.kind == "O" and len(col) > 0 and bool(_DATE.match(str(col.iloc[0])))
+
+
+def date_seconds(col: pd.Series, where_row: Callable[[int], str]) -> np.ndarray:
+    """Date-and-time cells (``2024-03-05 14:22:01.125``, ``05.03.2024 14:22:01,125``) as Unix seconds.
+
+    A time zone written in the cell is honoured; cells without one are read as UTC (the
+    recording is made relative to its first sample, so only the start shown in the metadata
+    depends on it). Dotted dates are day first (European).
+    """
+    if col.dtype.kind == "M":
+        stamps = pd.to_datetime(col, utc=True)
+    else:
+        text = col.astype(str).str.strip()
+        dayfirst = bool(re.match(r"^\d{1,2}\.", text.iloc[0]))
+        text = text.str.replace(r"(:\d{2}),(\d)", r"\1.\2", regex=True)  # decimal comma in the seconds
+        stamps = pd.to_datetime(text, errors="coerce", utc=True, format="mixed", dayfirst=dayfirst)
+    bad = stamps.isna() & col.notna()
+    if bad.any():
+        i = int(np.argmax(bad.to_numpy()))
+        raise InputError(f"{where_row(i)}: {str(col.iloc[i])!r} is not a date and time like the first cell's")
+    return stamps.to_numpy(dtype="datetime64[ns]").astype("int64") * 1e-9  # float64: 0.24 us steps near 2024
 
 
 def canonical_specs(path, src: RecordingSource, cmap: ColumnMap | None) -> list[ColumnSpec]:

@@ -1,8 +1,13 @@
 """Delimited text recordings: the canonical CSV (also ``.csv.gz``) and any table a column map describes.
 
 Comment and blank lines are skipped, a header line names the columns (or the map says
-``header = false`` and columns are taken by index), every cell must be a number. Errors name
-the file's own line numbers.
+``header = false`` and columns are taken by index), every cell must be a number (or, in a time
+column, a date and time). Errors name the file's own line numbers.
+
+Files as spreadsheets and loggers export them are read as they are: a UTF-8 byte-order mark
+(Excel's "CSV UTF-8") is dropped; the delimiter is taken from the header line (tab, ';' or ',';
+``.tsv`` is tab) unless a column map names it; a ';' or tab file whose cells read ``1,25`` uses
+the decimal comma (European locales).
 """
 
 from __future__ import annotations
@@ -35,6 +40,28 @@ def _split(line: str, delim: str | None) -> list[str]:
     return line.split() if delim is None else line.split(delim)
 
 
+_DECIMAL_COMMA = re.compile(r"^\s*[-+]?\d+,\d+([eE][-+]?\d+)?\s*$")
+
+
+def sniff_delimiter(first: str, path: Path, given: str | None) -> str | None:
+    """The delimiter a map gave, else the one the first (header) line uses: tab, ';' or ','."""
+    if given != "auto":
+        return given
+    if path.name.lower().removesuffix(".gz").endswith(".tsv") or "\t" in first:
+        return "\t"
+    return ";" if first.count(";") > first.count(",") else ","
+
+
+def sniff_decimal(lines: list[str], delim: str | None, given: str) -> str:
+    """``","`` when a ';' / tab / whitespace file writes its numbers as ``1,25`` (a European logger), else ``"."``."""
+    if given != "auto":
+        return given
+    if delim == ",":
+        return "."
+    cells = [c for line in lines[:20] for c in _split(line, delim)]
+    return "," if any(_DECIMAL_COMMA.match(c) for c in cells) else "."
+
+
 def read_text_table(path: Path, cmap: ColumnMap | None) -> RecordingSource:
     """Read a delimited text recording (see the module docstring) into raw float columns.
 
@@ -46,16 +73,15 @@ def read_text_table(path: Path, cmap: ColumnMap | None) -> RecordingSource:
     """
     try:
         if path.name.lower().endswith(".gz"):
-            with gzip.open(path, "rt", encoding="utf-8") as fh:
+            with gzip.open(path, "rt", encoding="utf-8-sig") as fh:
                 text = fh.read()
         else:
-            text = path.read_text(encoding="utf-8")
+            text = path.read_text(encoding="utf-8-sig")  # a BOM (Excel's "CSV UTF-8") is not a column name
     except (UnicodeDecodeError, OSError, EOFError) as exc:
         what = "gzip-compressed UTF-8 text (the file is cut short or not gzip)" if path.name.lower().endswith(".gz") else "UTF-8 text"
         raise InputError(f"{path}: cannot read as {what} ({exc.__class__.__name__}: {exc})") from None
     comment = cmap.comment if cmap else "#"
     skip = cmap.skip_rows if cmap else 0
-    delim = cmap.delimiter if cmap else ","
     header = cmap.header if cmap else True
     numbers, lines = [], []
     for no, line in enumerate(text.splitlines()[skip:], start=skip + 1):
@@ -65,6 +91,8 @@ def read_text_table(path: Path, cmap: ColumnMap | None) -> RecordingSource:
             lines.append(line)
     if not lines:
         raise InputError(f"{path}: no data (only blank or '{comment}' comment lines)")
+    delim = sniff_delimiter(lines[0], path, cmap.delimiter if cmap else "auto")
+    decimal = sniff_decimal(lines[1:] if header else lines, delim, cmap.decimal if cmap else "auto")
     names = None
     if header:
         names = [h.strip().strip("\"'") for h in _split(lines[0], delim)]
@@ -86,6 +114,7 @@ def read_text_table(path: Path, cmap: ColumnMap | None) -> RecordingSource:
             io.StringIO("\n".join(lines)),
             header=None,
             sep=r"\s+" if delim is None else delim,
+            decimal=decimal,
             skipinitialspace=True,
             engine="c",
         )

@@ -8,10 +8,11 @@ become SI floats, pressures absolute.
 from __future__ import annotations
 
 import re
-import tomllib
+from compliance.model.toml_file import read_toml
 from pathlib import Path
 
 from compliance.errors import InputError
+from compliance.recordings.sidecar_schema import check_sidecar
 from compliance.units import parse_quantity, registry
 
 __all__ = ["read_sidecar", "si_metadata", "sidecar_path"]
@@ -22,8 +23,21 @@ _TEXT_KEYS = ("description", "plant", "name", "notes", "source", "licence", "lic
 
 
 def sidecar_path(path) -> Path:
-    """The sidecar of a recording: ``X.csv`` / ``X.csv.gz`` / ``X.mat`` / ``X.cfg`` -> ``X.toml``."""
+    """The sidecar of a recording: ``X.csv`` / ``X.csv.gz`` / ``X.mat`` / ``X.cfg`` -> ``X.toml``.
+
+    A recording reached through a symbolic link with no sidecar beside the link has the one
+    beside its target (a shared data folder linked into a project).
+    """
     path = Path(path)
+    side = _beside(path)
+    if not side.exists() and path.is_symlink():
+        target = _beside(path.resolve())
+        if target.is_file():
+            return target
+    return side
+
+
+def _beside(path: Path) -> Path:
     name = path.name[:-3] if path.name.lower().endswith(".gz") else path.name
     return path.with_name(Path(name).stem + ".toml")
 
@@ -39,10 +53,8 @@ def read_sidecar(path) -> dict:
     side = sidecar_path(path)
     if not side.is_file():
         return {}
-    try:
-        data = tomllib.loads(side.read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise InputError(f"{side}: sidecar is not valid TOML ({exc})") from None
+    data, _ = read_toml(side, "recording sidecar")
+    check_sidecar(data, str(side))
     return si_metadata(data, str(side))
 
 

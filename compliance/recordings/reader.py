@@ -36,7 +36,7 @@ from compliance.recordings.delimited import TEXT_SUFFIXES, read_text_table
 from compliance.recordings.mat import read_mat
 from compliance.recordings.metadata import read_sidecar, si_metadata, sidecar_path
 from compliance.recordings.parquet import read_parquet
-from compliance.recordings.plausibility import check_ranges, check_time_base
+from compliance.recordings.plausibility import check_ranges, check_time_base, relative_time
 from compliance.metrics.trace_windows import true_runs
 
 __all__ = ["DEFAULT_REQUIRED", "read_recording", "si_metadata", "sidecar_path"]
@@ -93,8 +93,9 @@ def read_recording(path, column_map=None, *, required=DEFAULT_REQUIRED):
     row = (lambda i, _r=src.row, _d=drop: _r(i + _d))
     _check_finite(path, frame, row)
     _check_time(path, frame["time"].to_numpy(), row)
+    frame["time"], time_start = relative_time(path, frame["time"].to_numpy())
     check_ranges(path, frame, row)  # every sample, not only the first
-    meta = {}
+    meta = {"time_start": time_start} if time_start else {}
     if cmap is not None and cmap.metadata:
         meta.update(si_metadata(cmap.metadata, f"{cmap.source}: metadata"))
     meta.update(read_sidecar(path))

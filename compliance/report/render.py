@@ -88,12 +88,12 @@ def draw_figures(specs: list[dict], valve: dict | None = None, workers: int | No
         for s in specs:
             out[s["id"]] = _draw(s, valve)
         return out
-    from concurrent.futures import ProcessPoolExecutor
+    from compliance.processes import worker_pool
 
     _FIG_CTX.update(specs=specs, valve=valve)
     try:
         chunks = [list(range(w, n, workers)) for w in range(workers)]  # interleaved: similar costs per worker
-        with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("fork")) as pool:
+        with worker_pool(workers) as pool:
             for part in pool.map(_draw_chunk, chunks):
                 for i, svg in part:
                     out[specs[i]["id"]] = svg

@@ -85,7 +85,7 @@ def _load_chain(path: Path, seen: tuple[str, ...]) -> list[tuple[Path, str, dict
     key = str(path.resolve())
     if key in seen:
         raise InputError(f"{path}: extends itself through {' -> '.join(seen)}")
-    data, digest = read_toml(path)
+    data, digest = read_toml(path, "requirement file")
     model = validate_file(data, path)
     chain: list[tuple[Path, str, dict]] = []
     bases = model.extends if isinstance(model.extends, list) else ([model.extends] if model.extends else [])

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import time
 
+from compliance.processes import raise_if_stopping
 from compliance.campaign.results_files import write_json
 from compliance.files.atomic import write_json_atomic, write_text_atomic
 from compliance.sweep.evaluate import make_context
@@ -76,8 +77,7 @@ def run_sweep(spec, out_dir, *, scheduler=None, workers=None, progress=True, cli
     from pathlib import Path
 
     t0 = time.perf_counter()
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    out = Path(out_dir)  # created only when every result is in hand: a failed or interrupted sweep leaves no folder
     cfg, reqset = load_inputs(spec)
     ctx = make_context(cfg, reqset, spec.paths, spec.linear)
     base = nominal_values(cfg, spec.paths)
@@ -95,20 +95,23 @@ def run_sweep(spec, out_dir, *, scheduler=None, workers=None, progress=True, cli
                                    run_kw=run_kw)
     ids = [r.id for r in ctx.reqset.requirements]
     df = table(cands, rows, ids, spec.adjust, base)
-    files = write_table(df, out)
     best = best_index(df)
-    best_info = None
+    best_info, res = None, None
     if best is not None:
         values = cands[best]
         res = verify_settings(cfg, reqset, spec.paths, values, command_line=command_line, workers=workers)
         res["sweep"] = {"name": spec.name, "file": spec.path, "candidate": best, "values": values}
         if remedies is not None:
             res["remedies"] = remedies
-        write_json(res, out / "best-results.json")
         best_info = {"candidate": best, "values": values, "status": df.loc[best, "status"],
                      "shortfall": float(df.loc[best, "shortfall"]), "change": float(df.loc[best, "change"]),
                      "verified_status": res["summary"]["status"],
                      "failed_mandatory": res["summary"]["failed_mandatory"], "results_file": str(out / "best-results.json")}
+    raise_if_stopping()
+    out.mkdir(parents=True, exist_ok=True)
+    files = write_table(df, out)
+    if res is not None:
+        write_json(res, out / "best-results.json")
     counts = df["status"].value_counts().to_dict()
     summary = {
         "schema": SUMMARY_SCHEMA, "name": spec.name, "title": spec.title, "sweep_file": spec.path,
@@ -137,8 +140,7 @@ def run_yield_file(spec, out_dir, candidate: dict, label: str, *, scheduler=None
 
     if not spec.uncertain:
         raise InputError(f"{spec.path}: uncertain: no uncertain parameter declared; a yield run needs at least one")
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    out = Path(out_dir)  # created at the end, with every result in hand
     cfg, reqset = load_inputs(spec)
     ctx = make_context(cfg, reqset, spec.paths, spec.linear)
     from compliance.campaign.executor import dask_session
@@ -149,8 +151,10 @@ def run_yield_file(spec, out_dir, candidate: dict, label: str, *, scheduler=None
                                           seed=spec.yield_seed, confidence=spec.confidence, run_kw=run_kw)
     y.update(name=spec.name, label=label, executor=stats.as_dict() if stats else None)
     df = table(draws, rows, [r.id for r in ctx.reqset.requirements])
-    buf_files = write_table(df, out)
     res = verify_settings(cfg, reqset, spec.paths, candidate, workers=workers)
+    raise_if_stopping()
+    out.mkdir(parents=True, exist_ok=True)
+    buf_files = write_table(df, out)
     res["tolerance_yield"] = y
     y["files"] = {"units": buf_files, "results": str(out / "results.json")}
     write_json(res, out / "results.json")  # the nominal candidate's campaign with the yield: govcheck report renders it

@@ -10,14 +10,14 @@ field (exit 2) before any simulation. The format is documented in docs/scaling.m
 from __future__ import annotations
 
 import math
-import tomllib
+from compliance.model.toml_file import read_toml
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal, Union
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
-from compliance.errors import InputError
+from compliance.errors import InputError, did_you_mean
 from compliance.sweep.parameter_paths import ParamPath, describe
 from compliance.units import parse_quantity
 
@@ -125,6 +125,18 @@ class SweepSpec:
         return out
 
 
+def _keys_at(model, loc) -> list[str]:
+    """The keys a table at ``loc`` of the sweep file may hold (by their TOML spelling)."""
+    for part in loc:
+        fields = {(f.alias or n): f for n, f in model.model_fields.items()}
+        if part not in fields:
+            continue  # a free key of a dict table (a parameter path) or a union tag
+        ann = fields[part].annotation
+        args = [a for a in getattr(ann, "__args__", ()) if isinstance(a, type) and issubclass(a, BaseModel)]
+        model = ann if isinstance(ann, type) and issubclass(ann, BaseModel) else (args[0] if args else model)
+    return [(f.alias or n) for n, f in model.model_fields.items()]
+
+
 def _where_of(path: Path, loc) -> str:
     parts = [f'"{p}"' if isinstance(p, str) and "." in p else str(p) for p in loc if p not in ("str", "float", "int")]
     return f"{path}: {'.'.join(parts)}"
@@ -193,16 +205,18 @@ def load_sweep(source) -> SweepSpec:
         tolerance: one message naming the file and the field.
     """
     path = Path(source)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise InputError(f"{path}: sweep file not found") from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise InputError(f"{path}: not valid TOML ({exc})") from None
+    if not path.is_file():
+        raise InputError(f"{path}: sweep file not found")
+    data, _ = read_toml(path, "sweep file")
     try:
         raw = _SweepIn.model_validate(data)
     except ValidationError as exc:
-        err = exc.errors()[0]
+        errors = exc.errors()  # a misspelt key also leaves its right spelling missing: name the misspelling
+        err = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])
+        if err["type"] == "extra_forbidden":
+            key = str(err["loc"][-1])
+            raise InputError(f"{_where_of(path, err['loc'])}: unknown key '{key}'"
+                             f"{did_you_mean(key, _keys_at(_SweepIn, err['loc'][:-1]))}") from None
         raise InputError(f"{_where_of(path, err['loc'])}: {err['msg']}") from None
     if not raw.adjust:
         raise InputError(f"{path}: adjust: no adjustable parameter; name at least one")

@@ -7,12 +7,11 @@ its table, ``settings_from_dict`` checks a table and freezes it as :class:`Valid
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from compliance.errors import InputError, did_you_mean
-from compliance.model.toml_file import check_table
+from compliance.model.toml_file import check_table, read_toml
 from compliance.units import parse_quantity
 from compliance.validation.fit_metrics import (
     DEFAULT_LIMITS,
@@ -191,10 +190,7 @@ def read_settings_table(path) -> dict:
     p = Path(path)
     if not p.is_file():
         raise InputError(f"{p}: settings file not found")
-    try:
-        return tomllib.loads(p.read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise InputError(f"{p}: not valid TOML ({exc})") from None
+    return read_toml(p, "validation settings file")[0]
 
 
 def apply_overrides(table: dict, items, where: str = "--setting") -> dict:

@@ -305,7 +305,8 @@ case("char-valve-not-charging", "characterise valve rec.csv --volume 1L --supply
 case("char-friction-negative-window", "characterise friction rec.csv --window=-1s --area=1e-3m^2", "--window")
 case("char-friction-no-force", ["characterise", "friction", "rec.csv", "--area", "1000 mm^2"], "force")
 case("diag-unknown-effect", "diagnose plant.toml rec.csv --effects warp_drive -q", "warp_drive")
-case("diag-save-model-exists", "diagnose plant.toml rec.csv --save-model plant.toml", "exists already")
+case("diag-save-model-exists", "diagnose plant.toml rec.csv --save-model rec.toml", "exists already")
+case("diag-save-model-is-the-plant", "diagnose plant.toml rec.csv --save-model plant.toml", "is an input of this run ([CONFIG] RECORDING)")
 case("diag-jobs-zero", "diagnose plant.toml rec.csv -j 0", "--jobs")
 case("diag-joint-report", "diagnose plant.toml rec.csv rec.csv --report out/j.html", "not available for a joint")
 case("diag-joint-scheduler", "diagnose plant.toml rec.csv rec.csv --scheduler ftp://x", "scheduler")
@@ -413,3 +414,92 @@ case("check-remedies-bad-catalogue", "check plant.toml -r req.toml --remedies --
      {"cat.toml": 'schema = "govcheck-hardware/1"\n[options.x]\ngroup = "gearbox"\ntitle = "t"\ncost = 1\n'
                   'sets = { "cylinder.stroke" = "1 m" }\n'})
 case("check-remedies-negative-yield", ["check", "plant.toml", "-r", "req.toml", "--remedies", "--yield-units", "-1"], "--yield-units")
+
+# ------------------------------------------------------------------------------------- issue 28: inputs as people have them
+BOM = "\ufeff"
+VALS = "validate plant.toml s.csv --json out/v.json"
+
+
+def side(old, new):
+    """The good sidecar with one text changed."""
+    assert old in W.SIDECAR, old
+    return W.SIDECAR.replace(old, new, 1)
+
+
+def epoch_ms_csv() -> str:
+    lines = W.csv_text().splitlines()
+    return "\n".join([lines[0]] + [f"{1709648521000 + i}," + line.split(",", 1)[1] for i, line in enumerate(lines[1:])]) + "\n"
+
+
+def gap(a):
+    return np.concatenate([a[:100], a[150:] + 0.0])
+
+
+for cid, csv, sidecar, frag in [
+    # a wrong cause was named: the likely slip is named instead
+    ("side-unknown-key-did-you-mean", W.csv_text(), side("load_force", "load_forse"), "did you mean 'load_force'"),
+    ("side-unknown-table", W.csv_text(), W.SIDECAR + "[conditons]\nx = 1\n", "did you mean 'conditions'"),
+    ("side-load-in-tonnes", W.csv_text(), side("7000.0", '"0.7 t"'), "is a mass"),
+    ("side-load-omitted", W.csv_text(), side("load_force = 7000.0\n", ""), "load is not given"),
+    ("csv-pressure-in-bar", W.csv_text(cols(pressure_a=lambda a: a / 1e5, pressure_b=lambda a: a / 1e5)), W.SIDECAR,
+     "pressure_a' median 5.9 Pa abs - looks like bar without a unit"),
+    ("csv-pressure-in-kpa", W.csv_text(cols(supply_pressure=lambda a: a / 1e3)), W.SIDECAR, "looks like kPa without a unit"),
+    ("side-sample-time-in-hz", W.csv_text(), side("sample_time = 0.001", "sample_time = 1000.0"), "looks like a rate in Hz"),
+    ("csv-position-in-mm", W.csv_text(cols(position=lambda a: a * 1e3, reference=lambda a: a * 1e3)), W.SIDECAR, "millimetres"),
+    ("side-is-a-plant", W.csv_text(), W.PLANT_A, "this is a plant configuration, not a recording sidecar"),
+    ("side-bom-and-unknown-key", W.csv_text(), BOM + side("load_force", "lod_force"), "did you mean 'load_force'"),
+    # silently accepted before
+    ("csv-time-gap", W.csv_text(cols(**{k: gap for k in W.recording_columns()})), W.SIDECAR, "samples are missing"),
+    ("side-kp-in-v-per-mm", W.csv_text(), side("kp = 280.0", "kp = 0.28"), "V/mm written as V/m"),
+    ("side-start-contradicts-recording", W.csv_text(), side("initial_position = 0.08", "initial_position = 0.12"),
+     "contradicts the recording"),
+    ("side-supply-bar-without-unit", W.csv_text(), side("supply_pressure = 800000.0", "supply_pressure = 8.0"),
+     "looks like bar without a unit"),
+    ("csv-epoch-milliseconds", epoch_ms_csv(), W.SIDECAR,
+     "Unix time in milliseconds"),
+]:
+    case(cid, VALS, frag, {"s.csv": csv, "s.toml": sidecar})
+case("map-zero-gain", MAPPED.replace("map.toml", "badmap.toml"), "gain = 0",
+     {"bad.txt": mapped_ok, "badmap.toml": W.COLUMN_MAP.replace('unit = "mm" }', 'unit = "mm", gain = 0 }')})
+case("map-is-a-sidecar", MAPPED.replace("map.toml", "rec.toml"), "this is a recording sidecar, not a column map", {"bad.txt": mapped_ok})
+case("map-unknown-metadata-key", MAPPED.replace("map.toml", "badmap.toml"), "did you mean 'bore'",
+     {"bad.txt": mapped_ok, "badmap.toml": W.COLUMN_MAP + '[metadata]\nbor = "25.7 mm"\n'})
+# each file kind recognises the others
+case("config-is-a-requirement-file", "check req.toml -r req.toml -q", "this is a requirement file, not a plant configuration")
+case("req-is-a-plant", "check plant.toml -r plant.toml -q", "this is a plant configuration, not a requirement file")
+case("settings-is-a-requirement-file", "validate plant.toml rec.csv --settings req.toml",
+     "this is a requirement file, not a validation settings file")
+case("sweep-is-a-requirement-file", "sweep req.toml --out new-out", "this is a requirement file, not a sweep file")
+case("sweep-base-is-a-requirement-file", "sweep bad-sweep.toml --out new-out", "this is a requirement file, not a plant",
+     {"bad-sweep.toml": sweep('base = "plant.toml"', 'base = "req.toml"')})
+case("sweep-unknown-key-did-you-mean", "sweep bad-sweep.toml --out new-out", "did you mean 'method'",
+     {"bad-sweep.toml": sweep('method = "grid"', 'methd = "grid"')})
+case("sweep-yield-best-before-sweep", "sweep bad-sweep.toml --out new-out --yield best", "no sweep results",
+     {"bad-sweep.toml": SWEEP + '[uncertain."controller.kp"]\ndistribution = "normal"\nstd = "1 %"\n'})
+case("config-bom-and-unknown-key", "check bad.toml -r req.toml -q", "moving_mas",
+     {"bad.toml": BOM + plant('moving_mass =', 'moving_mas = { value = "1 kg", source = "paper" }\nmoving_mass =')})
+case("config-command-limit-below-saturation", "check bad.toml -r req.toml -q", "command_limit",
+     {"bad.toml": plant('command_limit = { value = "10 V"', 'command_limit = { value = "3 V"')})
+case("sim-sine-beyond-stroke", f"{SIM} --sine 100mm,1Hz", "outside the stroke")
+case("sim-sine-above-nyquist", f"{SIM} --sine 1mm,600Hz", "Nyquist")
+case("req-step-size-zero", CHECKR, "zero", {"bad-req.toml": req('size = "5 %stroke"', 'size = "0 %stroke"')})
+case("req-load-beyond-cylinder", CHECKR, "more than twice", {"bad-req.toml": req('load = "none"', 'load = "1 MN"')})
+case("gate-allow-unknown-id", "gate plant.toml --baseline plant.toml -r req.toml --allow-not-evaluated TCC -q",
+     "did you mean 'TC'")
+case("diag-effects-empty", ["diagnose", "plant.toml", "rec.csv", "--effects", ""], "--effects ''")
+# an output that is one of the inputs, or of the wrong kind
+case("out-reproduce-calibrate-is-the-plant", "reproduce plant.toml --calibrate plant.toml", "is an input of this run")
+case("out-reproduce-calibrate-json", "reproduce plant.toml --calibrate out/cal.json", ".toml")
+case("out-gate-json-is-baseline", "gate plant.toml --baseline out/good.json --json out/good.json", "is an input of this run")
+case("out-validate-json-is-recording-map", "validate plant.toml rec.csv --column-map map.toml --json map.toml", ".json")
+# internal errors before
+case("linear-tiny-moving-mass", "linear bad.toml", "no mode from the valve command",
+     {"bad.toml": plant('"30 kg"', '"1e-9 kg"')})
+case("check-epoch-year-10000", "check plant.toml -r req.toml --json out/r.json -q", "9999-12-31",
+     env={"SOURCE_DATE_EPOCH": "253402300800"})
+case("sweep-scheduler-no-port", ["sweep", "bad-sweep.toml", "--scheduler", "127.0.0.1", "--out", "new-out"], "--scheduler",
+     {"bad-sweep.toml": SWEEP})
+case("report-text-where-value-belongs", "report bad.json --report out/r.html", "where a number",
+     {"bad.json": lambda ws: W.damaged_results(ws / "bad.json")})
+case("bench-seed-negative", "diagnose-benchmark --seed -1 --cases 1", "--seed")
+case("bare-govcheck-no-command", [], "no COMMAND given")

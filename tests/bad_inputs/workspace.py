@@ -138,6 +138,15 @@ def build(ws: Path) -> None:
     ro.chmod(0o444)
 
 
+def damaged_results(path: Path) -> None:
+    """The shipped results fixture with text where the first requirement's worst value belongs (a hand edit)."""
+    import json
+
+    data = json.loads((REPO / "tests" / "data" / "results_fixture.json").read_text(encoding="utf-8"))
+    data["requirements"][0]["worst"]["value"] = "lots"
+    path.write_text(json.dumps(data), encoding="utf-8")
+
+
 def gz(text: str) -> bytes:
     """Gzip bytes of ``text`` (fixed mtime)."""
     return gzip.compress(text.encode("utf-8"), mtime=0)

@@ -91,4 +91,4 @@ def test_unwritable_output_is_refused_before_any_work(capsys):
     from compliance.cli import main
 
     assert main(["reproduce", "plant-a", "--calibrate", "/proc/no-such-folder/plant.toml"]) == 2
-    assert "cannot write" in capsys.readouterr().err
+    assert "does not exist (govcheck does not create folders)" in capsys.readouterr().err
