@@ -65,6 +65,22 @@ def _by_construction(closest: dict) -> str:
             "model the missing effect or measure them.")
 
 
+def _step_size(reqset, proc: str, stroke: float) -> float | None:
+    """Step size [m] of a steps procedure, None for any other."""
+    p = reqset.procedures.get(proc)
+    return p.settings["size"].resolve(stroke) if p is not None and p.kind == "steps" else None
+
+
+def _limited_steps(rid, where, cfg, req, h, stroke) -> str:
+    """A time constant held back by the set-point rate limiter: the gate follows the ramp at best."""
+    rate = min(cfg.params["controller.setpoint_opening_rate"], cfg.params["controller.setpoint_closing_rate"])
+    tau_max = req.resolved_limit(stroke)[-1]
+    return (f"{rid} binds ({where}): the set-point rate limiter ramps this {h*1e3:.1f} mm step at "
+            f"{rate*1e3:.1f} mm/s, so the gate reaches 63.2 % of it no sooner than 0.632 x {h*1e3:.1f} mm / "
+            f"{rate*1e3:.1f} mm/s = {0.632*h/rate:.3f} s (window <= {tau_max:.3g} s): the limiter that holds the strokes to "
+            "their rate slows the steps as much (pid_controller, set-point rate limiter).")
+
+
 def explain(rid: str | None, where: str | None, cfg, reqset, tried_limiter: bool) -> str:
     """One paragraph: why requirement ``rid`` (judged at run ``where``) binds, with the numbers."""
     if rid is None:
@@ -86,6 +102,8 @@ def explain(rid: str | None, where: str | None, cfg, reqset, tried_limiter: bool
                     f"atmosphere; the gate is held until their forces cross and then breaks away with the stored pressure "
                     f"difference - the end-stop surge. Throttles and gains act after it.{lim} The hardware that acts on it "
                     "(an exhaust back-pressure valve, cushioned cylinders) is not modelled (catalogue: not_modelled).")
+    if req.metric == "time_constant" and cfg.setpoint_rate_limited and _step_size(reqset, proc, L):
+        return _limited_steps(rid, where, cfg, req, _step_size(reqset, proc, L), L)
     if req.metric in ("opening_time", "closing_time", "time_constant"):
         v_c = choked_speed(cfg)
         need = L / req.resolved_limit(L)[-1] if req.metric != "time_constant" else None

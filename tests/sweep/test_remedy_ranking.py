@@ -102,3 +102,14 @@ def test_explanation_names_a_pass_by_construction():
                "binding_where": "independent-adjustment@governor-setup"}
     text = explain_closest(closest, load_plant("plant-a"), load_requirements("shpp-400kw"), True)
     assert "IEC61362-INDEP pass only by construction" in text
+
+def test_a_rate_limited_time_constant_is_explained_by_the_ramp():
+    """With the set-point limiter at 31.2 mm/s a 16 mm step reaches 63.2 % no sooner than 0.632 x 16 / 31.2 = 0.324 s."""
+    from compliance.model.config import load_plant
+    from compliance.requirements.loading import load_requirements
+    from compliance.sweep.binding_physics import explain
+
+    cfg = load_plant("plant-a").replace(params={"controller.setpoint_opening_rate": 0.0312,
+                                                "controller.setpoint_closing_rate": 0.0315})
+    text = explain("IEC61362-TC", "steps-10-down@tc-mid", cfg, load_requirements("shpp-400kw"), True)
+    assert "0.324 s" in text and "31.2 mm/s" in text
