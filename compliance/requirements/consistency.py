@@ -11,7 +11,13 @@ Two pairs are checked, with the arithmetic in the finding:
 - a full-stroke time window and a speed limit on the same full-stroke procedure: the straight part
   of a stroke of time T moves at L / T (25-75 % rule), and the peak speed is at least that, so a
   stroke time below L / v fails the speed limit. A window wholly below L / v is a ``conflict``; a
-  window whose lower edge is below it is narrowed to [L / v, high] (``narrowing``).
+  window whose lower edge is below it is narrowed to [L / v, high] (``narrowing``);
+- a time-constant window on steps and a rate limit judged on full strokes only (a different
+  procedure): when 0.632 h / tau_max exceeds the rate limit, the servo must move faster on those
+  steps than the strokes may, so both pass only when the device that limits the stroke rate does
+  not act on the steps (flow-control valves out where tau is measured, as a hydraulic servomotor's
+  rate limits are kept apart from its time constant in IEEE Std 1207-2011); a set-point rate
+  limiter at or below the stroke limit acts on every step and fails the window (``rate_split``).
 
 A conflict between two mandatory requirements stops ``govcheck check`` with exit code 2 (the
 requirement set is invalid input) unless ``--allow-conflicts`` is given; every finding is reported in
@@ -24,9 +30,9 @@ import math
 
 from compliance.errors import InputError
 
-__all__ = ["CONFLICT", "NARROWING", "TENSION", "check_consistency", "consistency_findings"]
+__all__ = ["CONFLICT", "NARROWING", "RATE_SPLIT", "TENSION", "check_consistency", "consistency_findings"]
 
-CONFLICT, TENSION, NARROWING = "conflict", "tension", "narrowing"
+CONFLICT, TENSION, NARROWING, RATE_SPLIT = "conflict", "tension", "narrowing", "rate_split"
 _TAU_FRACTION = 1.0 - math.exp(-1.0)  # 63.2 %, as metrics.step.TAU_FRACTION
 _SPEEDS = {"max_speed": None, "max_opening_speed": "opening", "max_closing_speed": "closing", "stroke_speed": None}
 _STROKE_TIMES = {"opening_time": "opening", "closing_time": "closing"}
@@ -48,9 +54,9 @@ def _lower(req, stroke):
     return lim[0] if req.comparator in (">=", ">", "within") else None
 
 
-def _finding(kind, a, b, procedure, text) -> dict:
+def _finding(kind, a, b, procedure, text, **figures) -> dict:
     return {"kind": kind, "requirements": [a.id, b.id], "procedure": procedure, "text": text,
-            "mandatory": a.severity == "mandatory" and b.severity == "mandatory"}
+            "mandatory": a.severity == "mandatory" and b.severity == "mandatory", **figures}
 
 
 def _tau_vs_speed(reqset, stroke, tau_req, v_req) -> list[dict]:
@@ -66,13 +72,14 @@ def _tau_vs_speed(reqset, stroke, tau_req, v_req) -> list[dict]:
         mean, first = _TAU_FRACTION * h / tau_max, h / tau_max
         head = (f"{tau_req.id} (time constant <= {tau_max:.3g} s) and {v_req.id} ({v_req.metric} <= {v * 1e3:.1f} mm/s) "
                 f"on {p} (steps of {h * 1e3:.2f} mm): ")
+        fig = {"step": h, "tau_max": tau_max, "v_max": v, "mean_speed": mean, "first_order_peak": first}
         if mean > v:
-            out.append(_finding(CONFLICT, tau_req, v_req, p, head + (
+            out.append(_finding(CONFLICT, tau_req, v_req, p, **fig, text=head + (
                 f"reaching 63.2 % of {h * 1e3:.2f} mm within {tau_max:.3g} s needs a mean speed of 0.632 x {h * 1e3:.2f} mm / "
                 f"{tau_max:.3g} s = {mean * 1e3:.1f} mm/s > {v * 1e3:.1f} mm/s, and the peak speed is at least the mean: "
                 "no servo can pass both")))
         elif first >= v:
-            out.append(_finding(TENSION, tau_req, v_req, p, head + (
+            out.append(_finding(TENSION, tau_req, v_req, p, **fig, text=head + (
                 f"a first-order answer meeting the window starts at h / tau >= {h * 1e3:.2f} mm / {tau_max:.3g} s = "
                 f"{first * 1e3:.1f} mm/s >= {v * 1e3:.1f} mm/s: only a servo rate limited on this step can pass both, "
                 "and its time constant is then a rate-limit figure")))
@@ -101,6 +108,42 @@ def _time_vs_speed(reqset, stroke, t_req, v_req) -> list[dict]:
     return out
 
 
+def _circuit(reqset, points) -> set:
+    """The flow-control settings (True installed, False out, None as configured) of the named operating points."""
+    return {reqset.operating_points[o].flow_control for o in points}
+
+
+def _tau_vs_rate_limit(reqset, stroke, tau_req, v_req) -> list[dict]:
+    """A time-constant window on steps against a rate limit judged on full strokes only (``rate_split``)."""
+    tau_max, v = _upper(tau_req, stroke), _upper(v_req, stroke)
+    if tau_max is None or v is None or v <= 0 or tau_req.source != "simulation":
+        return []
+    if not any(reqset.procedures[p].kind == "full_stroke" for p in v_req.procedures):
+        return []
+    valves_out = _circuit(reqset, tau_req.operating_points) == {False} and False not in _circuit(reqset, v_req.operating_points)
+    out = []
+    for p in sorted(set(tau_req.procedures) - set(v_req.procedures)):
+        proc = reqset.procedures[p]
+        if proc.kind != "steps":
+            continue
+        h = proc.settings["size"].resolve(stroke)
+        mean = _TAU_FRACTION * h / tau_max
+        if mean <= v:
+            continue
+        circuit = ("the file measures tau with the flow-control valves out and the strokes with them in, so the valves "
+                   "may set the stroke rate" if valves_out else
+                   "tau and the strokes are judged on the same circuit, so the device that limits the stroke rate must not act on these steps")
+        out.append(_finding(RATE_SPLIT, tau_req, v_req, p, step=h, tau_max=tau_max, v_max=v, mean_speed=mean,
+                            ramp_tau_min=_TAU_FRACTION * h / v, text=(
+            f"{tau_req.id} (time constant <= {tau_max:.3g} s on {p}, steps of {h * 1e3:.2f} mm) and {v_req.id} "
+            f"({v_req.metric} <= {v * 1e3:.1f} mm/s on full strokes): reaching 63.2 % of the step within {tau_max:.3g} s needs "
+            f"a mean speed of 0.632 x {h * 1e3:.2f} mm / {tau_max:.3g} s = {mean * 1e3:.1f} mm/s > {v * 1e3:.1f} mm/s, so the "
+            f"servo must move faster on these steps than the strokes may: {circuit}. A set-point rate limiter at or below "
+            f"{v * 1e3:.1f} mm/s acts on every step and gives tau >= 0.632 x {h * 1e3:.2f} mm / {v * 1e3:.1f} mm/s = "
+            f"{_TAU_FRACTION * h / v:.3f} s > {tau_max:.3g} s")))
+    return out
+
+
 def consistency_findings(reqset, stroke: float) -> list[dict]:
     """Every pair of limits in ``reqset`` that cannot hold together or narrow each other.
 
@@ -113,7 +156,8 @@ def consistency_findings(reqset, stroke: float) -> list[dict]:
     Returns
     -------
     list of dict
-        ``{"kind": conflict|tension|narrowing, "requirements": [id, id], "procedure", "text", "mandatory"}``.
+        ``{"kind": conflict|tension|narrowing|rate_split, "requirements": [id, id], "procedure", "text", "mandatory"}``,
+        with the figures of the arithmetic [SI] on the step findings (``step``, ``tau_max``, ``v_max``, ``mean_speed``).
     """
     reqs = [r for r in reqset.requirements if r.enabled and r.limit is not None]
     out = []
@@ -122,7 +166,7 @@ def consistency_findings(reqset, stroke: float) -> list[dict]:
             if b.metric not in _SPEEDS:
                 continue
             if a.metric == "time_constant":
-                out += _tau_vs_speed(reqset, stroke, a, b)
+                out += _tau_vs_speed(reqset, stroke, a, b) + _tau_vs_rate_limit(reqset, stroke, a, b)
             elif a.metric in _STROKE_TIMES:
                 out += _time_vs_speed(reqset, stroke, a, b)
     return out

@@ -3,10 +3,9 @@
 The closest candidate's binding requirement is explained by the physics its metric answers to,
 with the numbers of the configuration and the requirement file:
 
-- a time-constant window and a peak-speed limit on the same step size: a first-order answer
-  x(t) = s (1 - exp(-t/tau)) starts at s/tau, so tau <= tau_max means a peak speed >= s/tau_max;
-  a rate-limited answer reaches 63.2 % of s no sooner than 0.632 s / v_max (requirement-set
-  arithmetic, not a property of the plant);
+- limits of the requirement set that work against each other (a time-constant window against a
+  speed limit on the same steps, or against the stroke rate limit on full strokes): the findings of
+  ``requirements.consistency``, the one place that arithmetic lives, not a property of the plant;
 - the opening/closing time or time constant against the valve's choked flow: the fastest the
   valve can fill a chamber at supply pressure, v = C p_s rho_0 sqrt(T_0/T_s) R T_s / (p_s A)
   = C rho_0 R sqrt(T_0 T_s) / A (seed 000 eq. 1 with w = 1, isothermal chamber at supply pressure);
@@ -17,7 +16,9 @@ with the numbers of the configuration and the requirement file:
 
 from __future__ import annotations
 
-__all__ = ["choked_speed", "conflict_text", "explain", "explain_closest", "step_conflict"]
+from compliance.requirements.consistency import CONFLICT, RATE_SPLIT, TENSION, consistency_findings
+
+__all__ = ["choked_speed", "explain", "explain_closest", "set_findings"]
 
 SPEED_METRICS = ("max_speed", "max_opening_speed", "max_closing_speed")
 
@@ -32,50 +33,52 @@ def choked_speed(cfg, conductance: float | None = None) -> float:
     return q * p["air.gas_constant"] * p["air.supply_temperature"] / (p["air.supply_pressure"] * area)
 
 
-def step_conflict(reqset, stroke: float) -> list[dict]:
-    """Step procedures judged both by a time-constant window and by a peak-speed limit, with the arithmetic."""
-    out = []
-    for tc in (r for r in reqset.requirements if r.metric == "time_constant" and r.enabled and r.limit and r.source != "linear"):
-        tau_max = tc.resolved_limit(stroke)[-1]
-        for sp in (r for r in reqset.requirements if r.metric in SPEED_METRICS and r.enabled and r.limit):
-            v_max = sp.resolved_limit(stroke)[-1]
-            for proc in sorted(set(tc.procedures) & set(sp.procedures)):
-                size = reqset.procedures[proc].settings.get("size")
-                if size is None:
-                    continue
-                s = size.resolve(stroke)
-                out.append({"time_constant": tc.id, "speed": sp.id, "procedure": proc, "step": s, "tau_max": tau_max,
-                            "same_points": sorted(set(tc.operating_points) & set(sp.operating_points)),
-                            "v_max": v_max, "first_order_peak": s / tau_max, "ramp_tau_min": 0.632 * s / v_max,
-                            "first_order_conflict": s / tau_max >= v_max, "any_servo_conflict": 0.632 * s / v_max > tau_max})
-    return out
-
-
-def conflict_text(c: dict) -> str:
-    """The arithmetic of a time-constant window that no rate-limited servo can meet under a speed limit."""
-    where = ("at the same operating points" if c["same_points"] else
-             "judged at different operating points, so only a servo at least "
-             f"{c['ramp_tau_min'] / c['tau_max']:.1f} times faster there than where the speed is judged escapes it")
-    return (f"on {c['procedure']} ({c['step']*1e3:.1f} mm steps) {c['time_constant']} asks "
-            f"tau <= {c['tau_max']:.3f} s and {c['speed']} a peak speed <= {c['v_max']*1e3:.1f} mm/s; moving no faster than that, "
-            f"the gate reaches 63.2 % of the step after {c['ramp_tau_min']:.3f} s at the earliest "
-            f"(0.632 x {c['step']*1e3:.1f} mm / {c['v_max']*1e3:.1f} mm/s), and a first-order answer within the window "
-            f"starts at >= {c['first_order_peak']*1e3:.1f} mm/s ({where}).")
+def set_findings(reqset, stroke: float, rids) -> list[dict]:
+    """Findings of the requirement set's consistency check (``requirements.consistency``) that involve ``rids``,
+    the limits no servo can meet together first, then those that only a split of the rate limiting can meet."""
+    order = {CONFLICT: 0, RATE_SPLIT: 1, TENSION: 2}
+    found = [f for f in consistency_findings(reqset, stroke) if f["kind"] in order and set(f["requirements"]) & set(rids)]
+    return sorted(found, key=lambda f: (order[f["kind"]], not f["mandatory"]))
 
 
 def explain_closest(closest: dict, cfg, reqset, tried_limiter: bool) -> str:
-    """Why the closest candidate fails: a conflict of the requirement set it fails first, else its binding physics."""
-    failing = set(closest.get("failed_mandatory") or ())
-    L = cfg.params["cylinder.stroke"]
-    hard = [c for c in step_conflict(reqset, L) if c["any_servo_conflict"] and {c["time_constant"], c["speed"]} & failing]
+    """Why the closest candidate fails: a finding of the requirement set on what it fails, then its binding physics."""
+    failing = list(closest.get("failed_mandatory") or ())
     text = explain(closest.get("binding"), closest.get("binding_where"), cfg, reqset, tried_limiter)
-    if hard:
-        lead = "No servo can pass both: " if hard[0]["same_points"] else "The requirement set works against any pass: "
-        rest = set(closest.get("failed_mandatory") or ()) - {hard[0]["time_constant"], hard[0]["speed"]}
-        binding_in_conflict = closest.get("binding") in (hard[0]["time_constant"], hard[0]["speed"])
-        tail = "" if binding_in_conflict and not rest else " Besides, " + text
-        return lead + conflict_text(hard[0]) + tail
-    return text
+    text += _by_construction(closest)
+    found = set_findings(reqset, cfg.params["cylinder.stroke"], failing)
+    if not found:
+        return text
+    f = found[0]
+    lead = {CONFLICT: "No servo can pass both: ", TENSION: "The requirement set works against any pass: ",
+            RATE_SPLIT: "The requirement set asks for two speeds: "}[f["kind"]]
+    return lead + f["text"] + ". Besides, " + text
+
+
+def _by_construction(closest: dict) -> str:
+    """The failing mandatory requirements that pass only by construction: the model cannot evidence them."""
+    bc = closest.get("by_construction") or []
+    if not bc:
+        return ""
+    return (f" {', '.join(bc)} pass only by construction in the closest candidate (the model lacks the physics that could make "
+            "them fail, or a parameter was derived to give them): no setting or modelled hardware turns them into evidence; "
+            "model the missing effect or measure them.")
+
+
+def _step_size(reqset, proc: str, stroke: float) -> float | None:
+    """Step size [m] of a steps procedure, None for any other."""
+    p = reqset.procedures.get(proc)
+    return p.settings["size"].resolve(stroke) if p is not None and p.kind == "steps" else None
+
+
+def _limited_steps(rid, where, cfg, req, h, stroke) -> str:
+    """A time constant held back by the set-point rate limiter: the gate follows the ramp at best."""
+    rate = min(cfg.params["controller.setpoint_opening_rate"], cfg.params["controller.setpoint_closing_rate"])
+    tau_max = req.resolved_limit(stroke)[-1]
+    return (f"{rid} binds ({where}): the set-point rate limiter ramps this {h*1e3:.1f} mm step at "
+            f"{rate*1e3:.1f} mm/s, so the gate reaches 63.2 % of it no sooner than 0.632 x {h*1e3:.1f} mm / "
+            f"{rate*1e3:.1f} mm/s = {0.632*h/rate:.3f} s (window <= {tau_max:.3g} s): the limiter that holds the strokes to "
+            "their rate slows the steps as much (pid_controller, set-point rate limiter).")
 
 
 def explain(rid: str | None, where: str | None, cfg, reqset, tried_limiter: bool) -> str:
@@ -88,13 +91,9 @@ def explain(rid: str | None, where: str | None, cfg, reqset, tried_limiter: bool
     L = cfg.params["cylinder.stroke"]
     proc = (where or "").split("@")[0]
     if req.metric in SPEED_METRICS:
-        conflicts = [c for c in step_conflict(reqset, L) if c["speed"] == rid and (not proc or c["procedure"] == proc)]
-        if conflicts:
-            c = conflicts[0]
-            return (f"{rid} binds through a conflict in the requirement set: on {c['procedure']} ({c['step']*1e3:.1f} mm steps) "
-                    f"{c['time_constant']} asks tau <= {c['tau_max']:.3f} s, so a first-order answer starts at "
-                    f"s/tau >= {c['first_order_peak']*1e3:.1f} mm/s against the {c['v_max']*1e3:.1f} mm/s of {rid}; "
-                    f"only a rate-limited answer can meet both (it reaches 63.2 % after {c['ramp_tau_min']:.3f} s at best).")
+        found = [f for f in set_findings(reqset, L, [rid]) if f["procedure"] == proc]
+        if found:
+            return f"{rid} binds through a finding of the requirement set: {found[0]['text']}."
         if proc and reqset.procedures.get(proc) is not None and reqset.procedures[proc].kind == "full_stroke":
             lim = (" The set-point rate limiter with its ramp hold was in the space too: it trades the surge against the "
                    "stroke time (a small lead holds the gate back at breakaway and slows the stroke)." if tried_limiter else "")
@@ -103,6 +102,8 @@ def explain(rid: str | None, where: str | None, cfg, reqset, tried_limiter: bool
                     f"atmosphere; the gate is held until their forces cross and then breaks away with the stored pressure "
                     f"difference - the end-stop surge. Throttles and gains act after it.{lim} The hardware that acts on it "
                     "(an exhaust back-pressure valve, cushioned cylinders) is not modelled (catalogue: not_modelled).")
+    if req.metric == "time_constant" and cfg.setpoint_rate_limited and _step_size(reqset, proc, L):
+        return _limited_steps(rid, where, cfg, req, _step_size(reqset, proc, L), L)
     if req.metric in ("opening_time", "closing_time", "time_constant"):
         v_c = choked_speed(cfg)
         need = L / req.resolved_limit(L)[-1] if req.metric != "time_constant" else None

@@ -4,7 +4,8 @@ A task is a batch of candidates (index, settings). The worker holds the base con
 the requirement set and the planned runs (sent once), applies each candidate's settings,
 runs every planned procedure x operating point in turn without plot traces, and judges the
 requirements with the campaign's own :func:`~compliance.campaign.judge.judge`. What comes back
-is small: per requirement the worst value, margin, margin % and status.
+is small: per requirement the worst value, margin, margin % and status, and the basis the judge
+gives it (a pass by construction is no pass: ``sweep.ranking``, as the campaign's own verdict).
 """
 
 from __future__ import annotations
@@ -72,7 +73,7 @@ def evaluate_one(ctx: Context, values: dict) -> dict:
         reqs[e["id"]] = {"severity": e["severity"], "status": e["status"], "value": w.get("value"),
                          "margin": w.get("margin"), "margin_pct": w.get("margin_pct"), "where": w.get("run"),
                      "basis": e.get("basis")}
-    judged = [(e["severity"], e["status"]) for e in entries if e["status"] not in (OPEN, DISABLED)]
+    judged = [(e["severity"], e["status"], e.get("basis")) for e in entries if e["status"] not in (OPEN, DISABLED)]
     return {"status": overall_status(judged), "error": None, "requirements": reqs}
 
 

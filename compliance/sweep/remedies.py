@@ -133,6 +133,7 @@ def describe_candidate(adjust, base, values, row) -> dict:
         "binding_margin_pct": marg,
         "binding_where": row["requirements"][rid].get("where") if rid else None,
         "failed_mandatory": failing_mandatory(row),
+        "by_construction": sorted(r for r in failing_mandatory(row) if row["requirements"].get(r, {}).get("status") == "pass"),
         "total_shortfall": rank_key(row, 0.0)[1],
     }
 

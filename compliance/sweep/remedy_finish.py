@@ -70,6 +70,14 @@ def _yield(rem, ctx, cfg, uncertain, run_kw, units):
     }
 
 
+def _closest_configuration(cfg, ctx, closest):
+    """``cfg`` with the closest candidate's hardware and settings: its binding physics is told with its own numbers."""
+    from compliance.sweep.parameter_paths import apply_values
+
+    values = {**closest.get("hardware_values", {}), **closest.get("values", {})}
+    return apply_values(cfg, ctx.paths, {k: v for k, v in values.items() if k in ctx.paths})
+
+
 def finish(rem, given, ctx, cfg, reqset, uncertain, catalogue, *, run_kw, yield_units) -> dict:
     """Complete the ``remedies`` section (see the module note); ``given`` is :func:`as_given`'s answer."""
     rem["as_given_failed"] = given["candidate"]["failed_mandatory"]
@@ -77,7 +85,7 @@ def finish(rem, given, ctx, cfg, reqset, uncertain, catalogue, *, run_kw, yield_
         _never_worse(rem, given)
         c = rem["closest"]
         tried_limiter = any(s["path"].startswith("controller.setpoint_") for s in rem["space"])
-        rem["explanation"] = explain_closest(c, cfg, reqset, tried_limiter)
+        rem["explanation"] = explain_closest(c, _closest_configuration(cfg, ctx, c), reqset, tried_limiter)
         stages = ", ".join(s["stage"] + (f" ({' + '.join(s['options'])})" if s.get("options") else "") for s in rem.get("stages", []))
         hw = " with " + " + ".join(h["title"] for h in c["hardware"]) if c.get("hardware") else ""
         rem["note"] = (f"no candidate of the {rem['evaluated']} judged (stages: {stages}) passes every mandatory requirement; "

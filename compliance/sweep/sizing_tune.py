@@ -1,9 +1,17 @@
 """Throttles of a sized servo refined by simulation: the full stroke's 25-75 % time on target.
 
 The steady rule of ``sizing`` ignores the pressure transients of a stroke; here each meter-out
-conductance is corrected by a secant on log C until the simulated full stroke at the
-requirement's operating point (its set-up load, flow-control valves in) takes the target time
-(within ``TOLERANCE``). This is how plant A's own throttles were derived (models/plant-a.toml).
+conductance is corrected by a secant on log C until the simulated full stroke at the set-up
+point (flow-control valves in) takes the target time (within ``TOLERANCE``). This is how plant
+A's own throttles were derived (models/plant-a.toml, ``derived_for``: 5.0 s at 5.7 kN).
+
+The set-up point is where the flow-control valves are adjusted on site, as a commissioning
+engineer does it (plant paper section 5.2: at the governor set-up load): the operating point at
+which the requirement file judges the independent adjustment of those valves. A file without
+that test sets them at the stroke-time requirement's first point. A stroke-time requirement
+judged at other loads too (no load, rated load) is a check on that one setting, not a second
+target: one throttle cannot be tuned to several loads, and the check that follows sizing judges
+every load the file names.
 """
 
 from __future__ import annotations
@@ -13,17 +21,28 @@ import math
 from compliance import metrics as M
 from compliance.procedures.scenarios import full_command_stroke
 
-__all__ = ["TOLERANCE", "stroke_target", "tune_throttles"]
+__all__ = ["TOLERANCE", "setup_point", "stroke_target", "tune_throttles"]
 
 TOLERANCE = 0.005  # relative stroke-time error accepted
 KEYS = {"opening": "flow_control.opening_conductance", "closing": "flow_control.closing_conductance"}
 
 
+def setup_point(reqset, candidates) -> str:
+    """Name of the operating point among ``candidates`` where the file adjusts the flow-control valves (module note)."""
+    for r in reqset.requirements:
+        adjusts = any(reqset.procedures[p].kind == "independent_adjustment" for p in r.procedures if p in reqset.procedures)
+        if r.enabled and adjusts:
+            for o in r.operating_points:
+                if o in candidates and reqset.operating_points[o].flow_control is not False:
+                    return o
+    return candidates[0]
+
+
 def stroke_target(reqset, direction: str, stroke: float, given: float | None):
-    """(target time [s], operating point) of a direction's full stroke: the duty's time, else the window's middle."""
+    """(target time [s], set-up operating point) of a direction's full stroke: the duty's time, else the window's middle."""
     for r in reqset.requirements:
         if r.metric == f"{direction}_time" and r.enabled and r.operating_points:
-            op = reqset.operating_points[r.operating_points[0]]
+            op = reqset.operating_points[setup_point(reqset, list(r.operating_points))]
             if given is None and r.limit is not None:
                 lim = r.resolved_limit(stroke)
                 given = 0.5 * (lim[0] + lim[-1])

@@ -79,3 +79,15 @@ def test_check_refuses_a_conflicting_set_before_simulating(strict, tmp_path, cap
     err = capsys.readouterr().err
     assert code == 2 and "contradicts itself" in err and "40.5 mm/s" in err and "--allow-conflicts" in err
     assert not out.exists()
+
+
+def test_tau_window_against_the_stroke_rate_limit_across_procedures():
+    """shpp-400kw judges the stroke rate (32 mm/s) on full strokes and tau <= 0.25 s on 16 mm steps: 0.632 x 16 mm /
+    0.25 s = 40.5 mm/s, so the steps must run faster than the strokes may; a 32 mm/s rate limiter gives tau >= 0.316 s."""
+    from compliance.requirements.consistency import RATE_SPLIT
+
+    found = [f for f in consistency_findings(load_requirements("shpp-400kw"), 0.160) if f["kind"] == RATE_SPLIT]
+    assert {(f["procedure"], tuple(f["requirements"])) for f in found if f["mandatory"]} == {
+        ("steps-10", ("IEC61362-TC", "IEEE125-NOFASTER")), ("steps-10-down", ("IEC61362-TC", "IEEE125-NOFASTER"))}
+    f = found[0]
+    assert "40.5 mm/s > 32.0 mm/s" in f["text"] and "0.316 s > 0.25 s" in f["text"] and "valves out" in f["text"]

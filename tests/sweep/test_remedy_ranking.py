@@ -73,15 +73,43 @@ def test_save_remedy_needs_remedies(tmp_path):
 
 
 def test_requirement_set_conflict_arithmetic_of_the_shipped_file():
-    """shpp-400kw: tau <= 0.25 s on 16 mm steps needs >= 0.316 s at <= 32 mm/s: no rate-limited servo meets both."""
+    """shpp-400kw: tau <= 0.25 s on 16 mm steps needs a mean 40.5 mm/s > the 32 mm/s stroke rate limit; a rate limiter
+    at 32 mm/s gives tau >= 0.316 s. The explanation is the consistency check's finding, not arithmetic of its own."""
     from compliance.model.config import load_plant
+    from compliance.requirements.consistency import RATE_SPLIT
     from compliance.requirements.loading import load_requirements
-    from compliance.sweep.binding_physics import explain_closest, step_conflict
+    from compliance.sweep.binding_physics import explain_closest, set_findings
 
     reqset = load_requirements("shpp-400kw")
-    c = {x["procedure"]: x for x in step_conflict(reqset, 0.16)}
-    assert c["steps-10"]["ramp_tau_min"] == pytest.approx(0.632 * 0.016 / 0.032) and c["steps-10"]["any_servo_conflict"]
-    assert c["steps-5"]["first_order_peak"] == pytest.approx(0.032) and not c["steps-5"]["any_servo_conflict"]
+    found = {(f["procedure"], f["requirements"][1]): f for f in set_findings(reqset, 0.16, ["IEC61362-TC"])}
+    f = found[("steps-10", "IEEE125-NOFASTER")]
+    assert f["kind"] == RATE_SPLIT and f["mandatory"]
+    assert f["mean_speed"] == pytest.approx(0.632 * 0.016 / 0.25, rel=1e-3) and f["v_max"] == pytest.approx(0.032)
+    assert f["ramp_tau_min"] == pytest.approx(0.632 * 0.016 / 0.032, rel=1e-3)
+    assert ("steps-5", "IEEE125-NOFASTER") not in found  # 0.632 x 8 mm / 0.25 s = 20.2 mm/s fits under 32 mm/s
     text = explain_closest({"failed_mandatory": ["IEC61362-TC"], "binding": "IEC61362-TC", "binding_where": "steps-10@tc-mid"},
                            load_plant("plant-a"), reqset, True)
-    assert "0.316 s" in text and "steps-10" in text
+    assert "0.316 s" in text and "steps-10" in text and "40.5 mm/s > 32.0 mm/s" in text
+
+
+def test_explanation_names_a_pass_by_construction():
+    """A closest candidate that fails only because a mandatory requirement passes by construction says so."""
+    from compliance.model.config import load_plant
+    from compliance.requirements.loading import load_requirements
+    from compliance.sweep.binding_physics import explain_closest
+
+    closest = {"failed_mandatory": ["IEC61362-INDEP"], "by_construction": ["IEC61362-INDEP"], "binding": "IEC61362-INDEP",
+               "binding_where": "independent-adjustment@governor-setup"}
+    text = explain_closest(closest, load_plant("plant-a"), load_requirements("shpp-400kw"), True)
+    assert "IEC61362-INDEP pass only by construction" in text
+
+def test_a_rate_limited_time_constant_is_explained_by_the_ramp():
+    """With the set-point limiter at 31.2 mm/s a 16 mm step reaches 63.2 % no sooner than 0.632 x 16 / 31.2 = 0.324 s."""
+    from compliance.model.config import load_plant
+    from compliance.requirements.loading import load_requirements
+    from compliance.sweep.binding_physics import explain
+
+    cfg = load_plant("plant-a").replace(params={"controller.setpoint_opening_rate": 0.0312,
+                                                "controller.setpoint_closing_rate": 0.0315})
+    text = explain("IEC61362-TC", "steps-10-down@tc-mid", cfg, load_requirements("shpp-400kw"), True)
+    assert "0.324 s" in text and "31.2 mm/s" in text
