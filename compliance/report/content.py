@@ -127,8 +127,23 @@ def summary_rows(results: dict) -> list[dict]:
             "procedure": w.get("procedure"), "operating_point": w.get("operating_point"), "reason": reason,
             "anchor": "run-" + _slug(where) if where in run_ids else None,
             "note": e.get("note"), "loosened": e.get("loosened") or [],
+            "basis": BASIS_WORDS.get(str(e.get("basis")), str(e.get("basis")).replace("_", " ")) if e.get("basis") else None,
+            "band": band_text(e.get("band"), e["metric"]),
         })
     return out
+
+
+# how a verdict is known (the verdict work's ``basis`` key; absent in older results)
+BASIS_WORDS = {"modelled": "modelled", "by_construction": "by construction", "not_evaluated": "not evaluated",
+               "assumed": "assumed"}
+
+
+def band_text(band, metric: str) -> str | None:
+    """A verdict's value band under the declared parameter uncertainty (``{"low", "high"}``, SI) as text."""
+    if not isinstance(band, dict) or band.get("low") is None or band.get("high") is None:
+        return None
+    lo, hi = fmt_metric(band["low"], metric), fmt_metric(band["high"], metric)
+    return f"band {lo} to {hi}"
 
 
 def _run_evidence(results: dict, run_id: str) -> list[dict]:
@@ -238,9 +253,14 @@ def _slug(text: str) -> str:
 
 
 def parameter_rows(results: dict) -> list[dict]:
-    """Appendix table: every configuration parameter with value, unit, meaning and source."""
+    """Appendix table: every parameter the selected model uses, with value, unit, meaning and source."""
+    from compliance.report.signoff import used_by_model
+
     rows = []
+    options = results["plant"].get("options") or {}
     for p in sorted(results["plant"]["parameters"], key=lambda q: str(q.get("key"))):
+        if not used_by_model(str(p.get("key")), options):
+            continue  # a law or controller not selected: not part of this model
         src = p.get("source") or "\u2013"
         rows.append({"key": p.get("key"), "value": fmt_num(p.get("value"), 6), "unit": unit_text(p.get("unit", "")) or "\u2013",
                      "meaning": reader_text(p.get("meaning")), "source": src, "source_class": src if src in SOURCES else "other"})

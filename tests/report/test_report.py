@@ -84,7 +84,9 @@ def test_html_is_self_contained_with_every_figure_inline(rendered):
     n_pages = len(requirement_pages(res)[1])  # the worst case of each requirement page whose run is in the fixture
     assert n_pages >= 3
     assert doc.tags.count("figure") == n_pages + n_traces + n_val + n_lin
-    assert doc.tags.count("svg") == doc.tags.count("figure")
+    draft = sum(1 for tag, a in doc.attrs if tag == "svg" and a.get("class") == "draft-svg")  # the DRAFT watermark
+    assert draft == 1  # the fixture's configuration has no document number
+    assert doc.tags.count("svg") - draft == doc.tags.count("figure")
     # nothing outside the file: no scheme, no import, no src/href to anything but an in-page anchor
     assert "http:" not in text and "https:" not in text
     assert "@import" not in text and "url(http" not in text
@@ -112,19 +114,30 @@ def test_user_strings_are_escaped(rendered):
 def test_contents_in_order_and_every_requirement_in_summary(rendered):
     res, html_path, _ = rendered
     text = html_path.read_text(encoding="utf-8")
-    pos = [text.index(f'id="{s}"') for s in ("cover", "summary", "procedures", "linear", "validation", "appendix")]
+    sections = ("cover", "scope", "conditions", "summary", "procedures", "linear", "validation", "conclusions", "appendix")
+    pos = [text.index(f'id="{s}"') for s in sections]
     assert pos == sorted(pos)
     summary = text[text.index('id="summary"'):text.index('id="procedures"')]
     for e in res["requirements"]:
         assert e["id"] in summary
-    # the cover carries both sha256 digests, the verdict and the version
+    # the cover cites the sha256 digests (abbreviated) and the verdict; section 7.3 gives them in full
     cover = text[:text.index('id="contents"')]
-    assert res["plant"]["digest"] in cover and res["requirement_set"]["digest"] in cover
+    assert res["plant"]["digest"][:16] in cover and res["requirement_set"]["digest"][:16] in cover
     assert res["summary"]["status"].upper() in cover
-    # appendix: every parameter key with its source, the command line
+    control = text[text.index('id="conclusions"'):text.index('id="appendix"')]
+    assert res["plant"]["digest"] in control and res["requirement_set"]["digest"] in control
+    # every operating point is defined in section 2.1, before the evidence uses it
+    conditions = text[text.index('id="conditions"'):text.index('id="summary"')]
+    for name in res["requirement_set"]["operating_points"]:
+        assert name in conditions, name
+    # appendix: every parameter the model uses with its source (laws not selected are left out), the command line
+    from compliance.report.signoff import used_by_model
+
     appendix = text[text.index('id="appendix"'):]
+    used = [p for p in res["plant"]["parameters"] if used_by_model(p["key"], res["plant"]["options"])]
+    assert 0 < len(used) < len(res["plant"]["parameters"])
     for p in res["plant"]["parameters"]:
-        assert p["key"] in appendix
+        assert (p["key"] in appendix) == (p in used), p["key"]
     assert "govcheck check" in appendix
 
 
@@ -146,7 +159,7 @@ def test_absent_sections_say_not_run(tmp_path):
     text = out.read_text(encoding="utf-8")
     assert "Linear analysis (govcheck linear): not run." in text
     assert "Model validation against recordings (govcheck validate): not run." in text
-    assert _parse(text).tags.count("svg") == len(res["runs"][0]["traces"])
+    assert _parse(text).tags.count("svg") == len(res["runs"][0]["traces"]) + 1  # + the DRAFT watermark
 
 
 # --------------------------------------------------------------------------- PDF
@@ -163,7 +176,8 @@ def test_pdf_has_pages_verdict_and_every_requirement(rendered):
     # running footer with page numbers and a table of contents with page numbers
     assert f"Page 2 of {len(reader.pages)}" in text
     toc = reader.pages[1].extract_text()
-    assert re.search(r"1\. Summary, deviations and assumptions[ .]*\d+", toc)
+    assert re.search(r"3\. Results against the guarantees[ .]*\d+", toc)
+    assert re.search(r"7\. Conclusions, disposition, parties and revisions[ .]*\d+", toc)
 
 
 def _png_stats(path):
