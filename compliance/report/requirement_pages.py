@@ -9,6 +9,8 @@ servo actually covered is given, and excluded samples say why they were left out
 
 from __future__ import annotations
 
+import re
+
 from compliance.metrics import METRICS
 from compliance.units.formatting import fmt_margin_pct, fmt_value, unit_text
 
@@ -17,15 +19,25 @@ SPEED_METRICS = ("max_speed", "max_opening_speed", "max_closing_speed")
 STEP_TOLERANCE_METRICS = ("max_positioning_error", "steady_state_error")
 
 
-_PAPER_WORDS = (("seed 000", "plant-A paper"), ("seed 001", "plant-B paper"), ("seed section", "plant-A paper section"))
+_PAPER_WORDS = (("seed 000", "plant-A paper"), ("seed 001", "plant-B paper"), ("seed section", "plant-A paper section"),
+                ("seed paper", "source paper"), ("the seed", "the source paper"))
+_DOC_REF_RE = re.compile(r"\s*\((?:see )?[^()]*\b[\w./-]+\.(?:md|py|toml)\b[^()]*\)")  # "(reference-plant.md, 'Known tension')"
+_MODULE_REF_RE = re.compile(r"\bcompliance\.(\w+)(?:\.\w+)*")
+_PAPER_SECTION_RE = re.compile(r"(paper section [\d.]+, [^;)]*?)\bin section (\d[\d.]*)")
 
 
 def reader_text(text) -> str:
-    """Text from our declarations for a reader: internal names of the source papers in words."""
+    """Text from our declarations for a reader: internal names of the source papers in words, no file or module names.
+
+    A parenthesis that points at one of our documentation files is dropped (the report cannot
+    send its reader to the code base); a module named in a note becomes the stage it belongs to.
+    """
     text = "" if text is None else str(text)
     for a, b in _PAPER_WORDS:
         text = text.replace(a, b)
-    return text
+    text = _DOC_REF_RE.sub("", text)
+    text = _PAPER_SECTION_RE.sub(r"\1in the paper's section \2", text)  # never read as a section of this report
+    return _MODULE_REF_RE.sub(lambda m: f"govcheck's {m.group(1).replace('_', ' ')} analysis", text)
 
 
 def metric_text(value, metric: str) -> str:
