@@ -50,7 +50,7 @@ class LawFit:
         return [float(np.sqrt(np.mean(r * r))) for r in self.residuals]
 
 
-_SPEC = {  # name -> (low, high, log)
+_SPEC = {  # name -> (low, high, log); FIT_BOUNDS below is the public name (the report flags values at a bound)
     "bias": (-100.0, 100.0, False),
     "bias_per_pressure": (-2e-4, 2e-4, False),
     "coulomb": (0.0, 1000.0, False),
@@ -60,6 +60,9 @@ _SPEC = {  # name -> (low, high, log)
     "pressure_coefficient": (0.0, 1e-3, False),
     "bristle_stiffness": (1e2, 1e8, True),
 }
+
+
+FIT_BOUNDS = _SPEC
 
 
 def _names(pressure: bool, presliding: bool) -> list[str]:

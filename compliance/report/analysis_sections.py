@@ -255,7 +255,7 @@ def validation_section(val: dict | None, start: int) -> tuple[dict | None, list[
             fid = f"fig-{start + len(specs)}"
             specs.append({"id": fid, "kind": "waveform", "series": series, "scale": scale, "ylabel": f"{label} [{unit}]",
                           "windows": _shaded(windows, sig, ov.get("time")), "smooth": sig == "valve_command"})
-            figs.append({"id": fid, "signal": label, "role": ov.get("role")})
+            figs.append({"id": fid, "signal": label, "role": ov.get("role"), "shaded": bool(specs[-1]["windows"])})
         fits = [{"signal": SIGNAL_DISPLAY.get(s, (s,))[0], "fit": fmt_num(f.get("fit_percent"), 3),
                  "nrmse": fmt_num(f.get("nrmse"), 3), "rms": _sig(f.get("rms_error"), s), "max": _sig(f.get("max_abs_error"), s),
                  "fit_after": fmt_num(((after.get("fits") or {}).get(s) or {}).get("fit_percent"), 3) if after else None}
@@ -273,7 +273,11 @@ def validation_section(val: dict | None, start: int) -> tuple[dict | None, list[
                                   "bounds": " .. ".join(fmt_num(b, 3) for b in (p.get("bounds") or []))}
                                  for p in eff.get("params") or []]})
     rec = val.get("recording") or {}
-    ctx = {"finding": diagnosis_finding(diag) if diag else None, "recording": rec, "plant": val.get("plant") or {}, "conditions": val.get("conditions") or {},
+    first = modes[0] if modes else {}
+    pos = next((f for f in first.get("fits") or [] if f["signal"] == "position"), {})
+    ctx = {"fit_before": pos.get("fit") if pos.get("fit") not in (None, "\u2013") else None,
+           "fit_after": pos.get("fit_after") if pos.get("fit_after") not in (None, "\u2013") else None,
+           "finding": diagnosis_finding(diag) if diag else None, "recording": rec, "plant": val.get("plant") or {}, "conditions": val.get("conditions") or {},
            "modes": modes, "added": added, "diagnosis": bool(diag), "explanation": diag.get("explanation"),
            "warnings": val.get("warnings") or [], "pass": (val.get("summary") or {}).get("pass")}
     return ctx, specs
@@ -313,12 +317,11 @@ def diagnosis_finding(diag: dict) -> dict:
         if e.get("name") == diag.get("winner"):
             winner = e
     params = []
+    from compliance.units.formatting import fmt_si
+
     for p in (winner or {}).get("parameters") or []:
-        u = p.get("unit") or ""
-        se = p.get("stderr")
-        val = fmt_num(p.get("value"), 3)
-        params.append({"name": p.get("name"), "text": f"{val} \u00b1 {fmt_num(se, 2)} {pretty_unit(u)}".strip()
-                       if se is not None else f"{val} {pretty_unit(u)}".strip(), "meaning": p.get("meaning") or ""})
+        params.append({"name": p.get("name"), "text": fmt_si(p.get("value"), p.get("unit") or "", p.get("stderr")),
+                       "meaning": p.get("meaning") or "", "bound": _effect_bound(p)})
     runner = ranked[1] if len(ranked) > 1 else None
     step = NEXT_STEP.get(verdict, "")
     if runner is not None and runner.get("delta_bic") is not None and winner is not None and verdict in NEXT_STEP:
@@ -330,6 +333,27 @@ def diagnosis_finding(diag: dict) -> dict:
             "effect": (winner or {}).get("name") if verdict in ("missing_physics", "parameters_only") else None,
             "params": params if verdict in ("missing_physics", "parameters_only") else [],
             "explanation": diag.get("explanation"), "next": step}
+
+
+def _effect_bound(p: dict) -> str | None:
+    """"at its fit bound" when a fitted effect parameter sits on a bound of its declaration (effects catalogue)."""
+    from compliance.effects import EFFECTS
+    from compliance.report.friction import at_bound
+    from compliance.units.formatting import fmt_si
+
+    effect, _, name = str(p.get("name") or "").partition(".")
+    eff = EFFECTS.get(effect)
+    if eff is None or not name or p.get("value") is None:
+        return None
+    try:
+        spec = eff.param(name)
+    except (KeyError, ValueError):
+        return None
+    lo, hi = spec.bounds
+    if at_bound(p["value"], lo, hi, bool(getattr(spec, "log_scale", False))):
+        edge = lo if abs(p["value"] - lo) <= abs(p["value"] - hi) else hi
+        return f"at its fit bound ({fmt_si(edge, p.get('unit') or '')}): not determined by the recording"
+    return None
 
 
 def _shaded(windows: list, sig: str, time) -> list:
@@ -374,7 +398,8 @@ def _pct(v) -> str:
 
 
 def _sig(v, signal):
+    """An error of a signal in its display unit; an error of an absolute pressure is a difference (bar, not bar abs)."""
     if v is None:
         return "\u2013"
     label, unit, scale = SIGNAL_DISPLAY.get(signal, (signal, "", 1.0))
-    return f"{fmt_num(v * scale, 3)} {unit}"
+    return f"{fmt_num(v * scale, 3)} {unit.replace(' abs', '')}"

@@ -88,6 +88,18 @@ def setting_text(v) -> str:
     return str(v)
 
 
+def readable_settings(settings: dict) -> list[tuple[str, str]]:
+    """A settings or conditions mapping as (name in words, value in words): no Python literals, units typeset."""
+    out = []
+    for k, v in sorted(settings.items()):
+        if isinstance(v, dict):
+            text = "; ".join(f"{str(a).replace('_', ' ')} {setting_text(b)}" for a, b in sorted(v.items()) if b is not None)
+        else:
+            text = setting_text(v) if v is not None else "\u2013"
+        out.append((str(k).replace("_", " "), text or "\u2013"))
+    return out
+
+
 def status_class(status: str | None) -> str:
     """CSS class of a status badge."""
     return {"pass": "pass", "fail": "fail", "incomplete": "warn", "not_evaluated": "warn"}.get(status or "", "neutral")

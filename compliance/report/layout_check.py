@@ -73,7 +73,9 @@ def _box(el, inherited: dict, dx: float, dy: float, text: str):
 def svg_text_boxes(svg: str) -> tuple[tuple[float, float, float, float], list[tuple[str, tuple]]]:
     """The ``viewBox`` of an SVG and ``(label, box)`` for each text run in it."""
     plain = re.sub(r"\sxmlns(:\w+)?=\"[^\"]*\"", "", svg)
-    root = ET.fromstring(plain.replace("<svg", '<svg xmlns:xlink="http://www.w3.org/1999/xlink"', 1))
+    plain = re.sub(r"<(/?)[A-Za-z]+:", r"<\1", plain)  # prefixed elements (metadata) and attributes (xlink:href)
+    plain = re.sub(r"\s[A-Za-z]+:([A-Za-z-]+)=", r" \1=", plain)
+    root = ET.fromstring(plain)
     vb = tuple(float(v) for v in root.attrib.get("viewBox", "0 0 0 0").replace(",", " ").split())
     out: list = []
 

@@ -306,6 +306,16 @@ def render_report(results: dict, html_path=None, pdf_path=None, *, workers: int 
     _emit("report.html.j2", ctx, svgs, html_path, pdf_path)
 
 
+def file_sha256(path) -> str | None:
+    """sha256 of a recording file when it is still where the result says (else None: not cited)."""
+    import hashlib
+
+    try:
+        return hashlib.sha256(Path(path).read_bytes()).hexdigest() if path else None
+    except OSError:
+        return None
+
+
 def check_validation(result, where: str = "validation results") -> None:
     """Check a validation result has what its report needs (``InputError`` naming the key)."""
     if not isinstance(result, dict):
@@ -322,7 +332,8 @@ def check_validation(result, where: str = "validation results") -> None:
         raise InputError(f"{where}: key 'modes' should be an object of replay modes")
 
 
-def render_validation_report(result: dict, html_path, pdf_path=None, *, workers: int | None = None) -> None:
+def render_validation_report(result: dict, html_path, pdf_path=None, *, workers: int | None = None,
+                             document: dict | None = None) -> None:
     """Render the model-validation report of ``govcheck validate`` / ``govcheck diagnose``.
 
     Parameters
@@ -333,8 +344,14 @@ def render_validation_report(result: dict, html_path, pdf_path=None, *, workers:
         ``added``: effects with fitted parameters; ``explanation``: text).
     html_path : path
     pdf_path : path, optional
+    document : dict, optional
+        ``number``, ``revision`` and ``identity`` (the configuration's ``[identity]``) for the
+        document control; without identity and number the report is a DRAFT.
     """
-    _check_target(html_path, "--report")
+    if not html_path and not pdf_path:
+        raise InputError("render_validation_report: give html_path and/or pdf_path")
+    if html_path:
+        _check_target(html_path, "--report")
     if pdf_path:
         _check_target(pdf_path, "--pdf")
     check_validation(result)
@@ -343,7 +360,14 @@ def render_validation_report(result: dict, html_path, pdf_path=None, *, workers:
     plant = dict(result.get("plant") or {})
     plant["path"] = display_path(plant.get("path"))  # never an installation's absolute path
     ctx["recording"] = dict(ctx["recording"], path=display_path(ctx["recording"].get("path")))
+    rec = ctx["recording"]
+    digest = rec.get("digest") or rec.get("sha256") or file_sha256(result.get("recording", {}).get("path"))
+    files = [{"what": "Plant configuration", "path": plant.get("path") or plant.get("name"), "digest": plant.get("digest")},
+             {"what": "Recording", "path": rec.get("path"), "digest": digest}]
+    document = document or {}
     ctx = {**_common({"versions": {"govcheck": (result.get("tool") or {}).get("version", __version__)}}),
-           "v": ctx, "plant": plant, "settings": result.get("settings") or {}, "windows": result.get("windows") or [],
-           "created": fmt_date(result.get("created"))}
+           "v": ctx, "plant": plant, "settings": C.readable_settings(result.get("settings") or {}),
+           "conditions": C.readable_settings(ctx.get("conditions") or {}), "windows": result.get("windows") or [],
+           "created": fmt_date(result.get("created")), "identity": document.get("identity") or {},
+           "doc": S.document_block(document.get("identity") or {}, files, document)}
     _emit("validation.html.j2", ctx, svgs, html_path, pdf_path)

@@ -96,17 +96,30 @@ def basis(results: dict) -> dict:
             "provenance": dict(plant.get("provenance") or {})}
 
 
-def document_control(results: dict, document: dict | None = None) -> dict:
-    """Document number, revision, draft state and the sha256 of every input the report rests on.
+def document_block(identity: dict, files: list[dict], document: dict | None = None, *, needs_identity: bool = True) -> dict:
+    """Document number, revision, DRAFT state and the cited inputs of any govcheck report.
 
-    ``document``: ``number`` / ``revision`` given on the command line (they win over the
-    configuration's ``[identity]``), ``results`` (``{"path", "digest"}`` of the results file).
-    A report whose configuration has no ``[identity]`` or no document number is a DRAFT.
+    ``document``: ``number`` / ``revision`` from the command line (they win over the
+    ``[identity]`` table). Without an identity (when the report is about a configured unit,
+    ``needs_identity``) or without a document number the report is a DRAFT.
     """
     document = document or {}
-    ident = results["plant"].get("identity") or {}
-    number = document.get("number") or ident.get("document_number")
-    revision = document.get("revision") or ident.get("revision")
+    identity = identity or {}
+    number = document.get("number") or identity.get("document_number")
+    revision = document.get("revision") or identity.get("revision")
+    draft = (needs_identity and not identity) or not number
+    why = ("no [identity] table in the configuration" if needs_identity and not identity else "no document number "
+           "(--document-number)") if draft else None
+    return {"number": number, "revision": revision, "draft": draft, "draft_reason": why, "files": files,
+            "author": identity.get("author"), "test_date": identity.get("test_date")}
+
+
+def document_control(results: dict, document: dict | None = None) -> dict:
+    """:func:`document_block` of a compliance report: configuration, requirement files, results file, recording.
+
+    ``document`` may also carry ``results`` (``{"path", "digest"}`` of the saved results file).
+    """
+    document = document or {}
     plant, rs = results["plant"], results["requirement_set"]
     files = [{"what": "Plant configuration", "path": plant.get("path") or plant["name"], "digest": plant.get("digest")}]
     for f in rs.get("files") or [{"path": rs.get("path"), "digest": rs.get("digest")}]:
@@ -116,10 +129,7 @@ def document_control(results: dict, document: dict | None = None) -> dict:
     rec = (results.get("validation") or {}).get("recording") or {}
     if rec:
         files.append({"what": "Recording", "path": rec.get("path"), "digest": rec.get("digest")})
-    draft = not ident or not number
-    why = ("no [identity] table in the configuration" if not ident else "no document number") if draft else None
-    return {"number": number, "revision": revision, "draft": draft, "draft_reason": why, "files": files,
-            "author": ident.get("author"), "test_date": ident.get("test_date")}
+    return document_block(plant.get("identity") or {}, files, document)
 
 
 def _remedy_lines(rem) -> dict:
