@@ -47,14 +47,14 @@ MARGIN_CRITERION = {"phase_margin_deg": 30.0, "gain_margin_db": 6.0}
 
 
 def standards_cited(results: dict) -> list[str]:
-    """The standards the requirement file cites, each by its edition, and IEC 62006 for small hydro."""
+    """The governor standards the requirement file cites, each by its edition."""
     seen = []
     for e in results["requirement_set"].get("requirements") or []:
         std = str(e.get("standard") or "").replace("ANSI/", "")
         for key, text in STANDARDS.items():
             if key.replace(" ", "") in std.replace(" ", "") and text not in seen:
                 seen.append(text)
-    return seen + [SMALL_HYDRO]
+    return seen
 
 
 def paper_citation(results: dict) -> str | None:
@@ -80,6 +80,12 @@ def scope(results: dict) -> dict:
         if k in kinds:
             covered.append(names[k])
     covered += sorted(str(k).replace("_", " ") for k in kinds if k and k not in names)
+    standards = standards_cited(results)
+    if not standards:  # not a governor servo (plant B's robot): no gate, no turbine, no small-hydro code
+        return {"object": "the servo-pneumatic positioning system as modelled: valves, cylinders and the position "
+                          "controller", "covered": covered,
+                "excluded": ["tests of the built system", "paths, loads and supply conditions other than the ones of "
+                             "section 2.1"], "standards": [], "paper": paper_citation(results)}
     return {
         "object": "the servo-positioner alone: proportional valve, cylinders, meter-out flow-control valves and the "
                   "position controller, driving the wicket-gate ring against the modelled gate load",
@@ -88,7 +94,7 @@ def scope(results: dict) -> dict:
                      "load rejection and load acceptance of the unit (water hammer, overspeed)",
                      "emergency and quick closure (shut-down devices, closure on loss of air, power or signal)",
                      "the turbine, penstock and generator"],
-        "standards": standards_cited(results),
+        "standards": standards + [SMALL_HYDRO],
         "paper": paper_citation(results),
     }
 
