@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections import Counter
 
 from compliance.report.requirement_pages import limit_text, metric_text
-from compliance.units.formatting import fmt_margin_pct
+from compliance.units.formatting import fmt_margin_pct, fmt_si
 
 SOURCE_WORDS = {"paper": "from the paper", "assumed": "assumed", "derived": "derived", "user": "set by the user",
                 "fitted": "fitted to a recording"}
@@ -139,7 +139,8 @@ def _remedy_lines(rem) -> dict:
     out = {}
     fix = rem.get("remedy")
     if fix:
-        changes = ", ".join(f"{c['path']} {c['from']:.4g} -> {c['to']:.4g} {c['unit']}" for c in fix.get("changes", []))
+        changes = ", ".join(f"{c['path']} from {fmt_si(c['from'], c['unit'])} to {fmt_si(c['to'], c['unit'])}"
+                            for c in fix.get("changes", []))
         for rid in rem.get("failed", []):
             out[rid] = f"passes with {changes} (verified by a full campaign: {fix.get('verified', {}).get('status', 'not run')})"
         return out
@@ -149,7 +150,7 @@ def _remedy_lines(rem) -> dict:
         best = next((b for b in s.get("by_parameter", []) if b.get("delta_margin_pct", 0) > 0), None)
         if s["requirement"] not in out and best:
             out[s["requirement"]] = (f"no passing setting found; {best['path']} helps most "
-                                     f"({best['delta_margin_pct']:+.1f} points per {best['step']:.3g} {best['unit']})")
+                                     f"({best['delta_margin_pct']:+.1f} points per {fmt_si(best['step'], best['unit'])})")
     return out
 
 

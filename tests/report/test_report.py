@@ -510,4 +510,4 @@ def test_page_one_fix_lines_come_from_the_remedies_section():
     assert "hardware" in lines[failed[0]]
     res["remedies"] = {"failed": failed, "remedy": {"changes": [{"path": "controller.kp", "from": 280.0, "to": 400.0, "unit": "V/m"}],
                                                      "verified": {"status": "pass"}}}
-    assert all("280 -> 400 V/m" in f["remedy"] and "pass" in f["remedy"] for f in failures(res))
+    assert all("from 280 V/m to 400 V/m" in f["remedy"] and "pass" in f["remedy"] for f in failures(res))
