@@ -317,11 +317,12 @@ def diagnosis_finding(diag: dict) -> dict:
         if e.get("name") == diag.get("winner"):
             winner = e
     params = []
+    from compliance.report.fit_bounds import effect_bound
     from compliance.units.formatting import fmt_si
 
     for p in (winner or {}).get("parameters") or []:
         params.append({"name": p.get("name"), "text": fmt_si(p.get("value"), p.get("unit") or "", p.get("stderr")),
-                       "meaning": p.get("meaning") or "", "bound": _effect_bound(p)})
+                       "meaning": p.get("meaning") or "", "bound": effect_bound(p)})
     runner = ranked[1] if len(ranked) > 1 else None
     step = NEXT_STEP.get(verdict, "")
     if runner is not None and runner.get("delta_bic") is not None and winner is not None and verdict in NEXT_STEP:
@@ -333,27 +334,6 @@ def diagnosis_finding(diag: dict) -> dict:
             "effect": (winner or {}).get("name") if verdict in ("missing_physics", "parameters_only") else None,
             "params": params if verdict in ("missing_physics", "parameters_only") else [],
             "explanation": diag.get("explanation"), "next": step}
-
-
-def _effect_bound(p: dict) -> str | None:
-    """"at its fit bound" when a fitted effect parameter sits on a bound of its declaration (effects catalogue)."""
-    from compliance.effects import EFFECTS
-    from compliance.report.friction import at_bound
-    from compliance.units.formatting import fmt_si
-
-    effect, _, name = str(p.get("name") or "").partition(".")
-    eff = EFFECTS.get(effect)
-    if eff is None or not name or p.get("value") is None:
-        return None
-    try:
-        spec = eff.param(name)
-    except (KeyError, ValueError):
-        return None
-    lo, hi = spec.bounds
-    if at_bound(p["value"], lo, hi, bool(getattr(spec, "log_scale", False))):
-        edge = lo if abs(p["value"] - lo) <= abs(p["value"] - hi) else hi
-        return f"at its fit bound ({fmt_si(edge, p.get('unit') or '')}): not determined by the recording"
-    return None
 
 
 def _shaded(windows: list, sig: str, time) -> list:

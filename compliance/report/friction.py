@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from compliance.report.fit_bounds import at_bound
 from compliance.report.svg import styled, to_svg
 
 
@@ -92,20 +93,6 @@ CHI2_TEXT = ("\u03c7\u00b2/N: mean squared residual per sample in units of the r
              "fits down to the noise).")
 DBIC_TEXT = ("\u0394BIC: Bayesian information criterion relative to the best law (lower is better; more parameters "
              "are penalised). A difference above 10 is strong evidence; under 2 the data do not decide.")
-
-
-def at_bound(value, low, high, log: bool = False) -> bool:
-    """Whether a fitted value sits on its fit bound (within 0.1 % of the range, on a log scale for log parameters)."""
-    import math
-
-    if value is None:
-        return False
-    if log:
-        if value <= 0 or low <= 0:
-            return False
-        value, low, high = math.log10(value), math.log10(low), math.log10(high)
-    tol = 1e-3 * (high - low)
-    return value - low <= tol or high - value <= tol
 
 
 def _param_rows(params: list) -> list[dict]:

@@ -13,7 +13,7 @@ from pathlib import Path
 from compliance.report import acceptance as A
 from compliance.report import signoff as S
 from compliance.report.analysis_sections import distinct_points, linear_section
-from compliance.report.friction import at_bound
+from compliance.report.fit_bounds import at_bound
 from compliance.units.formatting import fmt_si
 
 FIXTURE = Path(__file__).resolve().parents[1] / "data" / "results_fixture.json"
