@@ -190,8 +190,8 @@ def write_friction_report(diag, html_path, pdf_path=None, *, document: dict | No
     svgs = {}
     for s in seals:
         named = []
-        for k, (caption, svg) in enumerate(s["figures"], 1):
-            fid = f"fig-{s['seal_index']}-{k}"
+        for caption, svg in s["figures"]:
+            fid = f"fig-{len(svgs) + 1}"  # numbered through the document (the SVG's inner ids carry the seal)
             svgs[fid] = svg
             named.append((caption, fid))
         s["figures"] = named
