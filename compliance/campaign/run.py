@@ -118,7 +118,8 @@ def plant_section(cfg) -> dict:
         })
     curve = None
     if cfg.load_curve is not None:
-        curve = {"position": [float(v) for v in cfg.load_curve[0]], "force": [float(v) for v in cfg.load_curve[1]]}
+        curve = {"position": [float(v) for v in cfg.load_curve[0]], "force": [float(v) for v in cfg.load_curve[1]],
+                 "source": cfg.sources.get("load.curve", "user")}
     return {
         "name": cfg.name,
         "description": cfg.description,

@@ -6,7 +6,8 @@ import shlex
 import sys
 from importlib import resources
 
-from compliance.cli.common import (add_jobs, add_outputs, add_parser, add_plant_argument, add_quiet, add_reproducible,
+from compliance.cli.common import (add_document_options, add_jobs, add_outputs, add_parser, add_plant_argument, add_quiet,
+                                   add_reproducible, document_options,
                                    check_args_outputs, plant_source)
 
 
@@ -57,6 +58,7 @@ def register(subparsers):
     from compliance.cli.remedies_options import add_remedies_options
 
     add_remedies_options(p)
+    add_document_options(p)
     add_jobs(p)
     add_quiet(p, "no progress bar; print only the verdict line")
     add_reproducible(p)
@@ -167,7 +169,10 @@ def run(args) -> int:
         table = summary_table(results)
         if render is not None:
             bar.set_postfix_str("report", refresh=False)
-            render(results, html_path=args.report, pdf_path=args.pdf, appendix=args.appendix)
+            from compliance.campaign.results_files import results_json
+
+            doc = document_options(args, args.json, results_json(results) if args.json else None)
+            render(results, html_path=args.report, pdf_path=args.pdf, appendix=args.appendix, document=doc)
             bar.update(1)
     if args.quiet:
         print(table.rstrip().splitlines()[-1])

@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import os
 import re
+from pathlib import Path
 
 from compliance.errors import InputError
 from compliance.model.force_limit import check_load_force  # noqa: F401 - simulate's --load check
@@ -125,6 +126,27 @@ def add_reproducible(parser) -> None:
     parser.add_argument("--reproducible", action="store_true",
                         help="byte-identical output files across runs: fixed 'created' (SOURCE_DATE_EPOCH, else "
                              "1970-01-01), no timings (also on when SOURCE_DATE_EPOCH is set)")
+
+
+def add_document_options(parser) -> None:
+    """``--document-number`` / ``--revision``: the report's document control (over the configuration's ``[identity]``)."""
+    parser.add_argument("--document-number", metavar="TEXT",
+                        help="document number printed on the report (else [identity] document_number; without one the "
+                             "report is marked DRAFT)")
+    parser.add_argument("--revision", metavar="TEXT", help="revision of the report (else [identity] revision)")
+
+
+def document_options(args, results_path=None, results_text: str | None = None) -> dict:
+    """The ``document`` argument of the report renderers: number, revision and the results file's sha256."""
+    import hashlib
+
+    from compliance.files.display import display_path
+
+    doc = {"number": getattr(args, "document_number", None), "revision": getattr(args, "revision", None)}
+    if results_path is not None:
+        data = results_text.encode("utf-8") if results_text is not None else Path(results_path).read_bytes()
+        doc["results"] = {"path": display_path(str(results_path)), "digest": hashlib.sha256(data).hexdigest()}
+    return doc
 
 
 def check_jobs(args) -> None:

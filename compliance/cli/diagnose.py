@@ -16,7 +16,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from compliance.cli.common import (add_recording_inputs, add_parser, add_jobs, add_outputs, add_quiet, add_reproducible, check_args_outputs,
-                                   check_sidecar_conditions, sidecar_plant, split_config)
+                                   check_sidecar_conditions, sidecar_plant, split_config, add_document_options,
+                                   document_options)
 from compliance.errors import InputError
 from compliance.files.atomic import write_json_atomic
 
@@ -52,8 +53,10 @@ def register(sub):
     p.add_argument("--scheduler", metavar="ADDR", help="several recordings: run the joint fits on Dask (local:N or "
                                                         "tcp://host:8786); default the local process pool")
     p.add_argument("--friction-bore", help='friction bench: piston bore, e.g. "25.7 mm" (else the column map\'s metadata)')
-    add_outputs(p, "json", "report", help={"json": "write the diagnosis (docs/diagnosis-schema.md) to FILE.json",
-                                           "report": "write an HTML report with the before/after figures to FILE.html"})
+    add_outputs(p, "json", "report", "pdf", help={"json": "write the diagnosis (docs/diagnosis-schema.md) to FILE.json",
+                                                  "report": "write an HTML report with the before/after figures to FILE.html",
+                                                  "pdf": "write the same report as an A4 PDF to FILE.pdf"})
+    add_document_options(p)
     p.add_argument("--save-model", metavar="FILE.toml", help="write the fitted plant configuration here (never overwrites; "
                                                             "nothing is saved when the diagnosis finds no mismatch)")
     add_quiet(p, "print only the verdict line")
@@ -109,8 +112,8 @@ def run(args) -> int:
     data = diag.to_dict()
     if args.json:
         write_json_atomic(args.json, _finish(data, args))
-    if args.report:
-        _render_servo_report(cfg, frame, meta, diag, data, args.report)
+    if args.report or args.pdf:
+        _render_servo_report(cfg, frame, meta, diag, data, args)
     _print_servo(data, args.quiet)
     if unsaved:
         print(f"note: {unsaved}")
@@ -153,7 +156,7 @@ def _print_servo(d: dict, quiet: bool) -> None:
         print(f"fitted model written to {d['saved_model']}")
 
 
-def _render_servo_report(cfg, frame, meta, diag, data: dict, html_path: str) -> None:
+def _render_servo_report(cfg, frame, meta, diag, data: dict, args) -> None:
     from compliance.report.render import render_validation_report
     from compliance.validation.validate import ValidationSettings, validate
 
@@ -173,7 +176,10 @@ def _render_servo_report(cfg, frame, meta, diag, data: dict, html_path: str) -> 
         for g, params in groups.items():
             diag_entry["added"].append({"name": g, "meaning": EFFECTS[g].meaning if g in EFFECTS else "", "params": params})
     result["diagnosis"] = diag_entry
-    render_validation_report(result, html_path)
+    from compliance.model.identity import identity_dict
+
+    document = {**document_options(args), "identity": identity_dict(cfg.identity)}
+    render_validation_report(result, args.report, args.pdf, document=document)
 
 
 def _run_friction(args, first, meta) -> int:
@@ -194,10 +200,16 @@ def _run_friction(args, first, meta) -> int:
     data = result.to_dict()
     if args.json:
         write_json_atomic(args.json, _finish(data, args))
-    if args.report:
+    if args.report or args.pdf:
         from compliance.report.friction import write_friction_report
 
-        write_friction_report(result, args.report)
+        bench = {k: str(v) for k, v in (meta or {}).items() if k in ("rig", "seal", "temperature", "operator", "date")}
+        bench.setdefault("rig", str((meta or {}).get("description") or "") or None)
+        if bore is not None:
+            bench["bore"] = f"{bore * 1e3:.3g} mm"
+        elif (meta or {}).get("bore"):
+            bench["bore"] = str(meta["bore"])
+        write_friction_report(result, args.report, args.pdf, document=document_options(args), bench=bench)
     print(format_friction(data, args.quiet))
     return 0
 

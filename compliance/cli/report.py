@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from compliance.cli.common import add_jobs, add_parser, check_args_outputs
+from compliance.cli.common import add_document_options, add_jobs, add_parser, check_args_outputs, document_options
 from compliance.errors import InputError
 from compliance.files.jsonable import read_json
 
@@ -34,6 +34,7 @@ def register(subparsers):
                         "cross-check and governor parameters are taken from the first file that has them)")
     p.add_argument("--validation", metavar="VALIDATION.json",
                    help="add a model validation written by 'govcheck validate --json'")
+    add_document_options(p)
     add_jobs(p, "processes drawing figures")
     p.add_argument("--appendix", choices=("none", "summary", "full"), default="summary",
                    help="compliance report appendix: none, summary (configuration, requirement file, versions; default) "
@@ -81,7 +82,8 @@ def run(args) -> int:
             val = read_json(args.validation, "validation")
             check_validation(val, str(args.validation))
             data["validation"] = val
-        render_report(data, html, args.pdf, workers=args.jobs, appendix=args.appendix)
+        render_report(data, html, args.pdf, workers=args.jobs, appendix=args.appendix,
+                      document=document_options(args, args.results))
     written = [p for p in (html, args.pdf) if p]
     print("report: " + ", ".join(written))
     return 0

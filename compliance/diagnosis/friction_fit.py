@@ -52,7 +52,7 @@ class LawFit:
         return [float(np.sqrt(np.mean(r * r))) for r in self.residuals]
 
 
-_SPEC = {  # name -> (low, high, log)
+_SPEC = {  # name -> (low, high, log); FIT_BOUNDS below is the public name (the report flags values at a bound)
     "bias": (-100.0, 100.0, False),
     "bias_per_pressure": (-2e-4, 2e-4, False),
     "coulomb": (0.0, 1000.0, False),
@@ -69,6 +69,9 @@ def law_flags(name: str) -> tuple[bool, bool, bool]:
     """(pressure dependent, pre-sliding, position dependent) of a law named by its effects joined by ``+``."""
     parts = set(name.split("+"))
     return PRESSURE_EFFECT in parts, PRESLIDING in parts, POSITION_EFFECT in parts
+
+
+FIT_BOUNDS = _SPEC
 
 
 def _names(pressure: bool, presliding: bool, position: bool = False) -> list[str]:

@@ -10,6 +10,7 @@ physics; the report prints it on page 1 and leaves a blank to fill in by hand fo
     document_number = "QA-GOV-0001"
     revision = "A"
     author = "J. Engineer"
+    witness = "for the owner: A. Witness"       # also supplier, test_date, revision_note
     [identity.equipment.valve]
     id = "5/3 proportional valve 1V1"
     serial = "SN 12345"
@@ -21,7 +22,8 @@ from types import MappingProxyType
 
 from compliance.errors import InputError
 
-FIELDS = ("site", "unit", "owner", "document_number", "revision", "author")
+FIELDS = ("site", "unit", "owner", "supplier", "witness", "test_date", "document_number", "revision", "revision_note",
+          "author")
 EQUIPMENT_FIELDS = ("id", "serial", "make", "model", "note")
 
 

@@ -27,15 +27,88 @@ def _op_label(a: dict) -> str:
         return str(a["label"])
     x = op.get("position")
     ld = op.get("load")
-    load = "no load" if ld is None else (f"load curve ({(op.get('load_force') or 0) / 1e3:.1f} kN)" if isinstance(ld, str)
+    load = "no load" if ld is None else (f"load curve, {(op.get('load_force') or 0) / 1e3:.1f} kN" if isinstance(ld, str)
                                           else f"{ld / 1e3:+.1f} kN")
     return f"{x * 1e3:.0f} mm, {load}" if isinstance(x, (int, float)) else "operating point"
 
 
-def linear_section(linear: dict | None, start: int) -> tuple[dict | None, list[dict]]:
+def _op_names(results: dict | None) -> list[tuple[str, float, object]]:
+    """The requirement file's operating points as (name, position [m], load: None | N | "curve")."""
+    if not results:
+        return []
+    from compliance.units.amounts import parse_amount
+
+    params = {p.get("key"): p.get("value") for p in results["plant"].get("parameters") or [] if isinstance(p, dict)}
+    stroke = params.get("cylinder.stroke") or 0.0
+    out = []
+    for name, op in (results["requirement_set"].get("operating_points") or {}).items():
+        if op.get("initial_position") is None:
+            continue
+        try:
+            x = parse_amount(op["initial_position"], "m", name).resolve(stroke)
+        except Exception:  # noqa: BLE001 - a position the report cannot read names no point
+            continue
+        ld = op.get("load")
+        out.append((name, x, params.get("load.nominal_force") if ld == "nominal" else ld))
+    return out
+
+
+def _same_load(a, b) -> bool:
+    if a is None or b is None or isinstance(a, str) or isinstance(b, str):
+        return a == b
+    return abs(float(a) - float(b)) < 1.0
+
+
+def distinct_points(analyses: list, results: dict | None = None) -> list[tuple[str, dict]]:
+    """The analyses at distinct (position, load) points, each labelled with the operating points it stands for."""
+    names = _op_names(results)
+    out, seen = [], set()
+    for a in analyses:
+        op = a.get("operating_point") or {}
+        x, ld = op.get("position"), op.get("load")
+        key = (round(x, 6) if isinstance(x, (int, float)) else None, ld if isinstance(ld, str) or ld is None else round(ld, 1))
+        if key in seen:
+            continue
+        seen.add(key)
+        which = [n for n, nx, nl in names if isinstance(x, (int, float)) and abs(nx - x) < 1e-6 and _same_load(nl, ld)]
+        label = _op_label(a)
+        out.append((label, a, which))
+    return out
+
+
+def _stability(f: dict) -> str:
+    """Against the stated margin criterion (MARGIN_CRITERION, our choice): meets / below / unstable / unknown."""
+    from compliance.report.acceptance import MARGIN_CRITERION
+
+    if f.get("stable") is False:
+        return "unstable"
+    pm, gm = f.get("phase_margin_deg"), f.get("gain_margin_db")
+    if f.get("stable") is None or pm is None or gm is None:
+        return "unknown"
+    ok = pm >= MARGIN_CRITERION["phase_margin_deg"] and gm >= MARGIN_CRITERION["gain_margin_db"]
+    return "meets" if ok else "below"
+
+
+def _map_minimum(omap: dict | None, name: str):
+    """Smallest value of a map quantity and where (position [m], load label)."""
+    vals = ((omap or {}).get("values") or {}).get(name)
+    if not vals:
+        return None
+    best = None
+    loads = omap.get("loads") or [None] * len(vals)
+    for i, row in enumerate(vals):
+        for j, v in enumerate(row):
+            if isinstance(v, (int, float)) and (best is None or v < best[0]):
+                best = (v, omap["positions"][j], loads[i])
+    return best
+
+
+def linear_section(linear: dict | None, start: int, results: dict | None = None) -> tuple[dict | None, list[dict]]:
     """Context of the linear-analysis section and its figure specs (ids from ``start``)."""
     if not linear:
         return None, []
+    from compliance.report.acceptance import MARGIN_CRITERION
+
     specs = []
 
     def add(kind, **kw):
@@ -44,7 +117,8 @@ def linear_section(linear: dict | None, start: int) -> tuple[dict | None, list[d
         return fid
 
     analyses = list(linear.get("analyses") or ([linear["analysis"]] if linear.get("analysis") else []))
-    labelled = [(_op_label(a), a) for a in analyses]
+    points_named = distinct_points(analyses, results)
+    labelled = [(f"P{k + 1} {label}", a) for k, (label, a, _) in enumerate(points_named)]  # keys as in the table
     maps = []
     omap = linear.get("map")
     if omap:
@@ -53,13 +127,22 @@ def linear_section(linear: dict | None, start: int) -> tuple[dict | None, list[d
                 maps.append({"id": add("map", omap=omap, name=name), "title": MAP_QUANTITIES[name][0],
                              "unit": MAP_QUANTITIES[name][1]})
     points = []
-    for label, a in labelled:
+    for k, (label, a, which) in enumerate(points_named):
         f = a.get("figures") or {}
-        points.append({"label": label, "time_constant": _ms(f.get("time_constant")),
+        points.append({"key": f"P{k + 1}", "label": label, "names": which, "time_constant": _ms(f.get("time_constant")),
                        "gain_margin": fmt_num(f.get("gain_margin_db"), 3), "phase_margin": fmt_num(f.get("phase_margin_deg"), 3),
                        "bandwidth": fmt_num(f.get("bandwidth_hz"), 3), "damping": fmt_num(f.get("damping_ratio"), 3),
                        "natural_frequency": fmt_num(f.get("natural_frequency_hz"), 3),
-                       "stable": f.get("stable")})
+                       "stable": f.get("stable"), "stability": _stability(f)})
+    minima = []
+    for name, unit in (("phase_margin_deg", "°"), ("gain_margin_db", " dB")):
+        m = _map_minimum(omap, name)
+        if m is not None:
+            where = f"{m[1] * 1e3:.0f} mm, " + ("no load" if m[2] is None else "load curve" if isinstance(m[2], str)
+                                                 else f"{m[2] / 1e3:+.1f} kN")
+            minima.append(f"{MAP_QUANTITIES[name][0]} {fmt_num(m[0], 3)}{unit} at {where}")
+    criterion = {"pm": MARGIN_CRITERION["phase_margin_deg"], "gm": MARGIN_CRITERION["gain_margin_db"], "minima": minima,
+                 "below": sum(1 for p in points if p["stability"] != "meets")}
     bode = add("bode", analyses=labelled) if any(a.get("bode") for _, a in labelled) else None
     poles = add("poles", analyses=labelled) if any((a.get("poles") or {}).get("closed_loop") for _, a in labelled) else None
     cross = []
@@ -81,14 +164,31 @@ def linear_section(linear: dict | None, start: int) -> tuple[dict | None, list[d
         rows = [{"name": k, "value": fmt_num(v, 4), "unit": units.get(k, "")} for k, v in params.items()]
         if g.get("Tg_linear") is not None:
             rows.append({"name": "Tg (linear)", "value": fmt_num(g["Tg_linear"], 4), "unit": "s"})
-        gov = {"model": g.get("model", "HYGOV"), "rows": rows, "basis": governor_basis(g.get("basis") or {})}
+        stroke = next((p.get("value") for p in ((results or {}).get("plant") or {}).get("parameters") or []
+                       if isinstance(p, dict) and p.get("key") == "cylinder.stroke"), None)
+        per_unit = f" (1 pu = the full stroke, {stroke * 1e3:.0f} mm)" if isinstance(stroke, (int, float)) else ""
+        intro = (f"{g.get('model', 'HYGOV')} is the hydro turbine-governor model of power-system simulation tools (IEEE PES "
+                 "TR 2013, hydro turbine-governor models): Tg is its gate-servomotor time constant, VELM the gate velocity "
+                 "limit, GMAX and GMIN the gate limits, UO and UC the opening and closing rate limits. Gate positions are "
+                 f"per unit (pu) of the stroke and rates in pu/s, per unit of stroke per second{per_unit}.")
+        gov = {"model": g.get("model", "HYGOV"), "rows": rows,
+               "basis": [intro] + governor_basis(g.get("basis") or {}, (results or {}).get("plant", {}).get("load_curve"))}
     notes = list((omap or {}).get("notes") or [])
     ctx = {"maps": maps, "points": points, "bode": bode, "poles": poles, "crosscheck": cross, "governor": gov,
-           "notes": notes, "window": (omap or {}).get("window")}
+           "notes": notes, "window": (omap or {}).get("window"), "criterion": criterion}
     return ctx, specs
 
 
-def governor_basis(b: dict) -> list[str]:
+def _curve_force(curve, x):
+    """Closing force of the load curve at position ``x`` [m] -> N (None without a curve)."""
+    import numpy as np
+
+    if not curve or not isinstance(x, (int, float)):
+        return None
+    return float(np.interp(x, curve["position"], curve["force"]))
+
+
+def governor_basis(b: dict, curve: dict | None = None) -> list[str]:
     """Where the HYGOV figures come from, in sentences (never a raw dict)."""
     if b.get("sentences"):  # the governor export writes its own (compliance.linear.governor_formats)
         return [str(s) for s in b["sentences"]]
@@ -96,7 +196,13 @@ def governor_basis(b: dict) -> list[str]:
     pt = b.get("Tg_point") or {}
     samples = [v for v in b.get("Tg_nonlinear_samples") or [] if isinstance(v, (int, float))]
     if samples:
-        where = _mm(pt.get("position")) + (", " + _load(pt.get("load")) + " load" if pt.get("load") is not None else "")
+        ld = pt.get("load")
+        if ld == "curve":
+            f = _curve_force(curve, pt.get("position"))
+            load = "on the load curve" + (f" ({f / 1e3:.1f} kN there)" if f is not None else "")
+        else:
+            load = "" if ld is None else ", " + _load(ld) + " load"
+        where = _mm(pt.get("position")) + (" " + load if ld == "curve" else load)
         out.append(f"Tg is the mean time constant of {len(samples)} nonlinear steps of "
                    + " and ".join(f"{100 * s:+.0f} %" for s in b.get("Tg_steps") or []) + f" of stroke at {where}: "
                    + ", ".join(fmt_value(v, "s", 3) for v in samples) + ".")
@@ -107,7 +213,7 @@ def governor_basis(b: dict) -> list[str]:
         out.append("UO and UC come from closed-loop strokes end to end (reference step, 25\u201375 % of stroke extrapolated)"
                    + (f" at a {fmt_value(load / 1e3, 'kN', 3)} closing load" if isinstance(load, (int, float)) else "")
                    + f": opening {fmt_value(o.get('stroke_time'), 's', 3)}, closing {fmt_value(c.get('stroke_time'), 's', 3)}. "
-                   "They differ slightly from the opening and closing times of section 2, which are judged on open-loop "
+                   "They differ slightly from the opening and closing times of section 4, which are judged on open-loop "
                    "full strokes at the governor set-up load.")
     return out
 
@@ -151,7 +257,7 @@ def validation_section(val: dict | None, start: int) -> tuple[dict | None, list[
             fid = f"fig-{start + len(specs)}"
             specs.append({"id": fid, "kind": "waveform", "series": series, "scale": scale, "ylabel": f"{label} [{unit}]",
                           "windows": _shaded(windows, sig, ov.get("time")), "smooth": sig == "valve_command"})
-            figs.append({"id": fid, "signal": label, "role": ov.get("role")})
+            figs.append({"id": fid, "signal": label, "role": ov.get("role"), "shaded": bool(specs[-1]["windows"])})
         fits = [{"signal": SIGNAL_DISPLAY.get(s, (s,))[0], "fit": fmt_num(f.get("fit_percent"), 3),
                  "nrmse": fmt_num(f.get("nrmse"), 3), "rms": _sig(f.get("rms_error"), s), "max": _sig(f.get("max_abs_error"), s),
                  "fit_after": fmt_num(((after.get("fits") or {}).get(s) or {}).get("fit_percent"), 3) if after else None}
@@ -169,7 +275,11 @@ def validation_section(val: dict | None, start: int) -> tuple[dict | None, list[
                                   "bounds": " .. ".join(fmt_num(b, 3) for b in (p.get("bounds") or []))}
                                  for p in eff.get("params") or []]})
     rec = val.get("recording") or {}
-    ctx = {"finding": diagnosis_finding(diag) if diag else None, "recording": rec, "plant": val.get("plant") or {}, "conditions": val.get("conditions") or {},
+    first = modes[0] if modes else {}
+    pos = next((f for f in first.get("fits") or [] if f["signal"] == "position"), {})
+    ctx = {"fit_before": pos.get("fit") if pos.get("fit") not in (None, "\u2013") else None,
+           "fit_after": pos.get("fit_after") if pos.get("fit_after") not in (None, "\u2013") else None,
+           "finding": diagnosis_finding(diag) if diag else None, "recording": rec, "plant": val.get("plant") or {}, "conditions": val.get("conditions") or {},
            "modes": modes, "added": added, "diagnosis": bool(diag), "explanation": diag.get("explanation"),
            "warnings": val.get("warnings") or [], "pass": (val.get("summary") or {}).get("pass")}
     return ctx, specs
@@ -209,12 +319,12 @@ def diagnosis_finding(diag: dict) -> dict:
         if e.get("name") == diag.get("winner"):
             winner = e
     params = []
+    from compliance.report.fit_bounds import effect_bound
+    from compliance.units.formatting import fmt_si
+
     for p in (winner or {}).get("parameters") or []:
-        u = p.get("unit") or ""
-        se = p.get("stderr")
-        val = fmt_num(p.get("value"), 3)
-        params.append({"name": p.get("name"), "text": f"{val} \u00b1 {fmt_num(se, 2)} {pretty_unit(u)}".strip()
-                       if se is not None else f"{val} {pretty_unit(u)}".strip(), "meaning": p.get("meaning") or ""})
+        params.append({"name": p.get("name"), "text": fmt_si(p.get("value"), p.get("unit") or "", p.get("stderr")),
+                       "meaning": p.get("meaning") or "", "bound": effect_bound(p)})
     runner = ranked[1] if len(ranked) > 1 else None
     step = NEXT_STEP.get(verdict, "")
     if runner is not None and runner.get("delta_bic") is not None and winner is not None and verdict in NEXT_STEP:
@@ -270,7 +380,8 @@ def _pct(v) -> str:
 
 
 def _sig(v, signal):
+    """An error of a signal in its display unit; an error of an absolute pressure is a difference (bar, not bar abs)."""
     if v is None:
         return "\u2013"
     label, unit, scale = SIGNAL_DISPLAY.get(signal, (signal, "", 1.0))
-    return f"{fmt_num(v * scale, 3)} {unit}"
+    return f"{fmt_num(v * scale, 3)} {unit.replace(' abs', '')}"

@@ -91,6 +91,18 @@ def setting_text(v) -> str:
     return str(v)
 
 
+def readable_settings(settings: dict) -> list[tuple[str, str]]:
+    """A settings or conditions mapping as (name in words, value in words): no Python literals, units typeset."""
+    out = []
+    for k, v in sorted(settings.items()):
+        if isinstance(v, dict):
+            text = "; ".join(f"{str(a).replace('_', ' ')} {setting_text(b)}" for a, b in sorted(v.items()) if b is not None)
+        else:
+            text = setting_text(v) if v is not None else "\u2013"
+        out.append((str(k).replace("_", " "), text or "\u2013"))
+    return out
+
+
 def status_class(status: str | None) -> str:
     """CSS class of a status badge."""
     return {"pass": "pass", "fail": "fail", "incomplete": "warn", "not_evaluated": "warn", "uncertain": "warn"}.get(status or "", "neutral")
@@ -131,10 +143,25 @@ def summary_rows(results: dict) -> list[dict]:
             "anchor": "run-" + _slug(where) if where in run_ids else None,
             "note": e.get("note"), "loosened": e.get("loosened") or [],
             # how the verdict is known and how sure it is (campaign.basis, campaign.uncertainty)
-            "basis": e.get("basis"), "basis_reason": w.get("basis_reason"), "band": e.get("band"),
+            "basis": BASIS_WORDS.get(str(e.get("basis")), str(e.get("basis")).replace("_", " ")) if e.get("basis") else None,
+            "basis_key": e.get("basis"), "basis_reason": w.get("basis_reason"),
+            "band": band_text(e.get("band"), e["metric"]), "band_pct": e.get("band"),
             "coverage": e.get("coverage"),
         })
     return out
+
+
+# how a verdict is known (the verdict work's ``basis`` key; absent in older results)
+BASIS_WORDS = {"modelled": "modelled", "by_construction": "by construction", "not_evaluated": "not evaluated",
+               "assumed": "assumed"}
+
+
+def band_text(band, metric: str) -> str | None:
+    """A verdict's value band under the declared parameter uncertainty (``{"low", "high"}``, SI) as text."""
+    if not isinstance(band, dict) or band.get("low") is None or band.get("high") is None:
+        return None
+    lo, hi = fmt_metric(band["low"], metric), fmt_metric(band["high"], metric)
+    return f"band {lo} to {hi}"
 
 
 def _run_evidence(results: dict, run_id: str) -> list[dict]:
@@ -244,9 +271,14 @@ def _slug(text: str) -> str:
 
 
 def parameter_rows(results: dict) -> list[dict]:
-    """Appendix table: every configuration parameter with value, unit, meaning and source."""
+    """Appendix table: every parameter the selected model uses, with value, unit, meaning and source."""
+    from compliance.report.signoff import used_by_model
+
     rows = []
+    options = results["plant"].get("options") or {}
     for p in sorted(results["plant"]["parameters"], key=lambda q: str(q.get("key"))):
+        if not used_by_model(str(p.get("key")), options):
+            continue  # a law or controller not selected: not part of this model
         src = p.get("source") or "\u2013"
         rows.append({"key": p.get("key"), "value": fmt_num(p.get("value"), 6), "unit": unit_text(p.get("unit", "")) or "\u2013",
                      "meaning": reader_text(p.get("meaning")), "source": src, "source_class": src if src in SOURCES else "other"})

@@ -74,7 +74,7 @@ def _shade(ax, t0, t1, color, alpha=0.12, label=None):
 
 @styled
 def trace_figure(trace: dict, marks: list, kind: str, prefix: str, *, tolerance=None, valve=None, speed_limit=None,
-                 compact: bool = False) -> str:
+                 compact: bool = False, tau_window=None) -> str:
     """Four stacked panels of one run, with the metrics measured on it marked.
 
     Parameters
@@ -103,6 +103,9 @@ def trace_figure(trace: dict, marks: list, kind: str, prefix: str, *, tolerance=
     compact : bool or "short"
         Three panels (no chamber pressures) in a shorter figure: the worst case on a requirement
         page ("short": shorter still, for a page shared by several requirements).
+    tau_window : (float, float), optional
+        Time-constant limits [s]: each step's window of allowed 63.2 % instants (from the end of
+        its dead time) is shaded on the position panel, beside the 63.2 % point measured.
     """
     label = trace.get("label")
     mk = _marks_of(marks, label) if label is not None else []
@@ -122,6 +125,8 @@ def trace_figure(trace: dict, marks: list, kind: str, prefix: str, *, tolerance=
     t_span = (float(t[0]), float(t[-1]))
 
     _position_panel(ax_x, ax_e, t, x, r, mk, closed_loop)
+    if tau_window is not None:
+        _tau_window(ax_x, mk, tau_window)
     _error_or_speed_panel(ax_e, t, x, r, closed_loop, tolerance, speed_limit)
     _command_panel(ax_u, t, _arr(trace, "valve_command"), valve)
     last = ax_u if ax_p is None else ax_p
@@ -130,6 +135,8 @@ def trace_figure(trace: dict, marks: list, kind: str, prefix: str, *, tolerance=
     last.set_xlabel("time [s]")
     last.set_xlim(*t_span)
     for ax in axes:
+        if compact:  # short panels: the unit on a second line, so stacked labels never run into each other
+            ax.set_ylabel(ax.get_ylabel().replace(" [", "\n["), linespacing=1.0)
         ax.yaxis.set_label_coords(-0.075, 0.5)  # aligned labels whatever the tick widths
     fig.subplots_adjust(left=0.1, right=0.985, top=0.94 if compact else 0.955, bottom=0.1 if compact else 0.075)
     return to_svg(fig, prefix)
@@ -161,8 +168,9 @@ def _error_or_speed_panel(ax_e, t, x, r, closed_loop, tolerance, speed_limit):
                 ax_e.axhline(s * tolerance * MM, color=COLORS["band"], lw=0.6)
         _plot(ax_e, t, e, color=COLORS["error"], lw=0.9, label="error = set-point \u2212 position")
         lim = np.nanpercentile(np.abs(e), 99.5) if np.isfinite(e).any() else 1.0
-        top = max(lim, 2.5 * tolerance * MM if tolerance else 0.0, 0.05) * 1.15
-        ax_e.set_ylim(-top, top)  # large transients are clipped: the band is what is judged
+        # scaled to the band when one is judged (step transients run off the panel: the settled error is what counts)
+        top = (2.5 * tolerance * MM) if tolerance else max(lim, 0.05) * 1.15
+        ax_e.set_ylim(-top, top)
         ax_e.set_ylabel("error [mm]")
         _legend(ax_e)
     elif x is not None:
@@ -176,6 +184,21 @@ def _error_or_speed_panel(ax_e, t, x, r, closed_loop, tolerance, speed_limit):
         _legend(ax_e)
     else:
         message_axes(ax_e, "position not recorded")
+
+
+def _tau_window(ax, mk, window) -> None:
+    """Shade, per step, where its 63.2 % instant must fall: [motion start + lo, motion start + hi]."""
+    lo, hi = window
+    first = True
+    for m in mk:
+        if m.get("type") != "motion_start" or m.get("value") is None:
+            continue
+        t0 = m["value"][0]
+        ax.axvspan(t0 + lo, t0 + hi, color=COLORS["band"], alpha=0.16, lw=0,
+                   label=f"\u03c4 limit {lo:g}\u2013{hi:g} s after motion start" if first else None)
+        first = False
+    if not first:
+        _legend(ax, top=True)
 
 
 def _command_panel(ax_u, t, u, valve):

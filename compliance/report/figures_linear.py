@@ -11,6 +11,9 @@ from matplotlib.colors import ListedColormap
 
 from compliance.report.svg import COLORS, message_axes, new_figure, plain, styled, to_svg
 
+# one colour per critical point (Okabe-Ito and two more): eight distinct points in plant A
+PALETTE = ["#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#000000", "#999933", "#882255"]
+
 MAP_QUANTITIES = {  # name -> (label, unit, display scale, requirement-window key or None)
     "time_constant": ("time constant", "ms", 1e3, "window"),
     "gain_margin_db": ("gain margin", "dB", 1.0, None),
@@ -105,7 +108,7 @@ def bode_figure(analyses: list, prefix: str) -> str:
     """
     fig, (am, ap) = new_figure("bode", 2, 1, sharex=True, gridspec_kw={"hspace": 0.1})
     shown = 0
-    palette = ["#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9"]
+    palette = PALETTE
     for k, (label, a) in enumerate(analyses):
         b = a.get("bode") or {}
         f = b.get("frequency_hz")
@@ -139,7 +142,7 @@ def bode_figure(analyses: list, prefix: str) -> str:
 def pole_figure(analyses: list, prefix: str) -> str:
     """Closed-loop poles (continuous) at each critical point, with the 0.25 s time-constant line."""
     fig, ax = new_figure("map")
-    palette = ["#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9"]
+    palette = PALETTE
     shown = 0
     for k, (label, a) in enumerate(analyses):
         poles = (a.get("poles") or {}).get("closed_loop")

@@ -8,30 +8,30 @@ against time over two strokes; the RMS error per pressure before and after; the 
 
 from __future__ import annotations
 
-import io
 from pathlib import Path
 
 import numpy as np
 
-from compliance.errors import InputError
-from compliance.files.atomic import write_text_atomic
+from compliance.report.fit_bounds import at_bound
+from compliance.report.svg import styled, to_svg
 
 
-def _svg(fig) -> str:
-    buf = io.StringIO()
-    fig.savefig(buf, format="svg", bbox_inches="tight")
-    text = buf.getvalue()
-    return text[text.find("<svg"):]
-
-
-def seal_figures(seal) -> list[tuple[str, str]]:
-    """(caption, inline SVG) of one ``SealDiagnosis``."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+@styled
+def seal_figures(seal, prefix: str = "fric") -> list[tuple[str, str]]:
+    """(caption, inline SVG) of one ``SealDiagnosis``, in the report's style (text kept, ids prefixed)."""
+    from matplotlib.figure import Figure
 
     from compliance.diagnosis.friction_fit import predict
+
+    class plt:  # the three figure sizes below, without pyplot's global state
+        @staticmethod
+        def subplots(nrows=1, ncols=1, figsize=None, squeeze=True):
+            fig = Figure(figsize=figsize)
+            return fig, fig.subplots(nrows, ncols, squeeze=squeeze)
+
+        @staticmethod
+        def close(fig):
+            return None
 
     runs = seal.runs
     base = seal.fits["baseline"]
@@ -43,16 +43,17 @@ def seal_figures(seal) -> list[tuple[str, str]]:
         r = runs[i]
         span = r.time <= min(r.time[-1], r.time[0] + 25.0)
         ax.plot(r.position[span] * 1e3, r.friction[span], color="k", lw=0.6, label="measured")
-        ax.plot(r.position[span] * 1e3, predict(r, base)[span], color="tab:blue", lw=0.7, label="baseline law")
+        ax.plot(r.position[span] * 1e3, predict(r, base)[span], color="tab:blue", lw=0.7, label="before: baseline law")
         if win is not None:
-            ax.plot(r.position[span] * 1e3, predict(r, win)[span], color="tab:orange", lw=0.7, label="with the added physics")
+            ax.plot(r.position[span] * 1e3, predict(r, win)[span], color="tab:orange", lw=0.7, label="after: with the added physics")
         ax.set_xlabel("position [mm]")
-        ax.set_ylabel("friction F - p_g A [N]")
-        ax.set_title(f"{r.name} ({r.pressure/1e5:.1f} bar g)", fontsize=9)
+        ax.set_ylabel("friction F \u2212 p\u00b7A [N]")
+        ax.set_title(f"{r.name} ({r.pressure / 1e3:.0f} kPa gauge)", fontsize=8)
         ax.grid(alpha=0.3)
     axes[0][0].legend(fontsize=7)
     fig.tight_layout()
-    out.append(("Hysteresis loops: measured friction against position, lowest and highest pressure", _svg(fig)))
+    out.append(("Hysteresis loops: measured friction against position at the lowest and highest pressure, before "
+                "(baseline law) and after (with the added physics)", to_svg(fig, f"{prefix}-1")))
     plt.close(fig)
     fig, axes = plt.subplots(len(picks), 1, figsize=(10.0, 2.6 * len(picks)), squeeze=False)
     for ax, i in zip(axes[:, 0], picks):
@@ -61,29 +62,30 @@ def seal_figures(seal) -> list[tuple[str, str]]:
         t0 = r.time[rev[2]] - 0.5 if rev.size > 4 else r.time[0]
         m = (r.time >= t0) & (r.time <= t0 + 8.0)
         ax.plot(r.time[m], r.friction[m], color="k", lw=0.7, label="measured")
-        ax.plot(r.time[m], predict(r, base)[m], color="tab:blue", lw=0.7, label="baseline law")
+        ax.plot(r.time[m], predict(r, base)[m], color="tab:blue", lw=0.7, label="before: baseline law")
         if win is not None:
-            ax.plot(r.time[m], predict(r, win)[m], color="tab:orange", lw=0.7, label="with the added physics")
+            ax.plot(r.time[m], predict(r, win)[m], color="tab:orange", lw=0.7, label="after: with the added physics")
         ax.set_ylabel("friction [N]")
-        ax.set_title(f"{r.name}", fontsize=9)
+        ax.set_title(f"{r.name}", fontsize=8)
         ax.grid(alpha=0.3)
     axes[-1, 0].set_xlabel("time [s]")
     axes[0, 0].legend(fontsize=7, ncol=3)
     fig.tight_layout()
-    out.append(("Friction against time over a few strokes (reversals: the transitions)", _svg(fig)))
+    out.append(("Friction against time over a few strokes, before and after (reversals: the transitions)",
+                to_svg(fig, f"{prefix}-2")))
     plt.close(fig)
     fig, ax = plt.subplots(figsize=(5.5, 3.2))
-    p = np.array([r.pressure / 1e5 for r in runs])
+    p = np.array([r.pressure / 1e3 for r in runs])
     w = 0.35 * (np.min(np.diff(p)) if p.size > 1 else 1.0)
-    ax.bar(p - w / 2, base.rms_per_run(), width=w, color="tab:blue", label="baseline law")
+    ax.bar(p - w / 2, base.rms_per_run(), width=w, color="tab:blue", label="before: baseline law")
     if win is not None:
-        ax.bar(p + w / 2, win.rms_per_run(), width=w, color="tab:orange", label=seal.winner.replace("+", " +\n"))
-    ax.set_xlabel("chamber pressure [bar g]")
+        ax.bar(p + w / 2, win.rms_per_run(), width=w, color="tab:orange", label="after: " + seal.winner.replace("+", " +\n"))
+    ax.set_xlabel("chamber pressure [kPa gauge]")
     ax.set_ylabel("RMS friction error [N]")
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3, axis="y")
     fig.tight_layout()
-    out.append(("RMS friction error per pressure, before and after", _svg(fig)))
+    out.append(("RMS friction error per pressure, before (baseline law) and after (the winning law)", to_svg(fig, f"{prefix}-3")))
     plt.close(fig)
     return out
 
@@ -94,47 +96,58 @@ DBIC_TEXT = ("\u0394BIC: Bayesian information criterion relative to the best law
              "are penalised). A difference above 10 is strong evidence; under 2 the data do not decide.")
 
 
-def _sha256(path) -> str | None:
-    import hashlib
+def _param_rows(params: list) -> list[dict]:
+    """Fitted parameters with SI prefixes, standard errors and a flag when a value sits on its fit bound."""
+    from compliance.diagnosis.friction_fit import FIT_BOUNDS
+    from compliance.units.formatting import fmt_si
 
-    try:
-        return hashlib.sha256(Path(path).read_bytes()).hexdigest()
-    except OSError:
-        return None
+    rows = []
+    for p in params:
+        if p.get("value") is None:
+            continue
+        b = FIT_BOUNDS.get(p["name"])
+        pinned = bool(b) and at_bound(p["value"], *b)
+        rows.append({"name": p["name"].replace("_", " "), "meaning": p.get("meaning") or "",
+                     "text": fmt_si(p["value"], p.get("unit") or "", p.get("stderr")),
+                     "bound": (f"at its fit bound ({fmt_si(b[0] if abs(p['value'] - b[0]) < abs(p['value'] - b[1]) else b[1], p.get('unit') or '')}): "
+                               "the data do not determine it and its standard error means nothing") if pinned else None})
+    return rows
 
 
-def _seal_context(seal, sd: dict) -> dict:
-    """What the report shows of one seal: finding, parameters with errors (SI units), ranked laws, residual remarks."""
-    from compliance.units.formatting import fmt_num, fmt_value, unit_text
+def _seal_context(seal, sd: dict, index: int) -> dict:
+    """What the report shows of one seal: finding, parameters with errors (SI prefixes), ranked laws, residual remarks."""
+    from compliance.units.formatting import fmt_num, fmt_si, fmt_value
 
     win = next((e for e in sd["effects"] if e["name"] == sd["winner"]), None) if sd["winner"] else None
-    params = [{"name": p["name"], "meaning": p.get("meaning") or "",
-               "text": f"{fmt_num(p['value'], 3)} \u00b1 {fmt_num(p['stderr'], 2)} {unit_text(p['unit'])}" if p.get("stderr") is not None
-               else f"{fmt_num(p['value'], 3)} {unit_text(p['unit'])}"}
-              for p in (win or {}).get("parameters") or [] if p.get("value") is not None]
-    ranked = [{"name": e["name"], "k": e["k"], "chi2": fmt_num(e.get("chi2_per_residual"), 3),
-               "dbic": fmt_num(e.get("delta_bic"), 3), "explained": fmt_value(100 * (e.get("explained_fraction") or 0), "%", 2),
-               "params": "; ".join(f"{p['name']} = {fmt_num(p['value'], 3)} {unit_text(p['unit'])}" for p in e["parameters"]
-                                   if p.get("value") is not None)} for e in sd["effects"]]
+    params = _param_rows((win or {}).get("parameters") or [])
+    ranked = [{"name": e["name"].replace("+", " + ").replace("_", " "), "k": e["k"], "chi2": fmt_num(e.get("chi2_per_residual"), 3),
+               "dbic": _dbic(e.get("delta_bic")), "explained": fmt_value(100 * (e.get("explained_fraction") or 0), "%", 3),
+               "params": "; ".join(f"{p['name'].replace('_', ' ')} {fmt_si(p['value'], p.get('unit') or '')}"
+                                   for p in e["parameters"] if p.get("value") is not None)} for e in sd["effects"]]
     floor = (sd.get("noise_floor") or {}).get("value")
     runs, remarks, after = [], [], []
     for run, b in sd["fit_before"].items():
         a = (sd.get("fit_after") or {}).get(run)
-        runs.append({"run": run, "p": fmt_value(b["pressure_gauge"] / 1e5, "bar", 3), "before": fmt_value(b["rms"], "N", 3),
-                     "after": fmt_value(a["rms"], "N", 3) if a else "\u2013"})
+        runs.append({"run": run, "p": fmt_si(b["pressure_gauge"], "Pa") + " gauge", "before": fmt_si(b["rms"], "N"),
+                     "after": fmt_si(a["rms"], "N") if a else "\u2013"})
         if a:
             after.append((a["rms"], b["pressure_gauge"], run))
     if after and floor:
         worst, best = max(after), min(after)
         if worst[0] > 2.0 * floor:
-            remarks.append(f"Residual left: the fitted law still misses by {fmt_value(worst[0], 'N', 3)} RMS at "
-                           f"{fmt_value(worst[1] / 1e5, 'bar', 2)} ({worst[2]}), {worst[0] / floor:.0f} \u00d7 the force noise "
-                           f"({fmt_value(floor, 'N', 2)}), against {fmt_value(best[0], 'N', 3)} at "
-                           f"{fmt_value(best[1] / 1e5, 'bar', 2)}. No candidate explains the rest; it is not noise. "
-                           "Use the law within the pressures tested and treat the remainder as model uncertainty.")
-    return {"seal": sd["seal"], "verdict": sd["verdict"], "winner": sd["winner"], "runner_up": sd.get("runner_up"),
+            remarks.append(f"Residual left: the fitted law still misses by {fmt_si(worst[0], 'N')} RMS at "
+                           f"{fmt_si(worst[1], 'Pa')} gauge ({worst[2]}), {worst[0] / floor:.0f} \u00d7 the force noise "
+                           f"({fmt_si(floor, 'N')}), against {fmt_si(best[0], 'N')} at {fmt_si(best[1], 'Pa')} gauge. No "
+                           "candidate explains the rest; it is not noise. Use the law within the pressures tested and treat "
+                           "the remainder as model uncertainty.")
+    pinned = [p["name"] for p in params if p["bound"]]
+    if pinned:
+        remarks.append("Parameters at their fit bounds (" + ", ".join(pinned) + "): the runs do not determine them; "
+                       "record runs that excite them (slower strokes for a Stribeck velocity) before using their values.")
+    return {"seal": sd["seal"], "seal_index": index, "verdict": sd["verdict"], "winner": (sd["winner"] or "").replace("+", " + ").replace("_", " "),
+            "runner_up": (sd.get("runner_up") or "").replace("+", " + ").replace("_", " "),
             "explanation": sd["explanation"], "params": params, "ranked": ranked, "runs": runs, "remarks": remarks,
-            "figures": seal_figures(seal), "holdout": _holdout_context(sd.get("holdout"))}
+            "figures": seal_figures(seal, f"fig-{index}"), "holdout": _holdout_context(sd.get("holdout"))}
 
 
 def _holdout_context(h: dict | None) -> dict | None:
@@ -154,32 +167,54 @@ def _holdout_context(h: dict | None) -> dict | None:
     return {"rows": rows, "note": note}
 
 
-def write_friction_report(diag, html_path) -> Path:
-    """Write the HTML report of a ``FrictionDiagnosis`` (atomically; refuses a directory).
+def _dbic(v) -> str:
+    """A BIC difference: whole numbers with thin-space thousands ("6 102 968"), small ones to one decimal."""
+    if v is None:
+        return "\u2013"
+    return f"{v:.1f}" if abs(v) < 100 else f"{v:,.0f}".replace(",", "\u2009")
 
-    Same template family, CSS and sign-off block as the compliance and validation reports:
-    the finding per seal first (verdict, law, fitted parameters with standard errors in SI
-    units, next step), then the evidence.
+
+BENCH_FIELDS = (("rig", "Test rig"), ("seal", "Seal"), ("bore", "Bore"), ("temperature", "Temperature"),
+                ("operator", "Operator"), ("date", "Date of the runs"))
+
+
+def write_friction_report(diag, html_path, pdf_path=None, *, document: dict | None = None, bench: dict | None = None):
+    """Write the HTML (and PDF) report of a ``FrictionDiagnosis``, atomically.
+
+    Same template family, CSS, document control and sign-off block as the compliance and
+    validation reports: the finding per seal first (verdict, law, fitted parameters with standard
+    errors and SI prefixes, parameters at a fit bound flagged, next step), then the evidence.
+    ``document``: ``number`` / ``revision`` (without a number the report is a DRAFT); ``bench``:
+    identity of the bench (rig, seal, bore, temperature, operator, date; blanks where not given).
     """
     import datetime as _dt
 
-    from compliance import __version__
-    from compliance.report.render import _css, _environment
+    from compliance.report.render import _check_target, _common, _emit, file_sha256
+    from compliance.report.signoff import document_block
     from compliance.units.formatting import fmt_date
 
-    path = Path(html_path)
-    if path.is_dir():
-        raise InputError(f"--report {path}: is a directory; expected an .html file name")
+    if html_path:
+        html_path = _check_target(html_path, "--report")
+    if pdf_path:
+        _check_target(pdf_path, "--pdf")
+    document = document or {}
     data = diag.to_dict()
-    seals = [_seal_context(seal, sd) for seal, sd in zip(diag.seals, data["seals"])]
+    seals = [_seal_context(seal, sd, i + 1) for i, (seal, sd) in enumerate(zip(diag.seals, data["seals"]))]
+    recordings = [{"what": "Recording", "path": Path(f).name, "digest": file_sha256(f)} for f in data["recordings"]]
+    bench = dict(bench or {})
+    bench.setdefault("seal", ", ".join(s["seal"] for s in seals))
+    ident = {"document_number": document.get("number")} if document.get("number") else {}
     now = fmt_date(_dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"))
-    ctx = {"recordings": [{"name": Path(f).name, "sha256": _sha256(f)} for f in data["recordings"]],
-           "verdict": data["verdict"], "seals": seals, "rendered": now, "govcheck_version": __version__,
-           "chi2_text": CHI2_TEXT, "dbic_text": DBIC_TEXT}
-    import jinja2
-
-    html_text = _environment().get_template("friction.html.j2").render(**ctx, css=jinja2.utils.markupsafe.Markup(_css()),
-                                                                       svg=jinja2.utils.markupsafe.Markup)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    write_text_atomic(path, html_text)
-    return path
+    svgs = {}
+    for s in seals:
+        named = []
+        for caption, svg in s["figures"]:
+            fid = f"fig-{len(svgs) + 1}"  # numbered through the document (the SVG's inner ids carry the seal)
+            svgs[fid] = svg
+            named.append((caption, fid))
+        s["figures"] = named
+    ctx = {**_common({}), "rendered": now, "verdict": data["verdict"], "seals": seals, "chi2_text": CHI2_TEXT,
+           "dbic_text": DBIC_TEXT, "doc": document_block(ident, recordings, document, needs_identity=False),
+           "bench": [(label, bench.get(key)) for key, label in BENCH_FIELDS]}
+    _emit("friction.html.j2", ctx, svgs, html_path, pdf_path)
+    return html_path

@@ -28,11 +28,12 @@ from compliance.errors import InputError
 from compliance.files.atomic import write_bytes_atomic
 from compliance.files.display import display_path
 from compliance.files.reproducible import fixed_created, is_reproducible
+from compliance.report import acceptance as A
 from compliance.report import content as C
 from compliance.report import signoff as S
 from compliance.report.analysis_sections import linear_section, validation_section
 from compliance.report.requirement_pages import requirement_pages
-from compliance.units.formatting import fmt_date, fmt_num, status_word, unit_text
+from compliance.units.formatting import fmt_date, fmt_num, fmt_si, status_word, unit_text
 
 TEMPLATES = resources.files("compliance.report") / "templates"
 VALIDATION_SCHEMA = "govcheck.validation/1"
@@ -51,7 +52,13 @@ def _draw(spec: dict, valve: dict | None = None) -> str:
     if k == "trace":
         return figures.trace_figure(spec["trace"], spec["marks"], spec["run_kind"], spec["id"],
                                     tolerance=spec.get("tolerance"), valve=valve, speed_limit=spec.get("speed_limit"),
-                                    compact=spec.get("compact", False))
+                                    compact=spec.get("compact", False), tau_window=spec.get("tau_window"))
+    if k in ("strokes", "dead_band"):
+        from compliance.report import figures_judged
+
+        if k == "strokes":
+            return figures_judged.stroke_pair_figure(spec["traces"], spec["marks"], spec["id"])
+        return figures_judged.dead_band_figure(spec["trace"], spec["id"], spec.get("limit"))
     if k == "map":
         return figures_linear.map_figure(spec["omap"], spec["name"], spec["id"])
     if k == "bode":
@@ -119,7 +126,7 @@ def _environment() -> jinja2.Environment:
         lstrip_blocks=True,
     )
     env.filters.update(status_class=C.status_class, status_word=status_word, num=fmt_num, unit=unit_text,
-                       setting=C.setting_text, words=C.reader_text)
+                       setting=C.setting_text, words=C.reader_text, si=lambda v, u: fmt_si(v, u or ""))
     return env
 
 
@@ -138,8 +145,11 @@ def _render(template: str, ctx: dict, svgs: dict, for_pdf: bool) -> str:
             return jinja2.utils.markupsafe.Markup(f'<img class="figure-img" alt="" src="{_svg_data_uri(svg)}">')
         return jinja2.utils.markupsafe.Markup(svg)  # our own SVG, user text never inside (see svg.py)
 
-    return env.get_template(template).render(**ctx, css=jinja2.utils.markupsafe.Markup(_css()), figure=figure,
-                                             for_pdf=for_pdf)
+    from compliance.report.svg import draft_mark_svg
+
+    Markup = jinja2.utils.markupsafe.Markup
+    draft = {"svg": Markup(draft_mark_svg()), "uri": Markup(_svg_data_uri(draft_mark_svg()))}
+    return env.get_template(template).render(**ctx, css=Markup(_css()), figure=figure, for_pdf=for_pdf, draft=draft)
 
 
 def _pdf_bytes(html: str) -> bytes:
@@ -204,12 +214,13 @@ def _common(results: dict) -> dict:
 APPENDIX_LEVELS = ("none", "summary", "full")
 
 
-def build_report(results: dict, workers: int | None = None, appendix: str = "summary") -> tuple[dict, dict]:
+def build_report(results: dict, workers: int | None = None, appendix: str = "summary",
+                 document: dict | None = None) -> tuple[dict, dict]:
     """Check the results and build the template context and the figures (no file written).
 
     ``appendix``: ``none`` (sign-off page, requirement pages, linear and validation sections),
     ``summary`` (+ configuration, requirement file, command, versions) or ``full`` (+ every run
-    with its figures).
+    with its figures). ``document``: see :func:`compliance.report.signoff.document_control`.
     """
     if appendix not in APPENDIX_LEVELS:
         raise InputError(f"--appendix {appendix}: expected one of {', '.join(APPENDIX_LEVELS)}")
@@ -217,7 +228,7 @@ def build_report(results: dict, workers: int | None = None, appendix: str = "sum
     pages, specs = requirement_pages(results, 1)
     sections, run_specs = C.procedure_sections(results, len(specs) + 1) if appendix == "full" else ([], [])
     specs += run_specs
-    lin_ctx, lin_specs = linear_section(results.get("linear"), len(specs) + 1)
+    lin_ctx, lin_specs = linear_section(results.get("linear"), len(specs) + 1, results)
     val_ctx, val_specs = validation_section(results.get("validation"), len(specs) + len(lin_specs) + 1)
     svgs = draw_figures(specs + lin_specs + val_specs, C.valve_marks(results), workers)
     plant, rs, summary = results["plant"], results["requirement_set"], results["summary"]
@@ -233,8 +244,15 @@ def build_report(results: dict, workers: int | None = None, appendix: str = "sum
         "basis": S.basis(results),
         "failures": S.failures(results),
         "not_evaluated": S.not_evaluated(results),
-        "deviations": S.deviations(results),
         "assumptions": S.assumptions(results),
+        "doc": S.document_control(results, document),
+        "scope": A.scope(results),
+        "conditions": A.conditions(results),
+        "method": A.method_rows(results),
+        "not_tested": A.not_tested(results),
+        "code_deviations": A.code_deviations(results),
+        "conclusions": A.conclusions(results),
+        "parties": A.parties(plant.get("identity") or {}),
         "remedies": results.get("remedies"),
         "pages": pages,
         "appendix": appendix,
@@ -253,7 +271,7 @@ def build_report(results: dict, workers: int | None = None, appendix: str = "sum
 
 
 def render_report(results: dict, html_path=None, pdf_path=None, *, workers: int | None = None,
-                  appendix: str = "summary") -> None:
+                  appendix: str = "summary", document: dict | None = None) -> None:
     """Render the compliance report of a ``govcheck check`` results dict.
 
     Parameters
@@ -269,6 +287,9 @@ def render_report(results: dict, html_path=None, pdf_path=None, *, workers: int 
     appendix : {"none", "summary", "full"}
         What follows the body: nothing; the configuration, requirement file, command and
         versions; or also every run with its figures.
+    document : dict, optional
+        ``number`` and ``revision`` (override the configuration's ``[identity]``) and
+        ``results`` (``{"path", "digest"}`` of the saved results file), for the document control.
 
     Raises
     ------
@@ -281,8 +302,18 @@ def render_report(results: dict, html_path=None, pdf_path=None, *, workers: int 
         _check_target(html_path, "--report")
     if pdf_path:
         _check_target(pdf_path, "--pdf")
-    ctx, svgs = build_report(results, workers, appendix)
+    ctx, svgs = build_report(results, workers, appendix, document)
     _emit("report.html.j2", ctx, svgs, html_path, pdf_path)
+
+
+def file_sha256(path) -> str | None:
+    """sha256 of a recording file when it is still where the result says (else None: not cited)."""
+    import hashlib
+
+    try:
+        return hashlib.sha256(Path(path).read_bytes()).hexdigest() if path else None
+    except OSError:
+        return None
 
 
 def check_validation(result, where: str = "validation results") -> None:
@@ -301,7 +332,8 @@ def check_validation(result, where: str = "validation results") -> None:
         raise InputError(f"{where}: key 'modes' should be an object of replay modes")
 
 
-def render_validation_report(result: dict, html_path, pdf_path=None, *, workers: int | None = None) -> None:
+def render_validation_report(result: dict, html_path, pdf_path=None, *, workers: int | None = None,
+                             document: dict | None = None) -> None:
     """Render the model-validation report of ``govcheck validate`` / ``govcheck diagnose``.
 
     Parameters
@@ -312,8 +344,14 @@ def render_validation_report(result: dict, html_path, pdf_path=None, *, workers:
         ``added``: effects with fitted parameters; ``explanation``: text).
     html_path : path
     pdf_path : path, optional
+    document : dict, optional
+        ``number``, ``revision`` and ``identity`` (the configuration's ``[identity]``) for the
+        document control; without identity and number the report is a DRAFT.
     """
-    _check_target(html_path, "--report")
+    if not html_path and not pdf_path:
+        raise InputError("render_validation_report: give html_path and/or pdf_path")
+    if html_path:
+        _check_target(html_path, "--report")
     if pdf_path:
         _check_target(pdf_path, "--pdf")
     check_validation(result)
@@ -322,7 +360,14 @@ def render_validation_report(result: dict, html_path, pdf_path=None, *, workers:
     plant = dict(result.get("plant") or {})
     plant["path"] = display_path(plant.get("path"))  # never an installation's absolute path
     ctx["recording"] = dict(ctx["recording"], path=display_path(ctx["recording"].get("path")))
+    rec = ctx["recording"]
+    digest = rec.get("digest") or rec.get("sha256") or file_sha256(result.get("recording", {}).get("path"))
+    files = [{"what": "Plant configuration", "path": plant.get("path") or plant.get("name"), "digest": plant.get("digest")},
+             {"what": "Recording", "path": rec.get("path"), "digest": digest}]
+    document = document or {}
     ctx = {**_common({"versions": {"govcheck": (result.get("tool") or {}).get("version", __version__)}}),
-           "v": ctx, "plant": plant, "settings": result.get("settings") or {}, "windows": result.get("windows") or [],
-           "created": fmt_date(result.get("created"))}
+           "v": ctx, "plant": plant, "settings": C.readable_settings(result.get("settings") or {}),
+           "conditions": C.readable_settings(ctx.get("conditions") or {}), "windows": result.get("windows") or [],
+           "created": fmt_date(result.get("created")), "identity": document.get("identity") or {},
+           "doc": S.document_block(document.get("identity") or {}, files, document)}
     _emit("validation.html.j2", ctx, svgs, html_path, pdf_path)

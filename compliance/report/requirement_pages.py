@@ -9,6 +9,8 @@ servo actually covered is given, and excluded samples say why they were left out
 
 from __future__ import annotations
 
+import re
+
 from compliance.metrics import METRICS
 from compliance.units.formatting import fmt_margin_pct, fmt_value, unit_text
 
@@ -17,15 +19,25 @@ SPEED_METRICS = ("max_speed", "max_opening_speed", "max_closing_speed")
 STEP_TOLERANCE_METRICS = ("max_positioning_error", "steady_state_error")
 
 
-_PAPER_WORDS = (("seed 000", "plant-A paper"), ("seed 001", "plant-B paper"), ("seed section", "plant-A paper section"))
+_PAPER_WORDS = (("seed 000", "plant-A paper"), ("seed 001", "plant-B paper"), ("seed section", "plant-A paper section"),
+                ("seed paper", "source paper"), ("the seed", "the source paper"))
+_DOC_REF_RE = re.compile(r"\s*\((?:see )?[^()]*\b[\w./-]+\.(?:md|py|toml)\b[^()]*\)")  # "(reference-plant.md, 'Known tension')"
+_MODULE_REF_RE = re.compile(r"\bcompliance\.(\w+)(?:\.\w+)*")
+_PAPER_SECTION_RE = re.compile(r"(paper section [\d.]+, [^;)]*?)\bin section (\d[\d.]*)")
 
 
 def reader_text(text) -> str:
-    """Text from our declarations for a reader: internal names of the source papers in words."""
+    """Text from our declarations for a reader: internal names of the source papers in words, no file or module names.
+
+    A parenthesis that points at one of our documentation files is dropped (the report cannot
+    send its reader to the code base); a module named in a note becomes the stage it belongs to.
+    """
     text = "" if text is None else str(text)
     for a, b in _PAPER_WORDS:
         text = text.replace(a, b)
-    return text
+    text = _DOC_REF_RE.sub("", text)
+    text = _PAPER_SECTION_RE.sub(r"\1in the paper's section \2", text)  # never read as a section of this report
+    return _MODULE_REF_RE.sub(lambda m: f"govcheck's {m.group(1).replace('_', ' ')} analysis", text)
 
 
 def metric_text(value, metric: str) -> str:
@@ -105,7 +117,7 @@ def _grouped(rows: list[dict]) -> list[dict]:
         if len(ms) == 1:
             continue
         if g["status"] == "not_evaluated":
-            g["steps"] = [{"text": "first point shown, the others alike (all in appendix E):",
+            g["steps"] = [{"text": "first point shown, the others alike:",
                            "excluded": True}] + g["steps"]
             continue
         worst = min(ms, key=lambda c: c["raw_margin"] if c["raw_margin"] is not None else float("inf"))
@@ -121,15 +133,59 @@ def _grouped(rows: list[dict]) -> list[dict]:
 
 
 def _pick_trace(run: dict, which: str | None) -> dict | None:
+    """The trace of ``run`` that the worst case ``which`` was measured on.
+
+    ``which`` names the direction first and, for the independent-adjustment runs, the valve
+    changed ("closing time when opening valve x0.5" -> trace "... opening x0.5 closing").
+    """
+    import re
+
     traces = run.get("traces") or []
     if not traces:
         return None
     if which:
+        words = str(which).split()
+        m = re.search(r"when (\w+) valve (x[\d.]+)", str(which))
+        if m and words:
+            want = f" {m.group(1)} {m.group(2)} {words[0]}"
+            for tr in traces:
+                if str(tr.get("label") or "").endswith(want):
+                    return tr
+        for tr in traces:
+            tail = str(tr.get("label") or "").rsplit(" ", 1)[-1]
+            if tail and words and tail == words[0]:
+                return tr
         for tr in traces:
             tail = str(tr.get("label") or "").rsplit(" ", 1)[-1]
             if tail and tail in which:
                 return tr
     return traces[0]
+
+
+def trace_words(label, run: dict) -> str:
+    """What a trace shows, from its own label (the caption is made from the data drawn, never from the verdict)."""
+    tail = str(label or "")
+    head = f"{run.get('procedure')}@{run.get('operating_point')}"
+    tail = tail[len(head):].strip() if tail.startswith(head) else ""
+    m = tail.split()
+    if len(m) == 3 and m[1].startswith("x"):
+        return f"{m[2]} stroke with the {m[0]} flow-control valve set to {m[1][1:]} \u00d7 its conductance"
+    if len(m) == 2 and m[0] == "base":
+        return f"{m[1]} stroke with both flow-control valves as set"
+    return f"{tail} stroke" if tail in ("opening", "closing") else tail
+
+
+def _stroke_partner(run: dict, tr: dict, entries: list) -> dict | None:
+    """The other direction's stroke when a page judges both opening and closing times on the same run."""
+    metrics = {e["metric"] for e in entries}
+    if not {"opening_time", "closing_time"} <= metrics:
+        return None
+    label = str(tr.get("label") or "")
+    for a, b in (("opening", "closing"), ("closing", "opening")):
+        if label.endswith(" " + a):
+            want = label[: -len(a)] + b
+            return next((t for t in run.get("traces") or [] if t.get("label") == want), None)
+    return None
 
 
 def _speed_excess(trace: dict, limit: float) -> dict | None:
@@ -166,7 +222,7 @@ def _distinct_reasons(reasons) -> list[str]:
 
 
 def requirement_pages(results: dict, start: int = 1) -> tuple[list[dict], list[dict]]:
-    """Pages of section 2 and their figure specs (ids from ``fig-{start}``).
+    """Pages of section 4 and their figure specs (ids from ``fig-{start}``).
 
     Requirements judged on exactly the same runs share a page (e.g. the opening/closing times
     of IEC 61362 and IEEE 125 on the same strokes); the page's plot is the worst case of its
@@ -204,12 +260,22 @@ def requirement_pages(results: dict, start: int = 1) -> tuple[list[dict], list[d
             lim = w.get("limit") or ((lead.get("rows") or [{}])[0].get("limit"))
             spec = {"id": f"fig-{start + len(specs)}", "kind": "trace", "trace": tr, "marks": run.get("marks") or [],
                     "run_kind": run["kind"], "compact": "short" if len(entries) > 2 or sum(len(r["cases"]) for r in reqs) >= 3 else True, "tolerance": max(lim) if lim and lead["metric"] in TOLERANCE_METRICS else None,
-                    "speed_limit": max(lim) if lim and lead["metric"] in SPEED_METRICS else None}
+                    "speed_limit": max(lim) if lim and lead["metric"] in SPEED_METRICS else None,
+                    "tau_window": tuple(lim) if lim and len(lim) == 2 and lead["metric"] == "time_constant" else None}
+            partner = _stroke_partner(run, tr, entries)
+            if partner is not None:  # opening and closing times on one page: both strokes drawn
+                spec = {"id": spec["id"], "kind": "strokes", "traces": [tr, partner], "marks": run.get("marks") or []}
+            elif lead["metric"] == "dead_band" and run["kind"] == "dead_band":  # the loop, with the width allowed
+                spec = {"id": spec["id"], "kind": "dead_band", "trace": tr, "limit": max(lim) if lim else None}
             specs.append(spec)
+            shown = [trace_words(t.get("label"), run) for t in ([tr, partner] if partner is not None else [tr])]
             page["figure"] = {"id": spec["id"], "run": run["id"], "procedure": run["procedure"],
-                              "operating_point": run["operating_point"], "which": w.get("which"),
-                              "trace": tr.get("label"), "limit_drawn": spec["tolerance"] is not None or spec["speed_limit"] is not None}
-            if spec["speed_limit"]:
+                              "operating_point": run["operating_point"], "which": " and ".join(x for x in shown if x),
+                              "trace": tr.get("label"),
+                              "limit_drawn": any(spec.get(k) is not None for k in ("tolerance", "speed_limit", "limit")),
+                              "kind": spec["kind"],
+                              "tau": spec.get("tau_window") is not None, "band_scaled": spec.get("tolerance") is not None}
+            if spec.get("speed_limit"):
                 ex = _speed_excess(tr, spec["speed_limit"])
                 if ex and ex.get("duration"):
                     page["facts"].append(
@@ -243,5 +309,5 @@ def _linear_contrast(results: dict) -> str | None:
         return None
     return ("Why a smaller time constant appears elsewhere: " + " and ".join(parts) + ". Both are small-signal figures "
             "(the linear model leaves out the valve dead zone, breakaway friction and flow saturation; Tg is the mean of two "
-            "5 % steps at one point). This requirement is judged on every simulated step of the nonlinear model; section 3's "
+            "5 % steps at one point). This requirement is judged on every simulated step of the nonlinear model; section 5's "
             "cross-check names the cause of the difference at each point.")

@@ -3,9 +3,8 @@
 The verdict with the basis it rests on (a simulated model; how many of its parameters are
 from the paper, assumed, derived, set by the user or fitted; whether the model was validated
 against a recording), every failure in one line with its failing number and what would fix it,
-the test cases that could not be evaluated with their reasons, the document identity and the
-deviations list (every FAIL and OPEN item with an owner to fill in), and the assumptions and
-what was not tested, in one place.
+the test cases that could not be evaluated with their reasons, the document control (number,
+revision, DRAFT state, the sha256 of every input) and the model assumptions.
 """
 
 from __future__ import annotations
@@ -13,29 +12,124 @@ from __future__ import annotations
 from collections import Counter
 
 from compliance.report.requirement_pages import limit_text, metric_text
-from compliance.units.formatting import STATUS_WORD, fmt_margin_pct
+from compliance.units.formatting import fmt_margin_pct, fmt_si
 
 SOURCE_WORDS = {"paper": "from the paper", "assumed": "assumed", "derived": "derived", "user": "set by the user",
                 "fitted": "fitted to a recording"}
 
 
+# parameters read only under one option value (model/assembly.py: the flow law, the friction law and the
+# controller type pick their own parameters; the others are not read at all)
+_ONLY_WHEN = (
+    (("valve.sonic_conductance", "valve.critical_pressure_ratio", "air.reference_density", "air.reference_temperature",
+      "flow_control."), "valve.flow_law", ("iso6358",)),
+    (("valve.effective_area",), "valve.flow_law", ("sanville",)),
+    (("valve.bobrow_coefficient",), "valve.flow_law", ("bobrow",)),
+    (("valve.power_law_",), "valve.flow_law", ("power_law",)),
+    (("friction.bristle_",), "friction.model", ("lugre",)),
+    (("friction.limit_velocity",), "friction.model", ("variable_viscous", "piecewise_stribeck")),
+    (("friction.static_force", "friction.coulomb_force", "friction.stribeck_velocity", "friction.viscous_coefficient"),
+     "friction.model", ("lugre", "variable_viscous")),
+    (("friction.breakaway_force", "friction.low_speed_coefficient", "friction.critical_velocity",
+      "friction.high_speed_coefficient"), "friction.model", ("piecewise_stribeck",)),
+    (("controller.closed_loop_", "controller.acceleration_observer", "controller.friction_observer",
+      "controller.velocity_filter"), "controller.type", ("state_feedback",)),
+    (("controller.kp", "controller.ki", "controller.kd", "controller.filter_cutoff", "controller.compensation_"),
+     "controller.type", ("pid",)),
+)
+
+
+def used_by_model(key: str, options: dict) -> bool:
+    """Whether the selected model (its flow law, friction law, controller) reads parameter ``key``."""
+    for prefixes, option, values in _ONLY_WHEN:
+        if any(key == p or (p.endswith(("_", ".")) and key.startswith(p)) for p in prefixes):
+            return str(options.get(option, "")) in values
+    return True
+
+
+def _deciding(results: dict, used: list[dict]) -> list[str]:
+    """The assumptions that decide verdicts: named by the verdicts' bands when present, else the usual suspects."""
+    named = []
+    for e in results["requirements"]:
+        for key in ((e.get("band") or {}).get("deciding") or []):
+            if key not in named:
+                named.append(str(key))
+    assumed = [p["key"] for p in used if p.get("source") == "assumed"]
+    out = []
+    if named:
+        out += [k for k in named][:3]
+    friction = [k for k in assumed if k.startswith("friction.")]
+    if friction and not any(k.startswith("friction.") for k in out):
+        out.append("every friction value (" + ", ".join(k.split(".", 1)[1].replace("_", " ") for k in friction) + ")")
+    curve = results["plant"].get("load_curve") or {}
+    ops = results["requirement_set"].get("operating_points") or {}
+    if curve and curve.get("source", "assumed") == "assumed" and any(o.get("load") == "curve" for o in ops.values()):
+        out.append("the gate load curve over the stroke")
+    for k in ("valve.saturation_voltage",):
+        if k in assumed:
+            out.append("the valve's full-opening voltage")
+    return out
+
+
 def basis(results: dict) -> dict:
-    """What every number of the report comes from: the model, its parameter sources, validation."""
+    """What every number of the report comes from: the model, the sources of the parameters it uses, validation."""
     plant = results["plant"]
-    counts = Counter(str(p.get("source") or "assumed") for p in plant.get("parameters") or [])
+    options = plant.get("options") or {}
+    params = [p for p in plant.get("parameters") or [] if isinstance(p, dict)]
+    used = [p for p in params if used_by_model(str(p.get("key")), options)]
+    counts = Counter(str(p.get("source") or "assumed") for p in used)
     fitted = sum(len(e.get("params") or []) for e in plant.get("effects") or [])
     parts = [f"{n} {SOURCE_WORDS.get(s, s)}" for s, n in counts.most_common()]
     val = results.get("validation")
     if val:
         ok = (val.get("summary") or {}).get("pass")
-        rec = (val.get("recording") or {}).get("path") or "a recording"
-        validated = f"validated against {rec}: {'PASS' if ok else 'FAIL' if ok is False else 'not decided'} (section 4)"
+        validated = (f"validated against a recording: {'PASS' if ok else 'FAIL' if ok is False else 'not decided'} "
+                     "(section 6)")
     else:
-        validated = "not validated: no recording of this servo was compared with the model (run govcheck validate)"
-    return {"model": plant["name"], "path": plant.get("path"), "params": ", ".join(parts), "n_params": sum(counts.values()),
-            "assumed": counts.get("assumed", 0), "effects": [e.get("name") for e in plant.get("effects") or []],
-            "fitted": fitted, "validated": validated, "validation_run": bool(val),
+        validated = "not validated: no recording of this servo was compared with the model"
+    bases = Counter(str(e.get("basis")) for e in results["requirements"] if e.get("basis"))
+    return {"model": plant["name"], "params": ", ".join(parts), "n_params": sum(counts.values()),
+            "n_unused": len(params) - len(used), "assumed": counts.get("assumed", 0),
+            "effects": [e.get("name") for e in plant.get("effects") or []], "fitted": fitted, "validated": validated,
+            "validation_run": bool(val), "deciding": _deciding(results, used),
+            "verdict_bases": [f"{n} {k.replace('_', ' ')}" for k, n in bases.most_common()],
             "provenance": dict(plant.get("provenance") or {})}
+
+
+def document_block(identity: dict, files: list[dict], document: dict | None = None, *, needs_identity: bool = True) -> dict:
+    """Document number, revision, DRAFT state and the cited inputs of any govcheck report.
+
+    ``document``: ``number`` / ``revision`` from the command line (they win over the
+    ``[identity]`` table). Without an identity (when the report is about a configured unit,
+    ``needs_identity``) or without a document number the report is a DRAFT.
+    """
+    document = document or {}
+    identity = identity or {}
+    number = document.get("number") or identity.get("document_number")
+    revision = document.get("revision") or identity.get("revision")
+    draft = (needs_identity and not identity) or not number
+    why = ("no [identity] table in the configuration" if needs_identity and not identity else "no document number "
+           "(--document-number)") if draft else None
+    return {"number": number, "revision": revision, "draft": draft, "draft_reason": why, "files": files,
+            "author": identity.get("author"), "test_date": identity.get("test_date")}
+
+
+def document_control(results: dict, document: dict | None = None) -> dict:
+    """:func:`document_block` of a compliance report: configuration, requirement files, results file, recording.
+
+    ``document`` may also carry ``results`` (``{"path", "digest"}`` of the saved results file).
+    """
+    document = document or {}
+    plant, rs = results["plant"], results["requirement_set"]
+    files = [{"what": "Plant configuration", "path": plant.get("path") or plant["name"], "digest": plant.get("digest")}]
+    for f in rs.get("files") or [{"path": rs.get("path"), "digest": rs.get("digest")}]:
+        files.append({"what": "Requirement file", "path": f.get("path"), "digest": f.get("digest")})
+    res = document.get("results") or {}
+    files.append({"what": "Results file", "path": res.get("path") or "not saved (no --json)", "digest": res.get("digest")})
+    rec = (results.get("validation") or {}).get("recording") or {}
+    if rec:
+        files.append({"what": "Recording", "path": rec.get("path"), "digest": rec.get("digest")})
+    return document_block(plant.get("identity") or {}, files, document)
 
 
 def _remedy_lines(rem) -> dict:
@@ -45,7 +139,8 @@ def _remedy_lines(rem) -> dict:
     out = {}
     fix = rem.get("remedy")
     if fix:
-        changes = ", ".join(f"{c['path']} {c['from']:.4g} -> {c['to']:.4g} {c['unit']}" for c in fix.get("changes", []))
+        changes = ", ".join(f"{c['path']} from {fmt_si(c['from'], c['unit'])} to {fmt_si(c['to'], c['unit'])}"
+                            for c in fix.get("changes", []))
         for rid in rem.get("failed", []):
             out[rid] = f"passes with {changes} (verified by a full campaign: {fix.get('verified', {}).get('status', 'not run')})"
         return out
@@ -55,7 +150,7 @@ def _remedy_lines(rem) -> dict:
         best = next((b for b in s.get("by_parameter", []) if b.get("delta_margin_pct", 0) > 0), None)
         if s["requirement"] not in out and best:
             out[s["requirement"]] = (f"no passing setting found; {best['path']} helps most "
-                                     f"({best['delta_margin_pct']:+.1f} points per {best['step']:.3g} {best['unit']})")
+                                     f"({best['delta_margin_pct']:+.1f} points per {fmt_si(best['step'], best['unit'])})")
     return out
 
 
@@ -87,38 +182,16 @@ def not_evaluated(results: dict) -> dict:
             "requirements": (results["summary"].get("counts") or {}).get("not_evaluated", 0)}
 
 
-def deviations(results: dict) -> list[dict]:
-    """Every FAIL, NOT EVALUATED and OPEN requirement, with what it needs and an owner field."""
-    out = []
-    for e in results["requirements"]:
-        if e["status"] not in ("fail", "open", "not_evaluated"):
-            continue
-        w = e.get("worst") or {}
-        if e["status"] == "open":
-            need = f"purchaser to set the limit (value found: {metric_text(w.get('value'), e['metric'])})"
-        elif e["status"] == "fail":
-            need = f"{metric_text(w.get('value'), e['metric'])} against {limit_text(e)}"
-        else:
-            need = "evidence missing (see its page)"
-        out.append({"id": e["id"], "title": e["title"], "status": e["status"], "word": STATUS_WORD.get(e["status"]),
-                    "severity": e["severity"], "need": need, "owner": (e.get("owner") or "")})
-    return out
-
-
 def assumptions(results: dict) -> list[str]:
-    """Assumptions the verdict rests on and what was not tested, gathered in one place."""
+    """The model assumptions the verdicts rest on (the readings of the requirements are departures, acceptance.py)."""
     b = basis(results)
     out = [f"Every value in this report is computed by simulating the model '{b['model']}'; no hardware was tested.",
-           f"{b['assumed']} of the {b['n_params']} model parameters are assumed (physically consistent choices not given "
-           "by the paper or the user; appendix A lists them)."]
+           f"{b['assumed']} of the {b['n_params']} parameters the model uses are assumed (physically consistent choices "
+           "not given by the paper or the user; appendix A lists them)"
+           + (f"; {b['n_unused']} further parameters of laws not selected are not used and not counted." if b["n_unused"] else ".")]
+    if b["deciding"]:
+        out.append("The assumptions that decide the verdicts: " + "; ".join(b["deciding"]) + ".")
     if not b["validation_run"]:
         out.append("The model has not been validated against a recording of this servo; friction, valve and leakage "
                    "parameters may differ on the real unit.")
-    for e in results["requirement_set"].get("requirements") or []:
-        note = str(e.get("note") or "")
-        if "assum" in note.lower() or "reads it as" in note.lower() or "reading" in note.lower():
-            out.append(f"{e['id']}: {note}")
-    rs_ops = results["requirement_set"].get("operating_points") or {}
-    out.append(f"Only the {len(rs_ops)} operating points of the requirement file were simulated; other loads, supply "
-               "pressures and temperatures were not.")
     return out

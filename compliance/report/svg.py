@@ -140,7 +140,9 @@ def to_svg(fig, prefix: str) -> str:
     if not re.fullmatch(r"[A-Za-z][A-Za-z0-9_-]*", prefix):
         raise ValueError(f"bad svg id prefix {prefix!r}")
     buf = io.StringIO()
-    fig.savefig(buf, format="svg", metadata={"Date": None, "Creator": None})
+    # tight: the viewBox is the extent of everything drawn (labels, legends above the axes), so no
+    # text can fall outside it whatever the labels' lengths; the CSS scales the figure to the text width
+    fig.savefig(buf, format="svg", metadata={"Date": None, "Creator": None}, bbox_inches="tight", pad_inches=0.03)
     return clean_svg(buf.getvalue(), prefix)
 
 
@@ -232,3 +234,22 @@ def message_axes(ax, text: str) -> None:
     for sp in ax.spines.values():
         sp.set_color("#c8ced3")
     ax.text(0.5, 0.5, text, transform=ax.transAxes, ha="center", va="center", color="#6b7780", fontsize=7.5)
+
+
+@functools.lru_cache(maxsize=1)
+def draft_mark_svg() -> str:
+    """The DRAFT watermark as an SVG of outlined glyphs (paths, no text: it never enters the extracted text)."""
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.path import Path as MPath
+    from matplotlib.textpath import TextPath
+
+    path = TextPath((0, 0), "DRAFT", size=100, prop=FontProperties(family="DejaVu Sans", weight="bold"))
+    ext = path.get_extents()
+    parts = []
+    for verts, code in path.iter_segments(simplify=False, curves=True):
+        pts = " ".join(f"{x - ext.x0:.1f} {ext.y1 - y:.1f}" for x, y in verts.reshape(-1, 2))
+        parts.append({MPath.MOVETO: "M", MPath.LINETO: "L", MPath.CURVE3: "Q", MPath.CURVE4: "C",
+                      MPath.CLOSEPOLY: "Z"}[code] + ("" if code == MPath.CLOSEPOLY else " " + pts))
+    w, h = ext.width, ext.height
+    return (f'<svg viewBox="0 0 {w:.0f} {h:.0f}" class="draft-svg"><path d="{" ".join(parts)}" '
+            'fill="#b42318" fill-opacity="0.10"/></svg>')

@@ -151,3 +151,39 @@ def format_value(value: float, unit: str) -> str:
     if unit == "kg/(s*Pa)":
         return f"{v:.2g} {unit}"
     return f"{v:.3g} {unit}" if unit else f"{v:.3g}"
+
+
+_PREFIXES = ((1e9, "G"), (1e6, "M"), (1e3, "k"), (1.0, ""), (1e-3, "m"), (1e-6, "\u00b5"), (1e-9, "n"), (1e-12, "p"))
+
+
+def si_prefix(value, unit: str) -> tuple[float, str]:
+    """The scale and prefixed unit that put ``value`` [SI ``unit``] between 1 and 1000: ``1.7e-6 N/Pa`` -> µN/Pa.
+
+    The prefix goes on the unit's first symbol; a first symbol with a power (``m^3``), a
+    dimensionless unit and per-unit units (``1/Pa``) keep their unit (scale 1).
+    """
+    head = unit.split("/")[0].split("*")[0] if unit else ""
+    if not head or "^" in head or head[0].isdigit() or head in ("%", "K") or value is None or not math.isfinite(value) \
+            or value == 0:
+        return 1.0, unit
+    if head == "kg":  # already prefixed: grams would read oddly for a mass flow
+        return 1.0, unit
+    if 0.1 <= abs(value) < 1000.0:
+        return 1.0, unit  # "0.93 N" reads better than "930 mN"
+    for scale, p in _PREFIXES:
+        if abs(value) >= scale * (1 - 1e-12):
+            return 1.0 / scale, p + unit
+    return 1.0 / _PREFIXES[-1][0], _PREFIXES[-1][1] + unit
+
+
+def fmt_si(value, unit: str, stderr=None, digits: int = 3) -> str:
+    """An SI value (and its standard error) with a sensible prefix, units typeset: ``1.66 ± 0.22 µN/Pa``."""
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return _DASH
+    scale, shown = si_prefix(float(value), unit or "")
+    text = f"{float(value) * scale:#.{digits}g}".rstrip(".")
+    if "e" in text:
+        text = fmt_num(float(value) * scale, digits)
+    if stderr is not None and math.isfinite(float(stderr)):
+        text += f" \u00b1 {fmt_num(float(stderr) * scale, 2)}"
+    return f"{text} {unit_text(shown)}".replace("-", "\u2212").strip()

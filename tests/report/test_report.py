@@ -84,7 +84,9 @@ def test_html_is_self_contained_with_every_figure_inline(rendered):
     n_pages = len(requirement_pages(res)[1])  # the worst case of each requirement page whose run is in the fixture
     assert n_pages >= 3
     assert doc.tags.count("figure") == n_pages + n_traces + n_val + n_lin
-    assert doc.tags.count("svg") == doc.tags.count("figure")
+    draft = sum(1 for tag, a in doc.attrs if tag == "svg" and a.get("class") == "draft-svg")  # the DRAFT watermark
+    assert draft == 1  # the fixture's configuration has no document number
+    assert doc.tags.count("svg") - draft == doc.tags.count("figure")
     # nothing outside the file: no scheme, no import, no src/href to anything but an in-page anchor
     assert "http:" not in text and "https:" not in text
     assert "@import" not in text and "url(http" not in text
@@ -112,19 +114,30 @@ def test_user_strings_are_escaped(rendered):
 def test_contents_in_order_and_every_requirement_in_summary(rendered):
     res, html_path, _ = rendered
     text = html_path.read_text(encoding="utf-8")
-    pos = [text.index(f'id="{s}"') for s in ("cover", "summary", "procedures", "linear", "validation", "appendix")]
+    sections = ("cover", "scope", "conditions", "summary", "procedures", "linear", "validation", "conclusions", "appendix")
+    pos = [text.index(f'id="{s}"') for s in sections]
     assert pos == sorted(pos)
     summary = text[text.index('id="summary"'):text.index('id="procedures"')]
     for e in res["requirements"]:
         assert e["id"] in summary
-    # the cover carries both sha256 digests, the verdict and the version
+    # the cover cites the sha256 digests (abbreviated) and the verdict; section 7.3 gives them in full
     cover = text[:text.index('id="contents"')]
-    assert res["plant"]["digest"] in cover and res["requirement_set"]["digest"] in cover
+    assert res["plant"]["digest"][:16] in cover and res["requirement_set"]["digest"][:16] in cover
     assert res["summary"]["status"].upper() in cover
-    # appendix: every parameter key with its source, the command line
+    control = text[text.index('id="conclusions"'):text.index('id="appendix"')]
+    assert res["plant"]["digest"] in control and res["requirement_set"]["digest"] in control
+    # every operating point is defined in section 2.1, before the evidence uses it
+    conditions = text[text.index('id="conditions"'):text.index('id="summary"')]
+    for name in res["requirement_set"]["operating_points"]:
+        assert name in conditions, name
+    # appendix: every parameter the model uses with its source (laws not selected are left out), the command line
+    from compliance.report.signoff import used_by_model
+
     appendix = text[text.index('id="appendix"'):]
+    used = [p for p in res["plant"]["parameters"] if used_by_model(p["key"], res["plant"]["options"])]
+    assert 0 < len(used) < len(res["plant"]["parameters"])
     for p in res["plant"]["parameters"]:
-        assert p["key"] in appendix
+        assert (p["key"] in appendix) == (p in used), p["key"]
     assert "govcheck check" in appendix
 
 
@@ -146,7 +159,7 @@ def test_absent_sections_say_not_run(tmp_path):
     text = out.read_text(encoding="utf-8")
     assert "Linear analysis (govcheck linear): not run." in text
     assert "Model validation against recordings (govcheck validate): not run." in text
-    assert _parse(text).tags.count("svg") == len(res["runs"][0]["traces"])
+    assert _parse(text).tags.count("svg") == len(res["runs"][0]["traces"]) + 1  # + the DRAFT watermark
 
 
 # --------------------------------------------------------------------------- PDF
@@ -163,7 +176,8 @@ def test_pdf_has_pages_verdict_and_every_requirement(rendered):
     # running footer with page numbers and a table of contents with page numbers
     assert f"Page 2 of {len(reader.pages)}" in text
     toc = reader.pages[1].extract_text()
-    assert re.search(r"1\. Summary, deviations and assumptions[ .]*\d+", toc)
+    assert re.search(r"3\. Results against the guarantees[ .]*\d+", toc)
+    assert re.search(r"7\. Conclusions, disposition, parties and revisions[ .]*\d+", toc)
 
 
 def _png_stats(path):
@@ -221,15 +235,21 @@ _BAD_PDF_TEXT = [
 
 @pytest.fixture(scope="module")
 def pdf_text(tmp_path_factory):
-    """Pages of the default (appendix summary) PDF of the fixture as text (poppler's pdftotext)."""
-    if shutil.which("pdftotext") is None:
-        pytest.skip("pdftotext not installed (Debian package poppler-utils)")
+    """Pages of the default (appendix summary) PDF of the fixture as text (poppler's pdftotext, else pdfplumber)."""
     out = tmp_path_factory.mktemp("signoff")
     res = _results()
     render_report(res, pdf_path=out / "r.pdf")
-    text = subprocess.run(["pdftotext", "-layout", str(out / "r.pdf"), "-"], capture_output=True, text=True,
-                          check=True, timeout=60).stdout
-    return res, text.split("\f")
+    return res, _pdf_pages(out / "r.pdf")
+
+
+def _pdf_pages(path) -> list[str]:
+    if shutil.which("pdftotext") is not None:
+        text = subprocess.run(["pdftotext", "-layout", str(path), "-"], capture_output=True, text=True,
+                              check=True, timeout=60).stdout
+        return text.split("\f")
+    pdfplumber = pytest.importorskip("pdfplumber", reason="neither pdftotext (poppler-utils) nor pdfplumber installed")
+    with pdfplumber.open(str(path)) as pdf:
+        return [p.extract_text() or "" for p in pdf.pages]
 
 
 @pytest.mark.parametrize("pattern, what", _BAD_PDF_TEXT)
@@ -257,13 +277,20 @@ def test_page_one_states_basis_failures_and_not_evaluated(pdf_text):
 def test_body_is_at_most_25_pages_and_appendix_levels(pdf_text, tmp_path):
     _, pages = pdf_text
     body = next(i for i, p in enumerate(pages) if re.search(r"^\s*Appendix\s*$", p, re.M))
-    validation = body - next(i for i, p in enumerate(pages) if re.search(r"^\s*4\. Model validation\s*$", p, re.M))
+    start = next(i for i, p in enumerate(pages) if re.search(r"^\s*6\. Model validation\s*$", p, re.M))
+    end = next(i for i, p in enumerate(pages)
+               if re.search(r"^\s*7\. Conclusions, disposition, parties and revisions\s*$", p, re.M))
     # plant A's report carries no validation (the fixture adds one to test that section)
+    validation = end - start
     assert body - validation <= 25, f"body without the validation section has {body - validation} pages"
+    for heading in ("1. Scope, references and test object", "2.1 Operating points", "2.2 Instrumentation and method",
+                    "3.1 Departures from the test code", "3.3 Conditions not tested", "7.1 Conclusions and disposition",
+                    "7.2 Parties and witnesses", "7.3 Document control and revision history"):
+        assert any(heading in p for p in pages[:body]), heading
     res = _results()
     render_report(res, pdf_path=tmp_path / "none.pdf", appendix="none")
-    none = subprocess.run(["pdftotext", str(tmp_path / "none.pdf"), "-"], capture_output=True, text=True).stdout
-    assert "Configuration parameters of" not in none and none.count("\f") <= body
+    none = _pdf_pages(tmp_path / "none.pdf")
+    assert "Configuration parameters of" not in "".join(none) and len(none) <= body
     with pytest.raises(InputError, match="--appendix"):
         render_report(res, pdf_path=tmp_path / "x.pdf", appendix="all")
 
@@ -290,7 +317,8 @@ def test_validation_report_renders(tmp_path):
     render_validation_report(val, out_h, out_p)
     text = out_h.read_text(encoding="utf-8")
     doc = _parse(text)
-    assert doc.tags.count("svg") == sum(len(m["overlays"]) for m in val["modes"].values())
+    draft = sum(1 for tag, a in doc.attrs if tag == "svg" and a.get("class") == "draft-svg")  # no document number
+    assert doc.tags.count("svg") - draft == sum(len(m["overlays"]) for m in val["modes"].values())
     assert "Diagnosis (govcheck diagnose): not run." in text
     assert "mismatch window" in text  # located windows shaded on the overlays
     assert "script" not in doc.tags and "&lt;script&gt;" in text
@@ -483,4 +511,4 @@ def test_page_one_fix_lines_come_from_the_remedies_section():
     assert "hardware" in lines[failed[0]]
     res["remedies"] = {"failed": failed, "remedy": {"changes": [{"path": "controller.kp", "from": 280.0, "to": 400.0, "unit": "V/m"}],
                                                      "verified": {"status": "pass"}}}
-    assert all("280 -> 400 V/m" in f["remedy"] and "pass" in f["remedy"] for f in failures(res))
+    assert all("from 280 V/m to 400 V/m" in f["remedy"] and "pass" in f["remedy"] for f in failures(res))
