@@ -108,6 +108,20 @@ def monte_carlo(cfg, reqset, results: dict, args) -> None:
     results["summary"] = summary_section(results["requirements"], results["summary"]["notes"], results["uncertainty"])
 
 
+def check_uncertainty_option(args, cfg=None) -> None:
+    """``--uncertainty N``: at least 2 plants (or 0), and, given the plant, a plant file that declares ranges."""
+    from compliance.errors import InputError
+
+    if args.uncertainty is not None and (args.uncertainty == 1 or args.uncertainty < 0):
+        raise InputError(f"--uncertainty {args.uncertainty}: expected at least 2 plants (or 0 for point values)")
+    if args.uncertainty and cfg is not None:
+        from compliance.campaign.uncertainty import ranged_parameters
+
+        if not ranged_parameters(cfg):
+            raise InputError(f"{cfg.path or cfg.name}: --uncertainty {args.uncertainty}: the plant file gives no parameter "
+                             "a range (range = [low, high] with range_note, docs/requirements.md 'Uncertainty')")
+
+
 def run(args) -> int:
     """Check outputs and inputs, run the campaign, print the table, write the outputs; exit code from the verdict."""
     from compliance.campaign.results_files import summary_table, write_json, write_junit
@@ -117,10 +131,7 @@ def run(args) -> int:
     from compliance.files.reproducible import fixed_created, is_reproducible
     from compliance.requirements.loading import load_requirements
 
-    if args.uncertainty is not None and (args.uncertainty == 1 or args.uncertainty < 0):
-        from compliance.errors import InputError
-
-        raise InputError(f"--uncertainty {args.uncertainty}: expected at least 2 plants (or 0 for point values)")
+    check_uncertainty_option(args)
     from compliance.cli.remedies_options import check_remedies_options
 
     check_args_outputs(args, (getattr(args, "save_remedy", None), "--save-remedy", (".toml",)))
@@ -137,13 +148,7 @@ def run(args) -> int:
     from compliance.requirements.consistency import check_consistency
 
     check_consistency(reqset, cfg.p("cylinder.stroke"), args.allow_conflicts)  # before any simulation
-    if args.uncertainty:
-        from compliance.campaign.uncertainty import ranged_parameters
-        from compliance.errors import InputError
-
-        if not ranged_parameters(cfg):
-            raise InputError(f"{cfg.path or cfg.name}: --uncertainty {args.uncertainty}: the plant file gives no parameter "
-                             "a range (range = [low, high] with range_note, docs/requirements.md 'Uncertainty')")
+    check_uncertainty_option(args, cfg)
     stages = 1 + bool(args.linear) + (render is not None)
     # the campaign reports its runs itself on a terminal; in a CI log these stage lines (and a heartbeat) show progress
     with progress(stages, "check", quiet=args.quiet or sys.stderr.isatty(), unit="stage", first="campaign") as bar:

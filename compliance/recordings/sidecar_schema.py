@@ -67,7 +67,7 @@ SIDECAR_SCHEMA: dict = {
         "anti_alias_cutoff": Value("Hz", "anti-alias filter cut-off"),
     },
     "channels": PerName({
-        "resolution": Value("", "smallest step of the channel, in the channel's SI unit"),
+        "resolution": Value(None, "smallest step of the channel, in the channel's own unit (converted with the channel)"),
         "delay": Value("s", "delay of the channel behind the others"),
         "gain": Value("", "relative gain error of the channel"),
     }),
