@@ -367,7 +367,7 @@ def run_practice(directory, cfg: PlantConfig, *, library=None, jobs: int = 1) ->
         frame, meta = read_recording(files[0])
         d = diagnose(cfg, frame, meta, effects=library, jobs=jobs)
         truth = list(ans.get("effects") or [])
-        correct, ambiguous_ok = practice_correct(d, truth)
+        correct, ambiguous_ok = practice_correct(d, truth, ans.get("accept"))
         fitted = {}
         if d.winner:
             fit = d.fits[d.winner]

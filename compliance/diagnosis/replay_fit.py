@@ -42,6 +42,8 @@ from compliance.diagnosis.operating_point import load_at_start
 from compliance.simulation.rk4 import N_OUT, OUTPUT_COLUMNS
 from compliance.simulation.pid_loop import simulate_core
 from compliance.diagnosis.noise_floor import position_noise_estimate
+from compliance.validation.logger_model import logger_model
+from compliance.validation.recorded_noise import position_quantum
 
 SIGNALS = ("position", "pressure_a", "pressure_b", "valve_command", "supply_pressure")
 _OUT = {name: i for i, name in enumerate(OUTPUT_COLUMNS)}
@@ -85,6 +87,14 @@ class ReplaySetup:
         Base-parameter overrides from the recording's sidecar.
     notes : list of str
     source : str
+    logged : ndarray or None
+        Controller periods at which the logger wrote a sample (None: every period); residuals,
+        noise floors and the injected noise use these samples only.
+    logger : LoggerModel or None
+        What the logger did to the signals (``validation.logger_model``), applied to every replay.
+    resolution : dict
+        Measured signal -> quantisation step [SI]: declared (``metadata["channels"]``) or the
+        lattice of the logged samples (0 when none).
     """
 
     time: np.ndarray
@@ -101,11 +111,19 @@ class ReplaySetup:
     overrides: dict = field(default_factory=dict)
     notes: list = field(default_factory=list)
     source: str = "<recording>"
+    logged: np.ndarray | None = None
+    logger: object = None
+    resolution: dict = field(default_factory=dict)
 
     @property
     def n_samples(self) -> int:
         """Number of controller periods simulated."""
         return self.time.size - 1
+
+    @property
+    def samples(self) -> np.ndarray:
+        """Indices of the controller grid that carry a logged sample."""
+        return np.arange(self.time.size) if self.logged is None else self.logged
 
 
 def segment_starts(time: np.ndarray, reference: np.ndarray, speed: np.ndarray | None = None,
@@ -180,6 +198,7 @@ def prepare_replay(cfg: PlantConfig, frame: pd.DataFrame, meta: dict, *, inject_
         Missing columns, a time base the controller clock cannot follow.
     """
     from compliance.validation.replay import initial_conditions, load_from_metadata, on_controller_clock, replay_config as _overrides_of
+    from compliance.validation.resampling import logged_indices
 
     src = str(meta.get("source_path", "<recording>"))
     for col in ("time", "position", "valve_command"):
@@ -192,28 +211,24 @@ def prepare_replay(cfg: PlantConfig, frame: pd.DataFrame, meta: dict, *, inject_
     notes: list[str] = []
     ts = run_cfg.p("controller.sample_time")
     frame, note = on_controller_clock(frame, ts, src)  # one sample per controller period
+    logged = None
     if note:
         notes.append(note)
+        logged = logged_indices(t, ts)
         t = frame["time"].to_numpy(dtype=float)
+        logged = logged[logged < t.size]
     closed = "reference" in frame.columns
     rec = {s: frame[s].to_numpy(dtype=float) for s in SIGNALS if s in frame.columns}
     init = initial_conditions(frame, run_cfg, src)
     x0 = init["initial_position"]
     pressures = init["initial_pressures"]
-    load = load_from_metadata(meta)
-    if load is None:
-        if pressures is not None and cfg.option("cylinder.arrangement") == "tandem":
-            load = (pressures[0] - pressures[1]) * (cfg.piston_area + cfg.rod_side_area)
-            notes.append(f"no load in the sidecar: {load/1e3:.2f} kN estimated from the initial pressure difference")
-        else:
-            load = 0.0
-            notes.append("no load in the sidecar and no pressures to estimate it: replayed without load")
+    load = _test_load(cfg, load_from_metadata(meta), pressures, notes)
     if closed:
         reference = frame["reference"].to_numpy(dtype=float)
     else:
         reference = np.full(t.size, x0)
         notes.append("no reference column: replayed open loop from the recorded valve command")
-    noise = position_noise_estimate(rec["position"]) if (closed and inject_noise) else np.zeros(t.size)
+    noise = _injected_noise(rec["position"], logged, ts) if (closed and inject_noise) else np.zeros(t.size)
     tt = t - t[0]
     states = {"position": _smooth(rec["position"]), "velocity": _smooth(rec["position"], 1, ts, _VELOCITY_WINDOW)}
     resets = (segment_starts(tt, reference if closed else rec["valve_command"], states["velocity"], max_segment)
@@ -228,8 +243,42 @@ def prepare_replay(cfg: PlantConfig, frame: pd.DataFrame, meta: dict, *, inject_
         time=tt, reference=np.ascontiguousarray(reference), command=np.ascontiguousarray(rec["valve_command"]),
         closed_loop=closed, load=load, initial_position=float(x0), initial_pressures=pressures,
         noise=np.ascontiguousarray(noise), recorded=rec, resets=resets, states=states, overrides=overrides,
-        notes=notes, source=src,
+        notes=notes, source=src, logged=logged, logger=logger_model(meta), resolution=_resolutions(rec, logged, meta),
     )
+
+
+def _test_load(cfg: PlantConfig, load, pressures, notes: list):
+    """The sidecar's load, else the initial pressure difference's (tandem), else none (noted)."""
+    if load is not None:
+        return load
+    if pressures is not None and cfg.option("cylinder.arrangement") == "tandem":
+        load = (pressures[0] - pressures[1]) * (cfg.piston_area + cfg.rod_side_area)
+        notes.append(f"no load in the sidecar: {load/1e3:.2f} kN estimated from the initial pressure difference")
+        return load
+    notes.append("no load in the sidecar and no pressures to estimate it: replayed without load")
+    return 0.0
+
+
+def _resolutions(rec: dict, logged: np.ndarray | None, meta: dict) -> dict:
+    """Signal -> quantisation step [SI]: the channel's declared resolution, else the logged samples' lattice."""
+    channels = meta.get("channels") or {}
+    out = {}
+    for s, v in rec.items():
+        declared = (channels.get(s) or {}).get("resolution")
+        out[s] = float(declared) if declared else position_quantum(v if logged is None else v[logged])
+    return out
+
+
+def _injected_noise(position: np.ndarray, logged: np.ndarray | None, ts: float) -> np.ndarray:
+    """The position noise the controller saw, estimated where the logger sampled it [m].
+
+    On a log slower than the controller the noise is known only at the logged instants: it is
+    estimated on those samples (smoother windows in seconds, not samples) and interpolated between.
+    """
+    if logged is None:
+        return position_noise_estimate(position)
+    est = position_noise_estimate(position[logged], dt=float(np.median(np.diff(logged))) * ts)
+    return np.interp(np.arange(position.size), logged, est)
 
 
 def replay_config(cfg: PlantConfig, setup: ReplaySetup) -> PlantConfig:
@@ -301,4 +350,5 @@ def run_replay(cfg: PlantConfig, setup: ReplaySetup, *, noise: np.ndarray | None
         if status >= 0:
             raise SimulationError(f"replay of {setup.source} became non-physical at t = {(k0 + status)*ts:.3f} s")
         out[k0:k1 + 1] = seg
-    return {s: out[:, _OUT[s]] for s in SIGNALS} | {c: out[:, _OUT[c]] for c in ("position_true", "temperature_a", "temperature_b")}
+    sim = {s: out[:, _OUT[s]] for s in SIGNALS} | {c: out[:, _OUT[c]] for c in ("position_true", "temperature_a", "temperature_b")}
+    return setup.logger.apply(sim, ts) if setup.logger is not None else sim  # as the logger recorded it

@@ -11,6 +11,7 @@ with a heteroscedastic error model from a parametric bootstrap).
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -94,13 +95,6 @@ def compared_signals(setup: ReplaySetup) -> tuple[str, ...]:
     return tuple(out)
 
 
-def _quantum(values: np.ndarray) -> float:
-    """Quantisation step of a recorded signal (0 when it is not on a grid); see compliance.validation.replay."""
-    from compliance.validation.replay import position_quantum
-
-    return position_quantum(values)
-
-
 def null_replay_errors(cfg: PlantConfig, setup: ReplaySetup, sensor: dict, seed: int = 7) -> dict:
     """How far a *correct* model's replay stays from its recording, signal by signal [SI].
 
@@ -131,11 +125,13 @@ def null_recording(cfg: PlantConfig, setup: ReplaySetup, sensor: dict, seed: int
     from compliance.simulation import Scenario, SensorNoise, simulate
     from compliance.diagnosis.replay_fit import prepare_replay
 
-    rec = setup.recorded
+    rec, res = setup.recorded, setup.resolution
+    qx, qp = res.get("position", 0.0), max(res.get("pressure_a", 0.0), res.get("pressure_b", 0.0))
+    # the simulated sensor quantises on top of its noise: its noise is what the estimate holds beyond q^2/12
     noise = SensorNoise(
-        position_std=sensor.get("position", 0.0), position_quantum=_quantum(rec["position"]),
-        pressure_std=max(sensor.get("pressure_a", 0.0), sensor.get("pressure_b", 0.0)),
-        pressure_quantum=_quantum(rec["pressure_a"]) if "pressure_a" in rec else 0.0,
+        position_std=math.sqrt(max(sensor.get("position", 0.0) ** 2 - qx * qx / 12.0, 0.0)), position_quantum=qx,
+        pressure_std=math.sqrt(max(max(sensor.get("pressure_a", 0.0), sensor.get("pressure_b", 0.0)) ** 2 - qp * qp / 12.0, 0.0)),
+        pressure_quantum=qp,
     )
     t = setup.time
     ts = float(np.median(np.diff(t)))
@@ -158,9 +154,13 @@ def null_recording(cfg: PlantConfig, setup: ReplaySetup, sensor: dict, seed: int
     for s_ in ("pressure_a", "pressure_b", "supply_pressure"):
         if s_ in rec:
             frame[s_] = syn[s_].to_numpy()[:n]
+    if setup.logger is not None:  # through the recording's instruments (filter, delays, calibration) ...
+        logged = setup.logger.apply({c: frame[c].to_numpy() for c in frame.columns}, ts)
+        frame = pd.DataFrame({c: logged[c] for c in frame.columns})
+    if setup.logged is not None:  # ... at the instants it logged
+        frame = frame.iloc[setup.logged[setup.logged < n]].reset_index(drop=True)
     meta = {"conditions": {"load_force": setup.load}, "source_path": "<null replay>"}
-    syn_setup = prepare_replay(cfg, frame, meta)
-    return syn_setup
+    return dataclasses.replace(prepare_replay(cfg, frame, meta), logger=setup.logger)
 
 
 def null_replay_floors(cfg: PlantConfig, setup: ReplaySetup, sensor: dict) -> tuple[dict, dict]:
@@ -232,12 +232,15 @@ def build_residual_model(cfg: PlantConfig, setup: ReplaySetup, *, stride: int = 
         Unused (kept for callers that already ran the nominal replay).
     """
     signals = compared_signals(setup)
-    sensor = {s: (0.0 if s == "valve_command" else sensor_noise_std(setup.recorded[s])) for s in signals}
+    logged = setup.samples
+    sensor = {s: (0.0 if s == "valve_command" else sensor_noise_std(setup.recorded[s][logged], resolution=setup.resolution.get(s, 0.0)))
+              for s in signals}
     try:
         null, null_local = null_replay_floors(cfg, setup, sensor)
     except (SimulationError, InputError):
         null, null_local = {}, {}
-    index = np.arange(0, setup.time.size, max(1, int(stride)))
+    step = float(np.median(np.diff(logged))) if logged.size > 1 else 1.0
+    index = logged[::max(1, int(round(stride / step)))]  # logged samples only, about ``stride`` periods apart
     floors, local = {}, {}
     for s in signals:
         own = sensor[s] if s != "position" or not setup.closed_loop else 0.0

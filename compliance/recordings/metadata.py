@@ -12,6 +12,7 @@ import tomllib
 from pathlib import Path
 
 from compliance.errors import InputError
+from compliance.recordings.instruments import instrument_facts
 from compliance.units import parse_quantity, registry
 
 __all__ = ["read_sidecar", "si_metadata", "sidecar_path"]
@@ -34,7 +35,8 @@ def read_sidecar(path) -> dict:
     Raises
     ------
     InputError
-        The sidecar is not valid TOML, or holds a pressure without ``abs`` / ``gauge``.
+        The sidecar is not valid TOML, holds a pressure without ``abs`` / ``gauge``, or a
+        ``[logger]`` / ``[channels.NAME]`` table that ``instruments.instrument_facts`` rejects.
     """
     side = sidecar_path(path)
     if not side.is_file():
@@ -43,7 +45,7 @@ def read_sidecar(path) -> dict:
         data = tomllib.loads(side.read_text(encoding="utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise InputError(f"{side}: sidecar is not valid TOML ({exc})") from None
-    return si_metadata(data, str(side))
+    return si_metadata(instrument_facts(data, str(side)), str(side))
 
 
 def si_metadata(data, where: str):
