@@ -64,6 +64,8 @@ def predicted_label(diag) -> str:
         return "none"
     if diag.verdict == "ambiguous":
         return "ambiguous"  # its own column: not a hit, not "unexplained" either
+    if diag.verdict == "instrumentation":
+        return "instrumentation"  # a logger or transducer finding: never a plant effect
     return "unexplained"
 
 
