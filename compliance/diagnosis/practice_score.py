@@ -73,4 +73,20 @@ def main_parameter(d, truth: list, params: dict) -> dict | None:
     return out
 
 
-__all__ = ["answer_in_si", "main_parameter", "practice_correct"]
+def practice_table(rep: dict) -> str:
+    """The scored practice recordings as a Markdown table (``benchmark.run_practice``'s result)."""
+    lines = ["| recording | truth | verdict | winner | right | largest residual after (x floor) | main parameter error | s |",
+             "|---|---|---|---|---|---|---|---|"]
+    for r in rep["recordings"]:
+        after = r.get("objective_after") or r.get("objective_before") or {}
+        worst = max(after.items(), key=lambda kv: kv[1], default=None)
+        main = r.get("main") or {}
+        err = f"{100 * main['error']:.0f} % ({main['parameter']})" if main.get("error") is not None else "-"
+        lines.append(f"| {r['name']} | {r['truth']} | {r['verdict']} | {r['winner'] or '-'} | "
+                     f"{'yes' if r['correct'] else 'no'} | {f'{worst[1]:.2f} ({worst[0]})' if worst else '-'} | {err} | "
+                     f"{r['seconds']:.0f} |")
+    lines.append(f"\n{rep['correct']}/{len(rep['recordings'])} right.")
+    return "\n".join(lines)
+
+
+__all__ = ["answer_in_si", "main_parameter", "practice_correct", "practice_table"]
