@@ -230,7 +230,10 @@ def prepare_replay(cfg: PlantConfig, frame: pd.DataFrame, meta: dict, *, inject_
         reference = np.full(t.size, x0)
         notes.append("no reference column: replayed open loop from the recorded valve command")
     resolution = _resolutions(rec, logged, meta)
-    noise = _injected_noise(rec["position"], logged, ts, resolution["position"]) if (closed and inject_noise) else np.zeros(t.size)
+    logger = logger_model(meta)
+    share = logger.noise_share("position", ts) if logger is not None else 1.0
+    noise = (_injected_noise(rec["position"], logged, ts, resolution["position"], share) if (closed and inject_noise)
+             else np.zeros(t.size))
     tt = t - t[0]
     states = {"position": _smooth(rec["position"]), "velocity": _smooth(rec["position"], 1, ts, _VELOCITY_WINDOW)}
     resets = (segment_starts(tt, reference if closed else rec["valve_command"], states["velocity"], max_segment)
@@ -245,7 +248,7 @@ def prepare_replay(cfg: PlantConfig, frame: pd.DataFrame, meta: dict, *, inject_
         time=tt, reference=np.ascontiguousarray(reference), command=np.ascontiguousarray(rec["valve_command"]),
         closed_loop=closed, load=load, initial_position=float(x0), initial_pressures=pressures,
         noise=np.ascontiguousarray(noise), recorded=rec, resets=resets, states=states, overrides=overrides,
-        notes=notes, source=src, logged=logged, logger=logger_model(meta), resolution=resolution,
+        notes=notes, source=src, logged=logged, logger=logger, resolution=resolution,
     )
 
 
@@ -271,7 +274,8 @@ def _resolutions(rec: dict, logged: np.ndarray | None, meta: dict) -> dict:
     return out
 
 
-def _injected_noise(position: np.ndarray, logged: np.ndarray | None, ts: float, quantum: float = 0.0) -> np.ndarray:
+def _injected_noise(position: np.ndarray, logged: np.ndarray | None, ts: float, quantum: float = 0.0,
+                    share: float = 1.0) -> np.ndarray:
     """The position noise the controller saw, estimated where the logger sampled it [m].
 
     On a log slower than the controller the noise is known only at the logged instants: it is
@@ -282,16 +286,20 @@ def _injected_noise(position: np.ndarray, logged: np.ndarray | None, ts: float, 
     trend log of a valve-offset servo (50 um transducer) its derivative term then dithered the
     valve with 0.29 V instead of the recorded 0.35 V, and a 30 ms sensor lag fitted as well as
     the true offset; with drawn readings the replay dithers 0.35 V and the offset's 1 s mean
-    command misfit falls from 0.08 V to 0.04 V.
+    command misfit falls from 0.08 V to 0.04 V. Behind an anti-alias filter (``share`` < 1: the
+    share of white noise it passes, ``LoggerModel.noise_share``) no logged sample is a reading
+    the controller saw: every reading is drawn, at the logged noise level divided by ``share``.
     """
-    if logged is None:
+    if logged is None and share == 1.0:
         return position_noise_estimate(position)
+    logged = np.arange(position.size) if logged is None else logged
     x = position[logged]
     est = position_noise_estimate(x, dt=float(np.median(np.diff(logged))) * ts)
     out = np.interp(np.arange(position.size), logged, est)
     between = np.ones(position.size, dtype=bool)
-    between[logged] = False
-    sigma = sensor_noise_std(x, resolution=quantum)
+    if share == 1.0:
+        between[logged] = False
+    sigma = sensor_noise_std(x, resolution=quantum) / share
     sigma = float(np.sqrt(max(sigma * sigma - quantum * quantum / 12.0, 0.0)))  # the noise beyond the quantisation
     base = position[between] - out[between]  # the interpolated reading without noise
     draw = base + np.random.default_rng(FILL_SEED).normal(0.0, sigma, int(between.sum()))

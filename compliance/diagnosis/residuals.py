@@ -127,6 +127,9 @@ def null_recording(cfg: PlantConfig, setup: ReplaySetup, sensor: dict, seed: int
 
     rec, res = setup.recorded, setup.resolution
     qx, qp = res.get("position", 0.0), max(res.get("pressure_a", 0.0), res.get("pressure_b", 0.0))
+    if setup.logger is not None:  # the transducers' own noise, before the logger's filter took its share
+        ts_ = float(np.median(np.diff(setup.time)))
+        sensor = {k: v / setup.logger.noise_share(k, ts_) for k, v in sensor.items()}
     # the simulated sensor quantises on top of its noise: its noise is what the estimate holds beyond q^2/12
     noise = SensorNoise(
         position_std=math.sqrt(max(sensor.get("position", 0.0) ** 2 - qx * qx / 12.0, 0.0)), position_quantum=qx,

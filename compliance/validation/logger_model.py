@@ -70,6 +70,20 @@ class LoggerModel:
             o[k] = o.get(k, 0.0) + float(v)
         return replace(self, delay=d, gain=g, offset=o)
 
+    def noise_share(self, name: str, ts: float) -> float:
+        """Share of white noise (standard deviation, sampled every ``ts`` [s]) the channel's filter passes [-].
+
+        A transducer's noise as the controller read it is the logged noise divided by this: a
+        first-order filter at 80 Hz passes half of 1 kHz white noise (sum of its squared impulse response).
+        """
+        fc = self.cutoff.get(name)
+        if not fc:
+            return 1.0
+        impulse = np.zeros(int(20.0 / (2.0 * math.pi * fc * ts)) + 50)  # 20 time constants
+        impulse[0] = 1.0
+        h = lfilter(*_coefficients(fc, ts), impulse)
+        return float(np.sqrt(np.sum(h * h)))
+
     def apply(self, signals: dict, ts: float) -> dict:
         """Simulated signals as the logger records them (arrays on the controller grid of step ``ts`` [s]).
 
@@ -94,13 +108,18 @@ class LoggerModel:
         return out
 
 
-def first_order_filter(x: np.ndarray, cutoff: float, ts: float) -> np.ndarray:
-    """First-order low-pass at ``cutoff`` [Hz] of samples every ``ts`` [s] (Tustin, prewarped), at rest on x[0]."""
+def _coefficients(cutoff: float, ts: float) -> tuple[np.ndarray, np.ndarray]:
     wc = 2.0 / ts * math.tan(math.pi * cutoff * ts)  # prewarped: the discrete filter's -3 dB point is the cutoff
     k = 2.0 / ts
-    b = np.array([wc, wc]) / (k + wc)
-    a = np.array([1.0, (wc - k) / (k + wc)])
-    y, _ = lfilter(b, a, x, zi=np.array([x[0] * (1.0 - b[0])]) if x.size else None)
+    return np.array([wc, wc]) / (k + wc), np.array([1.0, (wc - k) / (k + wc)])
+
+
+def first_order_filter(x: np.ndarray, cutoff: float, ts: float) -> np.ndarray:
+    """First-order low-pass at ``cutoff`` [Hz] of samples every ``ts`` [s] (Tustin, prewarped), at rest on x[0]."""
+    if not x.size:
+        return np.asarray(x, dtype=float)
+    b, a = _coefficients(cutoff, ts)
+    y, _ = lfilter(b, a, x, zi=np.array([x[0] * (1.0 - b[0])]))
     return y
 
 

@@ -86,3 +86,13 @@ def test_noise_floors_never_fall_below_the_quantisation():
     assert noise_floor(np.full(100, 0.07), resolution=q) == pytest.approx(q / math.sqrt(12.0))
     s = sensor_noise_std(x)
     assert math.sqrt(20e-6**2 + q * q / 12.0) * 0.8 < s < math.sqrt(20e-6**2 + q * q / 12.0) * 1.25
+
+
+def test_noise_share_is_what_the_filter_passes_of_white_noise():
+    """The controller read the transducer's noise; the DAQ logged it through its filter (80 Hz at 1 kHz: ~0.45 of it)."""
+    rng = np.random.default_rng(2)
+    n = rng.normal(0.0, 1.0, 200000)
+    m = LoggerModel(cutoff={"position": 80.0})
+    share = m.noise_share("position", 1e-3)
+    assert share == pytest.approx(np.std(first_order_filter(n, 80.0, 1e-3)), rel=0.02)
+    assert 0.40 < share < 0.50 and m.noise_share("pressure_a", 1e-3) == 1.0
