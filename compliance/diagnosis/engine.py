@@ -32,7 +32,8 @@ from compliance.diagnosis.fitted_model import fitted_plant, save_fitted
 from compliance.diagnosis.multi import CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_enough, contributions, set_effects, set_name
 from compliance.diagnosis.discriminate import design_test
 from compliance.diagnosis.empirical import empirical_term
-from compliance.diagnosis.instrument_candidates import VERDICT, instrument_candidates, instrument_verdict, instrumented, is_instrument
+from compliance.diagnosis.instrument_candidates import (PREFIX, VERDICT, instrument_candidates, instrument_verdict, instrumented,
+                                                       is_instrument)
 from compliance.diagnosis.split import adopted_fit, split_scan
 from compliance.diagnosis.friction_form import OPTION as FORM_OPTION, RETRY_VERDICTS, form_after_effects, friction_form_check
 from compliance.diagnosis.replay_fit import ReplaySetup, prepare_replay, replay_config, run_replay
@@ -204,7 +205,8 @@ def _decide(st: _Stage) -> dict:
             winner = kept[-1]["best"]
             reason = f"{' and '.join(set_effects(winner))} together explain {100*scores[winner].explained:.0f} % of the excess residual"
             verdict_name = "missing_physics" if scores[winner].explained >= EXPLAINED_ENOUGH else "unexplained"
-    verdict_name, winner, reason = instrument_verdict(scores, n, (verdict_name, winner, reason), [k for k in st.fits if is_instrument(k)])
+    verdict_name, winner, reason = instrument_verdict(scores, n, (verdict_name, winner, reason),
+                                                      [k for k in st.fits if k.startswith(PREFIX)])
     after = _own_floors(st, winner, verdict_name)
     verdict_name, reason = honest(verdict_name, winner, reason, after)
     objectives = {k: _objective(st, k) for k in st.fits if k != "nominal"}

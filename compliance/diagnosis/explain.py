@@ -5,7 +5,7 @@ from __future__ import annotations
 from compliance.effects import EFFECTS
 from compliance.diagnosis.candidates import FRICTION_LEVEL
 from compliance.diagnosis.friction_form import form_words
-from compliance.diagnosis.instrument_candidates import finding_words, is_instrument
+from compliance.diagnosis.instrument_candidates import PREFIX, finding_words, is_instrument
 from compliance.units.formatting import format_value
 
 # how each effect reads in words, with its main fitted value ({v} is filled in): ``Effect.explanation``
@@ -144,6 +144,8 @@ def _split_words(d, fp) -> str:
 def explain(d) -> str:
     """The paragraph for ``engine.Diagnosis`` ``d``."""
     text = _explain_core(d)
+    if d.winner and not is_instrument(d.winner) and PREFIX in d.winner:
+        text += f" Check your instrumentation too: {finding_words(d.fits[d.winner])}."
     if d.verdict == "partially_explained":
         text += f" It does not explain everything: what is left sits on {_left(d)}."
     return text + form_words(getattr(d, "friction_form", None)) + _contribution_words(d) + _ambiguity_words(d) + _empirical(d)

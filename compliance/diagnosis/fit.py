@@ -27,17 +27,17 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.optimize import least_squares
 
 from compliance.model.config import PlantConfig
 from compliance.effects import EFFECTS
-from compliance.errors import InputError, SimulationError
+from compliance.errors import InputError
 from compliance.diagnosis.candidates import Candidate, FitParam, apply
-from compliance.diagnosis.instrument_candidates import KIND, instrumented
-from compliance.diagnosis.replay_fit import ReplaySetup, run_replay
+from compliance.diagnosis.instrument_candidates import instrumented
+from compliance.diagnosis.replay_fit import ReplaySetup
 from compliance.diagnosis.residuals import ResidualModel, evaluate
 
 DIFF_STEP = 0.01  # forward-difference step, 1 % of each parameter's (log) range
@@ -63,25 +63,14 @@ class FitContext:
     setup: ReplaySetup
     model: ResidualModel
     sims: int = 0
-    _plant_replay: dict | None = field(default=None, repr=False)  # the parent's replay before the logger
 
     def residual(self, params, values) -> tuple[np.ndarray, dict | None]:
         """Normalised data residuals of a parameter set, and the replay (None if it failed).
 
-        Instrumentation parameters (``instrument_candidates``) act on the logger model only: a set
-        of nothing else reuses the parent configuration's replay and costs no simulation.
+        Instrumentation parameters (``instrument_candidates``) act on the logger model and on the
+        states the re-synchronisations read (the plant's, not the instrument's).
         """
         setup = instrumented(self.setup, params, values)
-        if params and all(fp.kind == KIND for fp in params):
-            if self._plant_replay is None:
-                self.sims += 1
-                try:
-                    self._plant_replay = run_replay(self.cfg, replace(self.setup, logger=None))
-                except SimulationError:
-                    return self.model.vector(None), None
-            raw = self._plant_replay
-            sim = setup.logger.apply(raw, self.cfg.p("controller.sample_time")) if setup.logger is not None else raw
-            return self.model.vector(sim), sim
         self.sims += 1
         try:
             cfg = apply(self.cfg, params, values)

@@ -5,7 +5,8 @@ logged a few ms late on a second acquisition module, a pressure transducer with 
 error, a logger that delays every channel (an undeclared anti-alias filter: a first-order filter
 at f_c delays slow signals by 1/(2 pi f_c)). None of these changes what the controller saw, so
 none is plant physics; each is fitted like an effect (``fit.FitContext`` puts it on the replayed
-channels through ``validation.logger_model``, with no new simulation) and competes under the same
+channels through ``validation.logger_model`` and takes it back from the states the
+re-synchronisations read, ``LoggerModel.true_states``) and competes under the same
 selection rule (``select.beats``): a plant-physics claim must beat the best of them, and when an
 instrumentation finding explains the recording the verdict is ``instrumentation``: check the
 instruments, the plant is not shown to be wrong.
@@ -81,18 +82,23 @@ def instrumented(setup, params, values):
             gain[name] = v
     if not delay and not gain:
         return setup
-    return replace(setup, logger=(setup.logger or LoggerModel()).with_extra(delay=delay, gain=gain))
+    ts = float(setup.time[1] - setup.time[0]) if setup.time.size > 1 else 1.0
+    states = LoggerModel(delay=delay, gain=gain).true_states(setup.states, ts)  # the re-synchronisations read the plant
+    return replace(setup, logger=(setup.logger or LoggerModel()).with_extra(delay=delay, gain=gain), states=states)
 
 
 def finding_words(fit) -> str:
-    """The finding of a fitted instrumentation candidate in words."""
+    """The instrumentation finding of a fit (an instrumentation candidate, or a plant explanation with one on top) in words."""
     from compliance.units.formatting import format_value
 
-    what = fit.name[len(PREFIX):]
+    pairs = [(fp, v) for fp, v in zip(fit.params, fit.values) if fp.kind == KIND]
+    if not pairs:
+        return ""
+    what = pairs[0][0].key[len(PREFIX):].split(".", 1)[0]
     if what == "pressure_gain":
-        v = ", ".join(f"{fp.name} x {val:.4f} ({100 * (val - 1):+.2f} % on gauge pressure)" for fp, val in zip(fit.params, fit.values))
+        v = ", ".join(f"{fp.name} x {val:.4f} ({100 * (val - 1):+.2f} % on gauge pressure)" for fp, val in pairs)
     else:
-        v = format_value(fit.values[0], "s")
+        v = format_value(pairs[0][1], "s")
     return MEANING.get(what, what).format(v=v)
 
 
@@ -118,3 +124,4 @@ def instrument_verdict(scores: dict, n: int, decided: tuple, names) -> tuple:
     why = (f"{best[len(PREFIX):].replace('_', ' ')} explains {100 * scores[best].explained:.0f} % of the excess residual"
            + (f" and {winner} does not beat it" if winner else "") + ": check the instrumentation, not the plant")
     return VERDICT, best, why
+

@@ -84,6 +84,30 @@ class LoggerModel:
         h = lfilter(*_coefficients(fc, ts), impulse)
         return float(np.sqrt(np.sum(h * h)))
 
+    def true_states(self, states: dict, ts: float) -> dict:
+        """Recorded states as the plant had them: calibration undone, delays taken back [SI arrays every ``ts``].
+
+        The replay reads measured states at its re-synchronisations; a channel logged ``delay``
+        late shows at t what the plant had at t - delay, and a gain error scales what it shows.
+        ``velocity`` follows the position's delay. Filters are not undone (that would amplify noise).
+        """
+        out = dict(states)
+        for name in FILTERED:
+            if name not in out:
+                continue
+            x = np.asarray(out[name], dtype=float)
+            g, o = self.gain.get(name, 1.0), self.offset.get(name, 0.0)
+            if g != 1.0 or o:
+                x = ATMOSPHERE_PA + (x - o - ATMOSPHERE_PA) / g if name in PRESSURES else (x - o) / g
+            d = self.delay.get(name, 0.0)
+            if d:
+                t = np.arange(x.size) * ts
+                x = np.interp(t + d, t, x)
+                if name == "position" and "velocity" in out:
+                    out["velocity"] = np.interp(t + d, t, np.asarray(out["velocity"], dtype=float))
+            out[name] = x
+        return out
+
     def apply(self, signals: dict, ts: float) -> dict:
         """Simulated signals as the logger records them (arrays on the controller grid of step ``ts`` [s]).
 

@@ -52,3 +52,17 @@ def test_pressures_logged_late_are_an_instrumentation_finding(cfg, recording):
     assert "check your instrumentation" in d.explanation.lower()
     accept = {"verdicts": ["no_mismatch", "parameters_only", "unexplained"], "named": ["time_offset"]}
     assert practice_correct(d, ["sensor:time_offset"], accept) == (True, False)
+
+
+
+def test_re_synchronisations_read_the_plant_through_the_instrument_taken_back(cfg, recording):
+    """A pressure logged 2 % high (gauge) and 5 ms late: the states a candidate's replay resets to are the plant's."""
+    frame, meta = recording
+    setup = prepare_replay(cfg, frame, meta)
+    cand = instrument_candidates(("position", "valve_command", "pressure_b"), True)
+    gain = instrumented(setup, cand[1].params, [1.02])
+    pb = setup.states["pressure_b"]
+    assert np.allclose(101325.0 + 1.02 * (gain.states["pressure_b"] - 101325.0), pb)
+    late = instrumented(setup, cand[0].params, [0.005])
+    assert late.states["pressure_b"][1000] == pytest.approx(pb[1005])
+    assert late.states["position"] is setup.states["position"]
