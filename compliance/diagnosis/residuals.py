@@ -18,7 +18,7 @@ import numpy as np
 
 from compliance.model.config import PlantConfig
 from compliance.errors import InputError, SimulationError
-from compliance.diagnosis.noise_floor import sensor_noise_std
+from compliance.diagnosis.noise_floor import QUANTISED_SHARE, sensor_noise_std
 from compliance.diagnosis.operating_point import load_at_start
 from compliance.diagnosis.replay_fit import ReplaySetup, run_replay
 
@@ -130,12 +130,9 @@ def null_recording(cfg: PlantConfig, setup: ReplaySetup, sensor: dict, seed: int
     if setup.logger is not None:  # the transducers' own noise, before the logger's filter took its share
         ts_ = float(np.median(np.diff(setup.time)))
         sensor = {k: v / setup.logger.noise_share(k, ts_) for k, v in sensor.items()}
-    # the simulated sensor quantises on top of its noise: its noise is what the estimate holds beyond q^2/12
-    noise = SensorNoise(
-        position_std=math.sqrt(max(sensor.get("position", 0.0) ** 2 - qx * qx / 12.0, 0.0)), position_quantum=qx,
-        pressure_std=math.sqrt(max(max(sensor.get("pressure_a", 0.0), sensor.get("pressure_b", 0.0)) ** 2 - qp * qp / 12.0, 0.0)),
-        pressure_quantum=qp,
-    )
+    noise = SensorNoise(position_std=_beyond_quantisation(sensor.get("position", 0.0), qx), position_quantum=qx,
+                        pressure_std=_beyond_quantisation(max(sensor.get("pressure_a", 0.0), sensor.get("pressure_b", 0.0)), qp),
+                        pressure_quantum=qp)
     t = setup.time
     ts = float(np.median(np.diff(t)))
     pre = int(round(NULL_PRE_ROLL / ts))
@@ -164,6 +161,19 @@ def null_recording(cfg: PlantConfig, setup: ReplaySetup, sensor: dict, seed: int
         frame = frame.iloc[setup.logged[setup.logged < n]].reset_index(drop=True)
     meta = {"conditions": {"load_force": setup.load}, "source_path": "<null replay>"}
     return dataclasses.replace(prepare_replay(cfg, frame, meta), logger=setup.logger)
+
+
+def _beyond_quantisation(std: float, q: float) -> float:
+    """The noise a simulated sensor adds before quantising at ``q``, from the recorded noise ``std`` [SI].
+
+    A coarse transducer's quantisation is part of the recorded spread (q^2/12 of its variance) and
+    the simulated sensor quantises on top of its noise, so its noise is what the spread holds beyond
+    that; a fine one's share (below ``QUANTISED_SHARE`` of the spread) is left in, as lab-grade
+    recordings were always replayed.
+    """
+    if q <= 0.0 or q / math.sqrt(12.0) <= QUANTISED_SHARE * std:
+        return std
+    return math.sqrt(max(std * std - q * q / 12.0, 0.0))
 
 
 def null_replay_floors(cfg: PlantConfig, setup: ReplaySetup, sensor: dict) -> tuple[dict, dict]:
