@@ -1,12 +1,17 @@
 """Diagnosis speed: wall time of ``govcheck diagnose`` on 30 s, 1 kHz recordings with the full library.
 
-Budget (issue 6): <= 60 s per 30 s recording on 2 cores with the full effect library.
-Measured as a cold process (``python -m compliance diagnose REC --plant plant-a --json OUT
---jobs N``: imports, numba cache load, reading, replays, every candidate fit, JSON) on the
-four practice recordings when ``../shared`` is beside the repository (else on two synthetic
-practice recordings), and the number of simulations each diagnosis ran.
+Budget (issue 24): <= 15 s per 30 s recording on 2 cores with the full effect library.
+Measured as a cold process (``python -m compliance diagnose REC --json OUT --jobs N``: imports,
+numba cache load, reading, replays, every candidate fit, JSON) on the four practice recordings
+when ``../shared`` is beside the repository (else on two synthetic practice recordings), and the
+number of simulations each diagnosis ran.
 
-Run: .venv/bin/python benchmarks/diagnose_speed.py [--jobs 2]
+The previous implementation is measured in the same run, on the same recordings, one after the
+other: ``--against REV`` (default ``main``) is checked out in a temporary git worktree and run
+the same way, and the ratio of the wall times is printed (``--against none`` skips it). Each
+side's numba cache is warmed by one untimed diagnosis first, so compilation is not counted.
+
+Run: .venv/bin/python benchmarks/diagnose_speed.py [--jobs 2] [--against main] [--recordings N]
 Not part of the timed test suite. The machine's other load counts: run it on a quiet machine.
 """
 
@@ -23,7 +28,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
-BUDGET = 60.0  # s per 30 s recording on 2 cores
+BUDGET = 15.0  # s per 30 s recording on 2 cores (issue 24)
 
 
 def _recordings(tmp: Path) -> list[Path]:
@@ -45,32 +50,65 @@ def _recordings(tmp: Path) -> list[Path]:
     return out
 
 
+def _diagnose(code: Path, rec: Path, out: Path, jobs: int) -> tuple[float, dict]:
+    """Wall time of one cold ``diagnose`` process running the package in ``code``, and its JSON."""
+    if out.exists():
+        out.unlink()
+    env = dict(os.environ, PYTHONPATH=str(code))
+    env.pop("NUMBA_CACHE_DIR", None)  # each side its own cache, keyed by its own compiled sources
+    cmd = [sys.executable, "-m", "compliance", "diagnose", str(rec), "--json", str(out), "--jobs", str(jobs), "--quiet"]
+    t0 = time.perf_counter()
+    p = subprocess.run(cmd, cwd=code, capture_output=True, text=True, check=False, env=env)
+    wall = time.perf_counter() - t0
+    if p.returncode != 0:
+        raise SystemExit(f"diagnose failed ({p.returncode}) in {code} on {rec}: {p.stderr[-2000:]}")
+    return wall, json.loads(out.read_text())
+
+
+def _previous(rev: str, tmp: Path) -> Path:
+    """A temporary worktree of ``rev`` (the previous implementation)."""
+    where = tmp / "previous"
+    subprocess.run(["git", "worktree", "add", "--detach", str(where), rev], cwd=ROOT, check=True, capture_output=True)
+    return where
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--against", default="main", help="git revision of the previous implementation, or 'none'")
+    ap.add_argument("--recordings", type=int, default=0, help="only the first N recordings (0: all)")
     args = ap.parse_args()
     with tempfile.TemporaryDirectory() as d:
         tmp = Path(d)
-        rows = []
-        for rec in _recordings(tmp):
-            out = tmp / "diag.json"
-            if out.exists():
-                out.unlink()
-            cmd = [sys.executable, "-m", "compliance", "diagnose", str(rec), "--plant", "plant-a", "--json", str(out),
-                   "--jobs", str(args.jobs), "--quiet"]
-            t0 = time.perf_counter()
-            p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, check=False)
-            wall = time.perf_counter() - t0
-            if p.returncode != 0:
-                raise SystemExit(f"diagnose failed ({p.returncode}) on {rec}: {p.stderr}")
-            data = json.loads(out.read_text())
-            rows.append((rec.name, wall, data["timing"]["seconds"], data["timing"]["simulations"], data["verdict"], data["winner"]))
+        recs = _recordings(tmp)[: args.recordings or None]
+        sides = {"this": ROOT}
+        if args.against != "none":
+            sides["previous"] = _previous(args.against, tmp)
+        try:
+            rows = []
+            for name, code in sides.items():
+                _diagnose(code, recs[0], tmp / "warm.json", args.jobs)  # numba cache of this side, untimed
+            for rec in recs:
+                row = {"name": rec.name}
+                for name, code in sides.items():
+                    wall, data = _diagnose(code, rec, tmp / f"{name}.json", args.jobs)
+                    row[name] = (wall, data["timing"]["simulations"], data["verdict"], data["winner"])
+                rows.append(row)
+        finally:
+            if "previous" in sides:
+                subprocess.run(["git", "worktree", "remove", "--force", str(sides["previous"])], cwd=ROOT, check=False)
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     print(f"govcheck diagnose, full library, --jobs {args.jobs} (load average at the end {load:.1f}):")
-    print(f"{'recording':34s} {'wall [s]':>9s} {'in-process [s]':>15s} {'simulations':>12s}  verdict")
-    for name, wall, inner, sims, verdict, winner in rows:
-        print(f"{name:34s} {wall:9.1f} {inner:15.1f} {sims:12d}  {verdict} {winner or ''}")
-    worst = max(r[1] for r in rows)
+    print(f"{'recording':34s} {'wall [s]':>9s} {'simulations':>12s} {'previous [s]':>13s} {'ratio':>6s}  verdict")
+    for r in rows:
+        wall, sims, verdict, winner = r["this"]
+        prev = r.get("previous")
+        extra = f"{prev[0]:13.1f} {prev[0] / wall:6.2f}" if prev else f"{'-':>13s} {'-':>6s}"
+        print(f"{r['name']:34s} {wall:9.1f} {sims:12d} {extra}  {verdict} {winner or ''}")
+    worst = max(r["this"][0] for r in rows)
+    if "previous" in rows[0]:
+        total = sum(r["previous"][0] for r in rows) / sum(r["this"][0] for r in rows)
+        print(f"speed ratio against {args.against} (previous wall / this wall, same run): {total:.2f}")
     print(f"worst {worst:.1f} s against the {BUDGET:.0f} s budget: {'within' if worst <= BUDGET else 'OVER'}")
 
 

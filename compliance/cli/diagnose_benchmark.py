@@ -90,17 +90,21 @@ def run(args) -> int:
     cfg = plant_from_args(args, fallback="plant-a")
     library = _names(args.library, "--library")
     if args.practice:
-        rep = run_practice(args.practice, cfg, library=library, jobs=jobs)
-        for row in rep["recordings"]:
+        def row_done(row):
             mark = "OK " if row["correct"] else ("AMB" if row.get("ambiguous_with_truth") else "BAD")
             print(f"{mark} {row['name']:32s} truth {row['truth']:18s} -> {row['verdict']:16s} {row['winner'] or '-':28s} "
-                  f"{row['seconds']:5.1f} s  {row['parameters']}")
+                  f"{row['seconds']:5.1f} s  {row['parameters']}", flush=True)
+
+        rep = run_practice(args.practice, cfg, library=library, jobs=jobs, progress=row_done)
         amb = sum(bool(r.get("ambiguous_with_truth")) for r in rep["recordings"])
         print(f"\n{rep['correct']}/{len(rep['recordings'])} practice recordings diagnosed correctly"
               + (f"; {amb} more called ambiguous with the truth among the explanations named" if amb else ""))
         print(f"main parameter within 25 %: {rep['main_within_25']} of {rep['main_scored']}"
               + (f"; not a hit but not identifiable by the test (split interval contains the truth): "
                  f"{rep['main_split_open_interval_contains_truth']}" if rep["main_split_open_interval_contains_truth"] else ""))
+        from compliance.diagnosis.practice_score import practice_table
+
+        print("\n" + practice_table(rep))
         if args.json:
             _write(args, rep)
         return 0 if rep["correct"] == len(rep["recordings"]) else 1

@@ -63,6 +63,8 @@ def predicted_label(diag) -> str:
         return "none"
     if diag.verdict == "ambiguous":
         return "ambiguous"  # its own column: not a hit, not "unexplained" either
+    if diag.verdict == "instrumentation":
+        return "instrumentation"  # a logger or transducer finding: never a plant effect
     return "unexplained"
 
 
@@ -335,7 +337,7 @@ def format_summary(report: dict) -> str:
 ANSWER_ALIASES = {alias: f"{name}.{p.name}" for name, eff in EFFECTS.items() for p in eff.params for alias in p.aliases}
 
 
-def run_practice(directory, cfg: PlantConfig, *, library=None, jobs: int = 1) -> dict:
+def run_practice(directory, cfg: PlantConfig, *, library=None, jobs: int = 1, progress=None) -> dict:
     """Diagnose every recording of a directory and score it against the directory's ANSWERS.json.
 
     ANSWERS.json maps a recording name (file name without ``.csv``/``.csv.gz``) to
@@ -366,7 +368,7 @@ def run_practice(directory, cfg: PlantConfig, *, library=None, jobs: int = 1) ->
         frame, meta = read_recording(files[0])
         d = diagnose(cfg, frame, meta, effects=library, jobs=jobs)
         truth = list(ans.get("effects") or [])
-        correct, ambiguous_ok = practice_correct(d, truth)
+        correct, ambiguous_ok = practice_correct(d, truth, ans.get("accept"))
         fitted = {}
         if d.winner:
             fit = d.fits[d.winner]
@@ -384,6 +386,8 @@ def run_practice(directory, cfg: PlantConfig, *, library=None, jobs: int = 1) ->
                      # the verdict's own yardstick (re-synchronised replay, x floor), every fitted value, the lag scan
                      "objective_before": d.objective_before, "objective_after": d.objective_after, "fitted": fitted,
                      "split": d.split})
+        if progress is not None:
+            progress(rows[-1])
     mains = [r["main"] for r in rows if r["main"]]
     return {"recordings": rows, "correct": sum(r["correct"] for r in rows), "main_scored": len(mains),
             "main_within_25": sum(m["within_25"] for m in mains),

@@ -160,6 +160,8 @@ def apply(cfg: PlantConfig, params, values) -> PlantConfig:
     base: dict[str, float] = {}
     effects: dict[str, dict[str, float]] = {}
     for fp, v in zip(params, values):
+        if fp.kind == "instrument":
+            continue  # on the logger, not the plant (instrument_candidates.instrumented)
         if fp.kind == "effect":
             effects.setdefault(fp.effect, {})[fp.name] = float(v)
         elif fp.key == FRICTION_LEVEL:

@@ -32,6 +32,8 @@ from compliance.diagnosis.fitted_model import fitted_plant, save_fitted
 from compliance.diagnosis.multi import CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_enough, contributions, set_effects, set_name
 from compliance.diagnosis.discriminate import design_test
 from compliance.diagnosis.empirical import empirical_term
+from compliance.diagnosis.instrument_candidates import (PREFIX, VERDICT, instrument_candidates, instrument_verdict, instrumented,
+                                                       is_instrument)
 from compliance.diagnosis.split import adopted_fit, split_scan
 from compliance.diagnosis.friction_form import OPTION as FORM_OPTION, RETRY_VERDICTS, form_after_effects, friction_form_check
 from compliance.diagnosis.replay_fit import ReplaySetup, prepare_replay, replay_config, run_replay
@@ -133,6 +135,7 @@ def _fit_singles(st: _Stage, names, recalibrate: bool) -> None:
     if bparams:
         tasks.append(("base", bparams, 2.0 * math.log(n) * max(1.0, chi2 / n)))
     tasks += [("effect", effect_candidate(e)) for e in signature_order(names, excess)]
+    tasks += [("effect", c) for c in instrument_candidates(st.model.signals, st.setup.closed_loop)]
     _run(st, tasks)
     base_fit = st.fits.get("base")
     singles = [f for f in st.fits.values() if f.name != "nominal"]
@@ -189,7 +192,7 @@ def _decide(st: _Stage) -> dict:
     """Verdict, winner, ambiguity set, each effect's own contribution (stage 5-6)."""
     n = st.model.size
     scores = score_all(st.fits, n)
-    effect_like = [k for k in st.fits if k not in ("nominal", "base")]
+    effect_like = [k for k in st.fits if k not in ("nominal", "base") and not is_instrument(k)]
     # "within the floor" on the objective every other verdict is judged on (time-resolved floors,
     # select.NOISE_TOLERANCE), not on the constant floor the JSON reports
     verdict_name, winner, reason = verdict(scores, n, _objective(st, "nominal"), effect_like)
@@ -202,10 +205,13 @@ def _decide(st: _Stage) -> dict:
             winner = kept[-1]["best"]
             reason = f"{' and '.join(set_effects(winner))} together explain {100*scores[winner].explained:.0f} % of the excess residual"
             verdict_name = "missing_physics" if scores[winner].explained >= EXPLAINED_ENOUGH else "unexplained"
+    verdict_name, winner, reason = instrument_verdict(scores, n, (verdict_name, winner, reason),
+                                                      [k for k in st.fits if k.startswith(PREFIX)])
     after = _own_floors(st, winner, verdict_name)
     verdict_name, reason = honest(verdict_name, winner, reason, after)
     objectives = {k: _objective(st, k) for k in st.fits if k != "nominal"}
-    ambiguous = ambiguity_set(scores, winner, objectives) if verdict_name != "no_mismatch" else []
+    plant_scores = {k: v for k, v in scores.items() if not is_instrument(k)}  # instruments were settled by beats()
+    ambiguous = ambiguity_set(plant_scores, winner, objectives) if verdict_name not in ("no_mismatch", VERDICT) else []
     if ambiguous and verdict_name in ("missing_physics", "parameters_only"):
         verdict_name = "ambiguous"
         reason = (f"{' and '.join(ambiguous)} explain the recording equally well (every signal within "
@@ -312,11 +318,12 @@ def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | N
     notes = list(st.setup.notes)
     fitted_cfg = full_win = seg_win = None
     if winner is not None:
-        wcfg = apply(st.rc, st.fits[winner].params, st.fits[winner].values)
-        if verdict_name in ("missing_physics", "parameters_only", "partially_explained", "ambiguous"):
-            full_win = _safe_replay(wcfg, full, notes, "full closed-loop replay of the winner")
-            fitted_cfg = fitted_plant(cfg, st.fits[winner], meta)
-        seg_win = _safe_replay(wcfg, st.setup, notes, "replay of the winner")
+        w = st.fits[winner]
+        wcfg = apply(st.rc, w.params, w.values)
+        if verdict_name in ("missing_physics", "parameters_only", "partially_explained", "ambiguous", VERDICT):
+            full_win = _safe_replay(wcfg, instrumented(full, w.params, w.values), notes, "full closed-loop replay of the winner")
+            fitted_cfg = None if is_instrument(winner) else fitted_plant(cfg, w, meta)
+        seg_win = _safe_replay(wcfg, instrumented(st.setup, w.params, w.values), notes, "replay of the winner")
     st.sims += 1 + (full_win is not None) + (seg_win is not None)
     diag = Diagnosis(
         verdict=verdict_name, reason=dec["reason"], winner=winner, runner_up=runner, fits=st.fits, scores=dec["scores"],

@@ -5,6 +5,7 @@ from __future__ import annotations
 from compliance.effects import EFFECTS
 from compliance.diagnosis.candidates import FRICTION_LEVEL
 from compliance.diagnosis.friction_form import form_words
+from compliance.diagnosis.instrument_candidates import PREFIX, finding_words, is_instrument
 from compliance.units.formatting import format_value
 
 # how each effect reads in words, with its main fitted value ({v} is filled in): ``Effect.explanation``
@@ -143,6 +144,8 @@ def _split_words(d, fp) -> str:
 def explain(d) -> str:
     """The paragraph for ``engine.Diagnosis`` ``d``."""
     text = _explain_core(d)
+    if d.winner and not is_instrument(d.winner) and PREFIX in d.winner:
+        text += f" Check your instrumentation too: {finding_words(d.fits[d.winner])}."
     if d.verdict == "partially_explained":
         text += f" It does not explain everything: what is left sits on {_left(d)}."
     return text + form_words(getattr(d, "friction_form", None)) + _contribution_words(d) + _ambiguity_words(d) + _empirical(d)
@@ -162,6 +165,10 @@ def _explain_core(d) -> str:
                 f"{share:.0f} % of the excess. The physics behind it is outside {_library(d)}; look at the located windows.")
     fit = d.fits[d.winner]
     change = _signal_change(d, list(d.fit_before))
+    if is_instrument(d.winner):
+        return (f"Check your instrumentation: the plant is not shown to be wrong. The model misses the recording {_where(d)} "
+                f"(the {SIGNAL_WORDS[worst_sig]} residual is {worst:.1f} times its noise floor) the way an instrument does: "
+                f"{finding_words(fit)}. No plant-physics explanation beats it." + (f" With it, {change}." if change else ""))
     if d.verdict == "parameters_only" or d.winner == "base":
         return (f"No physics is missing. The model misses the recording {_where(d)} (the {SIGNAL_WORDS[worst_sig]} residual is "
                 f"{worst:.1f} times its noise floor) because base parameters are off: {_base_changes(d, fit)}. "

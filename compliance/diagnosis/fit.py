@@ -36,6 +36,7 @@ from compliance.model.config import PlantConfig
 from compliance.effects import EFFECTS
 from compliance.errors import InputError
 from compliance.diagnosis.candidates import Candidate, FitParam, apply
+from compliance.diagnosis.instrument_candidates import instrumented
 from compliance.diagnosis.replay_fit import ReplaySetup
 from compliance.diagnosis.residuals import ResidualModel, evaluate
 
@@ -64,13 +65,18 @@ class FitContext:
     sims: int = 0
 
     def residual(self, params, values) -> tuple[np.ndarray, dict | None]:
-        """Normalised data residuals of a parameter set, and the replay (None if it failed)."""
+        """Normalised data residuals of a parameter set, and the replay (None if it failed).
+
+        Instrumentation parameters (``instrument_candidates``) act on the logger model and on the
+        states the re-synchronisations read (the plant's, not the instrument's).
+        """
+        setup = instrumented(self.setup, params, values)
         self.sims += 1
         try:
             cfg = apply(self.cfg, params, values)
         except InputError:
             return self.model.vector(None), None
-        return evaluate(self.model, cfg, self.setup)
+        return evaluate(self.model, cfg, setup)
 
 
 @dataclass

@@ -63,7 +63,7 @@ def locate_mismatch(cfg: PlantConfig, setup, signals, nominal: dict):
     bases = {k: v["value"] for k, v in per_unit_bases(cfg).items()}
     exclude = () if setup.closed_loop else ("valve_command",)
     settings = LocateSettings()
-    windows, _, _ = locate(rec, sim, regimes, bases, settings, exclude=exclude)
+    windows, _, _ = locate(rec, sim, regimes, bases, settings, exclude=exclude, resolutions=setup.resolution)
     events = merge_across_signals(windows, regimes, settings.merge_gap)
     mask = np.zeros(setup.time.size, dtype=bool)
     for e in events:

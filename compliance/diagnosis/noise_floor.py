@@ -16,6 +16,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.signal import savgol_coeffs, savgol_filter
 
+from compliance.validation.recorded_noise import quantisation_std
+
 POSITION_WINDOW = 41  # samples: the smoother that separates position noise from motion (1 kHz: 41 ms)
 POSITION_ORDER = 3
 HOLD_WINDOW = 301  # samples: while the servo holds, a smoother this long still follows the motion (1 kHz: 0.3 s) ...
@@ -23,6 +25,9 @@ HOLD_TOLERANCE = 2.0  # ... where what it removes beyond the short one stays wit
 SIGNAL_WINDOW = 21
 SIGNAL_ORDER = 2
 MAD_TO_STD = 1.4826  # normal distribution: std = 1.4826 * MAD
+QUANTISED_SHARE = 0.5  # quantisation std above this share of the MAD estimate: use the trimmed RMS
+TRIM = 0.01  # share of the largest residuals (transients) left out of the trimmed RMS
+TRIMMED_RMS = 0.9617  # RMS of a normal variable within its central 99 %, in standard deviations
 
 
 def _window(n: int, window: int, order: int) -> int:
@@ -37,8 +42,16 @@ def smoother_keep_factor(window: int, order: int) -> float:
     return float(1.0 - 2.0 * h0 + np.sum(h * h))
 
 
-def position_noise_estimate(position: np.ndarray) -> np.ndarray:
+def _odd_samples(window: int, dt: float) -> int:
+    """A window given in samples at 1 kHz, in samples at the step ``dt`` [s] (odd)."""
+    return int(round(window * 1e-3 / dt)) | 1
+
+
+def position_noise_estimate(position: np.ndarray, dt: float = 1e-3) -> np.ndarray:
     """The recording's position noise as the part a smoother does not keep [m].
+
+    ``dt`` is the sample step [s]; the windows below are stated at 1 kHz and keep their length
+    in seconds at other rates.
 
     The 41 ms smoother that follows a step keeps the noise below ~25 Hz, the band a spool or a
     dead band passes: a replayed controller fed only the rest crosses the dead band less often
@@ -51,9 +64,9 @@ def position_noise_estimate(position: np.ndarray) -> np.ndarray:
     x = np.asarray(position, dtype=float)
     if x.size < POSITION_ORDER + 3:
         return np.zeros_like(x)
-    w = _window(x.size, POSITION_WINDOW, POSITION_ORDER)
+    w = _window(x.size, _odd_samples(POSITION_WINDOW, dt), POSITION_ORDER)
     short = savgol_filter(x, w, POSITION_ORDER)
-    wl = HOLD_WINDOW
+    wl = _odd_samples(HOLD_WINDOW, dt)
     if x.size < 3 * wl:
         return np.ascontiguousarray(x - short)
     long = savgol_filter(x, wl, POSITION_ORDER)
@@ -68,7 +81,7 @@ def position_noise_estimate(position: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(np.where(holding, x - long, x - short))
 
 
-def sensor_noise_std(values: np.ndarray, window: int = SIGNAL_WINDOW, order: int = SIGNAL_ORDER) -> float:
+def sensor_noise_std(values: np.ndarray, window: int = SIGNAL_WINDOW, order: int = SIGNAL_ORDER, resolution: float = 0.0) -> float:
     """Robust estimate of the white sensor noise on a recorded signal [signal unit].
 
     Parameters
@@ -77,11 +90,14 @@ def sensor_noise_std(values: np.ndarray, window: int = SIGNAL_WINDOW, order: int
         Recorded signal (uniform sampling).
     window, order : int
         Savitzky-Golay smoother separating noise from the signal.
+    resolution : float
+        Declared quantisation step [signal unit]; 0: the lattice the values sit on, if any.
 
     Returns
     -------
     float
-        Standard deviation of the noise; transients barely move it (median absolute deviation).
+        Standard deviation of the noise; transients barely move it (median absolute deviation);
+        never below the quantisation's q / sqrt(12) (``recorded_noise.quantisation_std``).
     """
     x = np.asarray(values, dtype=float)
     if x.size < order + 3:
@@ -89,7 +105,16 @@ def sensor_noise_std(values: np.ndarray, window: int = SIGNAL_WINDOW, order: int
     w = _window(x.size, window, order)
     r = x - savgol_filter(x, w, order)
     mad = float(np.median(np.abs(r - np.median(r))))
-    std = MAD_TO_STD * mad / np.sqrt(smoother_keep_factor(w, order))
+    keep = np.sqrt(smoother_keep_factor(w, order))
+    std = MAD_TO_STD * mad / keep
+    q_std = quantisation_std(x, resolution)
+    if q_std > QUANTISED_SHARE * std:
+        # a coarse lattice (50 um against 20 um of noise): the residual takes a few values and its median
+        # absolute deviation says little; the RMS of all but its largest TRIM share does not collapse
+        a = np.abs(r - np.median(r))
+        kept = a[a <= np.quantile(a, 1.0 - TRIM)]
+        std = max(std, float(np.sqrt(np.mean(kept * kept))) / keep / TRIMMED_RMS)
+    std = max(std, q_std)
     if std == 0.0:  # heavily quantised, noise-free signal: quantisation noise q/sqrt(12)
         steps = np.abs(np.diff(x))
         steps = steps[steps > 0]

@@ -14,13 +14,27 @@ def answer_in_si(name: str, value: float) -> float:
     return value * ANSWER_TO_SI.get(name, 1.0)
 
 
-def practice_correct(d, truth: list) -> tuple[bool, bool]:
+def _accepted(d, accept: dict) -> bool:
+    """A verdict the answers' ``accept`` lists, or a winner naming only an instrumentation finding."""
+    if d.verdict in accept.get("verdicts", ()):
+        return True
+    names = [w for w in (d.winner or "").split("+") if w]
+    if not names or any(w in EFFECTS for w in names):
+        return False  # a catalogue effect claimed for a truth that is not plant physics
+    return any(any(word in w for word in accept.get("named", ())) for w in names)
+
+
+def practice_correct(d, truth: list, accept: dict | None = None) -> tuple[bool, bool]:
     """(right verdict and top explanation, ambiguous with the truth among the explanations named).
 
     A truth of declared effects needs ``missing_physics`` with exactly those effects on top; a truth
     that is not a declared effect (a parameter error such as ``valve_conductance``) needs
     ``parameters_only``; no truth needs ``no_mismatch`` (``parameters_only`` accepted: no physics missing).
+    ``accept`` (ANSWERS.json, where the plain rule does not fit: a sensor-only truth) lists the
+    verdicts that count as right and the words an instrumentation finding's name may carry.
     """
+    if accept:
+        return _accepted(d, accept), False
     winner_effects = [e for e in (d.winner or "").split("+") if e in EFFECTS]
     declared = [e for e in truth if e in EFFECTS]
     if declared:
@@ -59,4 +73,20 @@ def main_parameter(d, truth: list, params: dict) -> dict | None:
     return out
 
 
-__all__ = ["answer_in_si", "main_parameter", "practice_correct"]
+def practice_table(rep: dict) -> str:
+    """The scored practice recordings as a Markdown table (``benchmark.run_practice``'s result)."""
+    lines = ["| recording | truth | verdict | winner | right | largest residual after (x floor) | main parameter error | s |",
+             "|---|---|---|---|---|---|---|---|"]
+    for r in rep["recordings"]:
+        after = r.get("objective_after") or r.get("objective_before") or {}
+        worst = max(after.items(), key=lambda kv: kv[1], default=None)
+        main = r.get("main") or {}
+        err = f"{100 * main['error']:.0f} % ({main['parameter']})" if main.get("error") is not None else "-"
+        lines.append(f"| {r['name']} | {r['truth']} | {r['verdict']} | {r['winner'] or '-'} | "
+                     f"{'yes' if r['correct'] else 'no'} | {f'{worst[1]:.2f} ({worst[0]})' if worst else '-'} | {err} | "
+                     f"{r['seconds']:.0f} |")
+    lines.append(f"\n{rep['correct']}/{len(rep['recordings'])} right.")
+    return "\n".join(lines)
+
+
+__all__ = ["answer_in_si", "main_parameter", "practice_correct", "practice_table"]

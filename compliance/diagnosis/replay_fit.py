@@ -41,7 +41,9 @@ from compliance.model.rest_state import initial_state, set_rest_internal_states
 from compliance.diagnosis.operating_point import load_at_start
 from compliance.simulation.rk4 import N_OUT, OUTPUT_COLUMNS
 from compliance.simulation.pid_loop import simulate_core
-from compliance.diagnosis.noise_floor import position_noise_estimate
+from compliance.diagnosis.noise_floor import position_noise_estimate, sensor_noise_std
+from compliance.validation.logger_model import logger_model
+from compliance.validation.recorded_noise import position_quantum
 
 SIGNALS = ("position", "pressure_a", "pressure_b", "valve_command", "supply_pressure")
 _OUT = {name: i for i, name in enumerate(OUTPUT_COLUMNS)}
@@ -49,6 +51,7 @@ MAX_SEGMENT = 2.0  # s; longest stretch replayed without re-synchronising
 MIN_SEGMENT = 0.5  # s; a set-point change closer than this to the last reset does not start a new segment
 PRE_STEP = 0.1  # s; a segment starts this long before a set-point change (the servo is still at rest)
 _STATE_WINDOW = 41  # samples; Savitzky-Golay window for the states read from the recording
+FILL_SEED = 20240  # seed of the readings drawn between a slow logger's samples (``_injected_noise``)
 _VELOCITY_WINDOW = 81  # samples; cubic S-G derivative: 20 um noise at 1 kHz -> ~0.25 mm/s velocity noise
 
 
@@ -85,6 +88,14 @@ class ReplaySetup:
         Base-parameter overrides from the recording's sidecar.
     notes : list of str
     source : str
+    logged : ndarray or None
+        Controller periods at which the logger wrote a sample (None: every period); residuals,
+        noise floors and the injected noise use these samples only.
+    logger : LoggerModel or None
+        What the logger did to the signals (``validation.logger_model``), applied to every replay.
+    resolution : dict
+        Measured signal -> quantisation step [SI]: declared (``metadata["channels"]``) or the
+        lattice of the logged samples (0 when none).
     """
 
     time: np.ndarray
@@ -101,11 +112,19 @@ class ReplaySetup:
     overrides: dict = field(default_factory=dict)
     notes: list = field(default_factory=list)
     source: str = "<recording>"
+    logged: np.ndarray | None = None
+    logger: object = None
+    resolution: dict = field(default_factory=dict)
 
     @property
     def n_samples(self) -> int:
         """Number of controller periods simulated."""
         return self.time.size - 1
+
+    @property
+    def samples(self) -> np.ndarray:
+        """Indices of the controller grid that carry a logged sample."""
+        return np.arange(self.time.size) if self.logged is None else self.logged
 
 
 def segment_starts(time: np.ndarray, reference: np.ndarray, speed: np.ndarray | None = None,
@@ -180,6 +199,7 @@ def prepare_replay(cfg: PlantConfig, frame: pd.DataFrame, meta: dict, *, inject_
         Missing columns, a time base the controller clock cannot follow.
     """
     from compliance.validation.replay import initial_conditions, load_from_metadata, on_controller_clock, replay_config as _overrides_of
+    from compliance.validation.resampling import logged_indices
 
     src = str(meta.get("source_path", "<recording>"))
     for col in ("time", "position", "valve_command"):
@@ -192,28 +212,28 @@ def prepare_replay(cfg: PlantConfig, frame: pd.DataFrame, meta: dict, *, inject_
     notes: list[str] = []
     ts = run_cfg.p("controller.sample_time")
     frame, note = on_controller_clock(frame, ts, src)  # one sample per controller period
+    logged = None
     if note:
         notes.append(note)
+        logged = logged_indices(t, ts)
         t = frame["time"].to_numpy(dtype=float)
+        logged = logged[logged < t.size]
     closed = "reference" in frame.columns
     rec = {s: frame[s].to_numpy(dtype=float) for s in SIGNALS if s in frame.columns}
     init = initial_conditions(frame, run_cfg, src)
     x0 = init["initial_position"]
     pressures = init["initial_pressures"]
-    load = load_from_metadata(meta)
-    if load is None:
-        if pressures is not None and cfg.option("cylinder.arrangement") == "tandem":
-            load = (pressures[0] - pressures[1]) * (cfg.piston_area + cfg.rod_side_area)
-            notes.append(f"no load in the sidecar: {load/1e3:.2f} kN estimated from the initial pressure difference")
-        else:
-            load = 0.0
-            notes.append("no load in the sidecar and no pressures to estimate it: replayed without load")
+    load = _test_load(cfg, load_from_metadata(meta), pressures, notes)
     if closed:
         reference = frame["reference"].to_numpy(dtype=float)
     else:
         reference = np.full(t.size, x0)
         notes.append("no reference column: replayed open loop from the recorded valve command")
-    noise = position_noise_estimate(rec["position"]) if (closed and inject_noise) else np.zeros(t.size)
+    resolution = _resolutions(rec, logged, meta)
+    logger = logger_model(meta)
+    share = logger.noise_share("position", ts) if logger is not None else 1.0
+    noise = (_injected_noise(rec["position"], logged, ts, resolution["position"], share) if (closed and inject_noise)
+             else np.zeros(t.size))
     tt = t - t[0]
     states = {"position": _smooth(rec["position"]), "velocity": _smooth(rec["position"], 1, ts, _VELOCITY_WINDOW)}
     resets = (segment_starts(tt, reference if closed else rec["valve_command"], states["velocity"], max_segment)
@@ -228,8 +248,63 @@ def prepare_replay(cfg: PlantConfig, frame: pd.DataFrame, meta: dict, *, inject_
         time=tt, reference=np.ascontiguousarray(reference), command=np.ascontiguousarray(rec["valve_command"]),
         closed_loop=closed, load=load, initial_position=float(x0), initial_pressures=pressures,
         noise=np.ascontiguousarray(noise), recorded=rec, resets=resets, states=states, overrides=overrides,
-        notes=notes, source=src,
+        notes=notes, source=src, logged=logged, logger=logger, resolution=resolution,
     )
+
+
+def _test_load(cfg: PlantConfig, load, pressures, notes: list):
+    """The sidecar's load, else the initial pressure difference's (tandem), else none (noted)."""
+    if load is not None:
+        return load
+    if pressures is not None and cfg.option("cylinder.arrangement") == "tandem":
+        load = (pressures[0] - pressures[1]) * (cfg.piston_area + cfg.rod_side_area)
+        notes.append(f"no load in the sidecar: {load/1e3:.2f} kN estimated from the initial pressure difference")
+        return load
+    notes.append("no load in the sidecar and no pressures to estimate it: replayed without load")
+    return 0.0
+
+
+def _resolutions(rec: dict, logged: np.ndarray | None, meta: dict) -> dict:
+    """Signal -> quantisation step [SI]: the channel's declared resolution, else the logged samples' lattice."""
+    channels = meta.get("channels") or {}
+    out = {}
+    for s, v in rec.items():
+        declared = (channels.get(s) or {}).get("resolution")
+        out[s] = float(declared) if declared else position_quantum(v if logged is None else v[logged])
+    return out
+
+
+def _injected_noise(position: np.ndarray, logged: np.ndarray | None, ts: float, quantum: float = 0.0,
+                    share: float = 1.0) -> np.ndarray:
+    """The position noise the controller saw, estimated where the logger sampled it [m].
+
+    On a log slower than the controller the noise is known only at the logged instants: it is
+    estimated on those samples (smoother windows in seconds, not samples). Between them the
+    controller saw other, independent readings: they are drawn (seeded, ``FILL_SEED``) with the
+    noise level the logged samples show and quantised like the transducer. Interpolating instead
+    would hand the replayed controller a smoother signal than the real one read: on a 250 Hz
+    trend log of a valve-offset servo (50 um transducer) its derivative term then dithered the
+    valve with 0.29 V instead of the recorded 0.35 V, and a 30 ms sensor lag fitted as well as
+    the true offset; with drawn readings the replay dithers 0.35 V and the offset's 1 s mean
+    command misfit falls from 0.08 V to 0.04 V. Behind an anti-alias filter (``share`` < 1: the
+    share of white noise it passes, ``LoggerModel.noise_share``) no logged sample is a reading
+    the controller saw: every reading is drawn, at the logged noise level divided by ``share``.
+    """
+    if logged is None and share == 1.0:
+        return position_noise_estimate(position)
+    logged = np.arange(position.size) if logged is None else logged
+    x = position[logged]
+    est = position_noise_estimate(x, dt=float(np.median(np.diff(logged))) * ts)
+    out = np.interp(np.arange(position.size), logged, est)
+    between = np.ones(position.size, dtype=bool)
+    if share == 1.0:
+        between[logged] = False
+    sigma = sensor_noise_std(x, resolution=quantum) / share
+    sigma = float(np.sqrt(max(sigma * sigma - quantum * quantum / 12.0, 0.0)))  # the noise beyond the quantisation
+    base = position[between] - out[between]  # the interpolated reading without noise
+    draw = base + np.random.default_rng(FILL_SEED).normal(0.0, sigma, int(between.sum()))
+    out[between] = (np.round(draw / quantum) * quantum if quantum > 0 else draw) - base
+    return out
 
 
 def replay_config(cfg: PlantConfig, setup: ReplaySetup) -> PlantConfig:
@@ -301,4 +376,5 @@ def run_replay(cfg: PlantConfig, setup: ReplaySetup, *, noise: np.ndarray | None
         if status >= 0:
             raise SimulationError(f"replay of {setup.source} became non-physical at t = {(k0 + status)*ts:.3f} s")
         out[k0:k1 + 1] = seg
-    return {s: out[:, _OUT[s]] for s in SIGNALS} | {c: out[:, _OUT[c]] for c in ("position_true", "temperature_a", "temperature_b")}
+    sim = {s: out[:, _OUT[s]] for s in SIGNALS} | {c: out[:, _OUT[c]] for c in ("position_true", "temperature_a", "temperature_b")}
+    return setup.logger.apply(sim, ts) if setup.logger is not None else sim  # as the logger recorded it

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 
 from compliance.effects import EFFECTS
+from compliance.diagnosis.instrument_candidates import finding_words, is_instrument
 from compliance.files.jsonable import json_number
 from compliance.model.parameters import BASE_BY_KEY
 from compliance.diagnosis.candidates import FRICTION_LEVEL
@@ -18,7 +19,10 @@ SCHEMA = "govcheck-diagnosis/1"  # docs/diagnosis-schema.md
 def _param_rows(cfg, fit) -> list[dict]:
     rows = []
     for fp, v, e in zip(fit.params, fit.values, fit.stderr):
-        if fp.kind == "effect":
+        if fp.kind == "instrument":  # a finding about the logger or a transducer, not the plant
+            rows.append({"name": fp.key, "kind": "instrument", "value": json_number(v), "stderr": json_number(e), "unit": fp.unit,
+                         "meaning": "check your instrumentation: " + finding_words(fit), "nominal": json_number(fp.nominal)})
+        elif fp.kind == "effect":
             rows.append({"name": fp.key, "kind": "effect", "value": json_number(v), "stderr": json_number(e), "unit": fp.unit,
                          "meaning": EFFECTS[fp.effect].param(fp.name).meaning, "default": json_number(fp.nominal)})
         elif fp.key == FRICTION_LEVEL:
@@ -79,7 +83,7 @@ def diagnosis_to_dict(d) -> dict:
     for rank, name in enumerate(ranked, start=1):
         f = d.fits[name]
         s = d.scores[name]
-        kind = "nominal" if name == "nominal" else "base" if name == "base" else "effect"
+        kind = "nominal" if name == "nominal" else "base" if name == "base" else "instrument" if is_instrument(name) else "effect"
         effects.append({
             "rank": rank,
             "name": name,

@@ -11,13 +11,14 @@ with a heteroscedastic error model from a parametric bootstrap).
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from compliance.model.config import PlantConfig
 from compliance.errors import InputError, SimulationError
-from compliance.diagnosis.noise_floor import sensor_noise_std
+from compliance.diagnosis.noise_floor import QUANTISED_SHARE, sensor_noise_std
 from compliance.diagnosis.operating_point import load_at_start
 from compliance.diagnosis.replay_fit import ReplaySetup, run_replay
 
@@ -94,13 +95,6 @@ def compared_signals(setup: ReplaySetup) -> tuple[str, ...]:
     return tuple(out)
 
 
-def _quantum(values: np.ndarray) -> float:
-    """Quantisation step of a recorded signal (0 when it is not on a grid); see compliance.validation.replay."""
-    from compliance.validation.replay import position_quantum
-
-    return position_quantum(values)
-
-
 def null_replay_errors(cfg: PlantConfig, setup: ReplaySetup, sensor: dict, seed: int = 7) -> dict:
     """How far a *correct* model's replay stays from its recording, signal by signal [SI].
 
@@ -131,12 +125,14 @@ def null_recording(cfg: PlantConfig, setup: ReplaySetup, sensor: dict, seed: int
     from compliance.simulation import Scenario, SensorNoise, simulate
     from compliance.diagnosis.replay_fit import prepare_replay
 
-    rec = setup.recorded
-    noise = SensorNoise(
-        position_std=sensor.get("position", 0.0), position_quantum=_quantum(rec["position"]),
-        pressure_std=max(sensor.get("pressure_a", 0.0), sensor.get("pressure_b", 0.0)),
-        pressure_quantum=_quantum(rec["pressure_a"]) if "pressure_a" in rec else 0.0,
-    )
+    rec, res = setup.recorded, setup.resolution
+    qx, qp = res.get("position", 0.0), max(res.get("pressure_a", 0.0), res.get("pressure_b", 0.0))
+    if setup.logger is not None:  # the transducers' own noise, before the logger's filter took its share
+        ts_ = float(np.median(np.diff(setup.time)))
+        sensor = {k: v / setup.logger.noise_share(k, ts_) for k, v in sensor.items()}
+    noise = SensorNoise(position_std=_beyond_quantisation(sensor.get("position", 0.0), qx), position_quantum=qx,
+                        pressure_std=_beyond_quantisation(max(sensor.get("pressure_a", 0.0), sensor.get("pressure_b", 0.0)), qp),
+                        pressure_quantum=qp)
     t = setup.time
     ts = float(np.median(np.diff(t)))
     pre = int(round(NULL_PRE_ROLL / ts))
@@ -158,9 +154,26 @@ def null_recording(cfg: PlantConfig, setup: ReplaySetup, sensor: dict, seed: int
     for s_ in ("pressure_a", "pressure_b", "supply_pressure"):
         if s_ in rec:
             frame[s_] = syn[s_].to_numpy()[:n]
+    if setup.logger is not None:  # through the recording's instruments (filter, delays, calibration) ...
+        logged = setup.logger.apply({c: frame[c].to_numpy() for c in frame.columns}, ts)
+        frame = pd.DataFrame({c: logged[c] for c in frame.columns})
+    if setup.logged is not None:  # ... at the instants it logged
+        frame = frame.iloc[setup.logged[setup.logged < n]].reset_index(drop=True)
     meta = {"conditions": {"load_force": setup.load}, "source_path": "<null replay>"}
-    syn_setup = prepare_replay(cfg, frame, meta)
-    return syn_setup
+    return dataclasses.replace(prepare_replay(cfg, frame, meta), logger=setup.logger)
+
+
+def _beyond_quantisation(std: float, q: float) -> float:
+    """The noise a simulated sensor adds before quantising at ``q``, from the recorded noise ``std`` [SI].
+
+    A coarse transducer's quantisation is part of the recorded spread (q^2/12 of its variance) and
+    the simulated sensor quantises on top of its noise, so its noise is what the spread holds beyond
+    that; a fine one's share (below ``QUANTISED_SHARE`` of the spread) is left in, as lab-grade
+    recordings were always replayed.
+    """
+    if q <= 0.0 or q / math.sqrt(12.0) <= QUANTISED_SHARE * std:
+        return std
+    return math.sqrt(max(std * std - q * q / 12.0, 0.0))
 
 
 def null_replay_floors(cfg: PlantConfig, setup: ReplaySetup, sensor: dict) -> tuple[dict, dict]:
@@ -232,12 +245,15 @@ def build_residual_model(cfg: PlantConfig, setup: ReplaySetup, *, stride: int = 
         Unused (kept for callers that already ran the nominal replay).
     """
     signals = compared_signals(setup)
-    sensor = {s: (0.0 if s == "valve_command" else sensor_noise_std(setup.recorded[s])) for s in signals}
+    logged = setup.samples
+    sensor = {s: (0.0 if s == "valve_command" else sensor_noise_std(setup.recorded[s][logged], resolution=setup.resolution.get(s, 0.0)))
+              for s in signals}
     try:
         null, null_local = null_replay_floors(cfg, setup, sensor)
     except (SimulationError, InputError):
         null, null_local = {}, {}
-    index = np.arange(0, setup.time.size, max(1, int(stride)))
+    step = float(np.median(np.diff(logged))) if logged.size > 1 else 1.0
+    index = logged[::max(1, int(round(stride / step)))]  # logged samples only, about ``stride`` periods apart
     floors, local = {}, {}
     for s in signals:
         own = sensor[s] if s != "position" or not setup.closed_loop else 0.0

@@ -83,12 +83,14 @@ def read_text_table(path: Path, cmap: ColumnMap | None) -> RecordingSource:
     comment = cmap.comment if cmap else "#"
     skip = cmap.skip_rows if cmap else 0
     header = cmap.header if cmap else True
-    numbers, lines = [], []
+    numbers, lines, comments = [], [], []
     for no, line in enumerate(text.splitlines()[skip:], start=skip + 1):
         stripped = line.strip()
         if stripped and not stripped.startswith(comment):
             numbers.append(no)
             lines.append(line)
+        elif stripped and not lines:
+            comments.append(stripped[len(comment):].strip())  # the logger's own header lines (instruments.py)
     if not lines:
         raise InputError(f"{path}: no data (only blank or '{comment}' comment lines)")
     delim = sniff_delimiter(lines[0], path, cmap.delimiter if cmap else "auto")
@@ -138,4 +140,4 @@ def read_text_table(path: Path, cmap: ColumnMap | None) -> RecordingSource:
     def get(spec: ColumnSpec):
         return columns[column_position(spec, keys, str(path), "column", too_few, "header has")], None
 
-    return RecordingSource(keys, get, lambda i: f"line {numbers[i]}")
+    return RecordingSource(keys, get, lambda i: f"line {numbers[i]}", extra={"comment_lines": comments} if comments else None)

@@ -13,6 +13,7 @@ from pathlib import Path
 
 from compliance.errors import InputError
 from compliance.recordings.sidecar_schema import check_sidecar
+from compliance.recordings.instruments import instrument_facts
 from compliance.units import parse_quantity, registry
 
 __all__ = ["read_sidecar", "si_metadata", "sidecar_path"]
@@ -48,14 +49,15 @@ def read_sidecar(path) -> dict:
     Raises
     ------
     InputError
-        The sidecar is not valid TOML, or holds a pressure without ``abs`` / ``gauge``.
+        The sidecar is not valid TOML, holds a pressure without ``abs`` / ``gauge``, or a
+        ``[logger]`` / ``[channels.NAME]`` table that ``instruments.instrument_facts`` rejects.
     """
     side = sidecar_path(path)
     if not side.is_file():
         return {}
     data, _ = read_toml(side, "recording sidecar")
     check_sidecar(data, str(side))
-    return si_metadata(data, str(side))
+    return si_metadata(instrument_facts(data, str(side)), str(side))
 
 
 def si_metadata(data, where: str):

@@ -34,6 +34,7 @@ from compliance.recordings.columns import RecordingSource, build_frame, canonica
 from compliance.recordings.comtrade import partner_file, read_comtrade
 from compliance.recordings.delimited import TEXT_SUFFIXES, read_text_table
 from compliance.recordings.mat import read_mat
+from compliance.recordings.instruments import instrument_facts, logger_from_comments
 from compliance.recordings.metadata import read_sidecar, si_metadata, sidecar_path
 from compliance.recordings.parquet import read_parquet
 from compliance.recordings.plausibility import check_ranges, check_time_base, relative_time
@@ -97,10 +98,9 @@ def read_recording(path, column_map=None, *, required=DEFAULT_REQUIRED):
     check_ranges(path, frame, row)  # every sample, not only the first
     meta = {"time_start": time_start} if time_start else {}
     if cmap is not None and cmap.metadata:
-        meta.update(si_metadata(cmap.metadata, f"{cmap.source}: metadata"))
+        meta.update(si_metadata(instrument_facts(cmap.metadata, f"{cmap.source}: metadata"), f"{cmap.source}: metadata"))
     meta.update(read_sidecar(path))
-    if src.extra:
-        meta.update(src.extra)
+    meta = _with_source_facts(meta, dict(src.extra or {}))
     _merge_channel_facts(meta, channel_facts(path, src, specs, cmap))
     time_spec = cmap.spec("time") if cmap is not None else None
     check_time_base(path, frame["time"].to_numpy(), meta,
@@ -133,6 +133,23 @@ def _merge_channel_facts(meta: dict, facts: dict) -> None:
             old = entry.get(key)
             numeric = isinstance(old, (int, float)) and not isinstance(old, bool)
             entry[key] = max(float(old), value) if key == "resolution" and numeric else (old if old is not None else value)
+
+
+def _with_source_facts(meta: dict, extra: dict) -> dict:
+    """Metadata with what the file itself says: a format's own channel facts (a COMTRADE channel's
+    resolution) under the declared ones, and logger facts from recognised comment lines only when
+    neither the sidecar nor the column map declares a ``[logger]``."""
+    comments = extra.pop("comment_lines", None)
+    channels = extra.pop("channels", None)
+    meta.update(extra)
+    if channels:
+        declared = meta.get("channels") or {}
+        meta["channels"] = {name: {**channels.get(name, {}), **declared.get(name, {})} for name in {**channels, **declared}}
+    if "logger" not in meta:
+        stated = logger_from_comments(comments)
+        if stated:
+            meta["logger"] = stated
+    return meta
 
 
 def _detect_format(path: Path, cmap: ColumnMap | None) -> str:

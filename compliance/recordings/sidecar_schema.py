@@ -4,8 +4,9 @@ Every key the readers, the replay and the characterisation look up is declared h
 SI unit; anything else is an error with the closest known key (``load_forse`` -> ``load_force``),
 so a misspelt key is never silently ignored and its default silently used. A quantity string
 of the wrong kind (a load in tonnes, a mass, where a force is expected) is named before any
-conversion hides it. Tables are added here, in one place: ``[logger]`` and ``[channels.NAME]``
-(per-channel facts, docs/recording-format.md) are declared like the others.
+conversion hides it. The instruments' tables, ``[logger]`` and ``[channels.NAME]``
+(docs/recording-format.md), have their own declaration in ``recordings/instruments.py``, which
+checks them; here they are known keys.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from dataclasses import dataclass
 
 from compliance.errors import InputError, did_you_mean
 
-__all__ = ["SIDECAR_SCHEMA", "Free", "PerName", "Value", "check_sidecar"]
+__all__ = ["SIDECAR_SCHEMA", "Free", "Value", "check_sidecar"]
 
 
 @dataclass(frozen=True)
@@ -24,13 +25,6 @@ class Value:
     unit: str | None
     meaning: str
     also: tuple[str, ...] = ()
-
-
-@dataclass(frozen=True)
-class PerName:
-    """A table of tables keyed by a free name (``[channels.position]``), each laid out as ``table``."""
-
-    table: dict
 
 
 @dataclass(frozen=True)
@@ -62,15 +56,9 @@ SIDECAR_SCHEMA: dict = {
         "kd": Value("V*s/m", "derivative gain"),
         "sample_time": Value("s", "controller sample interval"),
     },
-    "logger": {
-        "rate": Value("Hz", "logger sample rate"),
-        "anti_alias_cutoff": Value("Hz", "anti-alias filter cut-off"),
-    },
-    "channels": PerName({
-        "resolution": Value(None, "smallest step of the channel, in the channel's own unit (converted with the channel)"),
-        "delay": Value("s", "delay of the channel behind the others"),
-        "gain": Value("", "relative gain error of the channel"),
-    }),
+    # the instruments' tables are declared and checked in one place, recordings/instruments.py
+    "logger": Free("the logger: rate, anti-alias filter (recordings/instruments.py)"),
+    "channels": Free("each channel's sensor: delay, resolution, gain, offset (recordings/instruments.py)"),
     "synthesis": Free("how a synthetic recording was made (compliance.recordings.synth)"),
 }
 
@@ -106,12 +94,7 @@ def check_sidecar(data, where: str, schema: dict | None = None, keys: str = "") 
             raise InputError(f"{path}: unknown key '{key}'{did_you_mean(key, schema)} (known: {', '.join(schema)})")
         if isinstance(spec, Free):
             continue
-        if isinstance(spec, PerName):
-            if not isinstance(value, dict):
-                raise InputError(f"{path}: expected a table of tables such as [{key}.position]")
-            for name, table in value.items():
-                check_sidecar(table, where, spec.table, f"{dotted}.{name}")
-        elif isinstance(spec, dict):
+        if isinstance(spec, dict):
             check_sidecar(value, where, spec, dotted)
         else:
             _check_value(value, spec, path)

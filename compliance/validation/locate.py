@@ -26,6 +26,7 @@ import numpy as np
 import pandas as pd
 
 from compliance.errors import InputError
+from compliance.validation.recorded_noise import quantisation_std
 from compliance.validation.regimes import Regimes, attribute
 
 SIGNALS = ("position", "valve_command", "pressure_a", "pressure_b", "supply_pressure")
@@ -147,7 +148,7 @@ def residuals(recording: pd.DataFrame, simulated: pd.DataFrame, signals=SIGNALS,
     return out
 
 
-def noise_floor(values: np.ndarray, rest: np.ndarray | None = None, minimum: float = 0.0) -> float:
+def noise_floor(values: np.ndarray, rest: np.ndarray | None = None, minimum: float = 0.0, resolution: float = 0.0) -> float:
     """Noise standard deviation of a recorded signal from its first differences (see module doc).
 
     Parameters
@@ -158,6 +159,9 @@ def noise_floor(values: np.ndarray, rest: np.ndarray | None = None, minimum: flo
         Samples at rest; used when there are at least ``MIN_REST_SAMPLES`` consecutive pairs.
     minimum : float
         Lower bound of the result (SI).
+    resolution : float
+        Declared quantisation step (SI); 0: the lattice of the values, if any. The floor is never
+        below its q / sqrt(12) (``recorded_noise.quantisation_std``).
     """
     y = np.asarray(values, dtype=float)
     d = np.diff(y)
@@ -165,10 +169,11 @@ def noise_floor(values: np.ndarray, rest: np.ndarray | None = None, minimum: flo
         pair = np.asarray(rest[1:], dtype=bool) & np.asarray(rest[:-1], dtype=bool)
         if np.count_nonzero(pair) >= MIN_REST_SAMPLES:
             d = d[pair]
+    q_std = quantisation_std(y, resolution)
     if d.size == 0:
-        return float(minimum)
+        return max(float(minimum), q_std)
     sigma = 1.4826 * float(np.median(np.abs(d - np.median(d)))) / math.sqrt(2.0)
-    return max(sigma, float(minimum))
+    return max(sigma, float(minimum), q_std)
 
 
 def smoothed_abs(time: np.ndarray, values: np.ndarray, window: float) -> np.ndarray:
@@ -227,6 +232,7 @@ def locate(
     bases: dict[str, float],
     settings: LocateSettings = LocateSettings(),
     exclude=(),
+    resolutions: dict | None = None,
 ) -> tuple[list[Window], dict[str, float], dict[str, np.ndarray]]:
     """Located windows of every compared signal, sorted by start time.
 
@@ -241,6 +247,8 @@ def locate(
     settings : LocateSettings
     exclude : iterable of str
         Signals not compared.
+    resolutions : dict, optional
+        Signal -> quantisation step (SI) of its channel, a lower bound of its floor.
 
     Returns
     -------
@@ -255,7 +263,7 @@ def locate(
     levels: dict[str, np.ndarray] = {}
     for sig, r in res.items():
         base = bases.get(sig, 0.0)
-        floor = noise_floor(recording[sig].to_numpy(dtype=float), rest, settings.min_floor_pu * base)
+        floor = noise_floor(recording[sig].to_numpy(dtype=float), rest, settings.min_floor_pu * base, (resolutions or {}).get(sig, 0.0))
         if not floor > 0:
             floor = max(float(np.max(np.abs(r))) * 1e-9, 1e-300)
         floors[sig] = floor

@@ -1,4 +1,4 @@
-"""The sensor noise a recording carries: its position quantum, its noise realisation, a robust spread.
+"""The sensor noise a recording carries: its quantum and quantisation noise, its noise realisation, a robust spread.
 
 A closed-loop replay feeds the recording's own position noise to the simulated sensor, so the
 model's controller sees the same noise-driven crossings of the valve dead band as the real one.
@@ -29,6 +29,19 @@ def position_quantum(position: np.ndarray) -> float:
     if np.max(np.abs(k - np.round(k))) > 1e-3 or np.any(np.abs(k) > 1e12):
         return 0.0
     return q
+
+
+def quantisation_std(values: np.ndarray, resolution: float = 0.0) -> float:
+    """Standard deviation of uniform quantisation, q / sqrt(12) [signal unit] (Widrow & Kollar 2008).
+
+    ``q`` is the declared ``resolution`` when given (> 0), else the lattice the values sit on
+    (``position_quantum``; 0 when they sit on none). A noise floor is never below it: with a
+    coarse transducer (50 um against 20 um of noise) most sample-to-sample differences are zero
+    and a difference- or median-based noise estimate collapses, while a model can match the
+    reading no closer than the quantisation.
+    """
+    q = float(resolution) if resolution and resolution > 0 else position_quantum(values)
+    return q / np.sqrt(12.0)
 
 
 def estimate_position_noise(position: np.ndarray, sample_time: float) -> np.ndarray:

@@ -28,6 +28,7 @@ from compliance.errors import InputError
 from compliance.model.config import PlantConfig
 from compliance.simulation import OUTPUT_COLUMNS, Scenario, SensorNoise, simulate
 from compliance.simulation.profiles import Profile
+from compliance.validation.logger_model import logger_model
 from compliance.validation.recorded_noise import NOISE_FREE_STD, estimate_position_noise, position_quantum, robust_std
 from compliance.validation.resampling import (
     controller_grid,
@@ -211,9 +212,13 @@ def replay(cfg: PlantConfig, recording: pd.DataFrame, metadata: dict | None = No
         u = zoh_interval_average(tr, recording["valve_command"].to_numpy(dtype=float), edges)
         sim = simulate(run_cfg, Scenario(command=Profile(grid, u), **scenario_kw))
     t_sim = sim["time"].to_numpy(dtype=float)
+    instruments = logger_model(metadata)
+    cols = {c: sim[c].to_numpy(dtype=float) for c in OUTPUT_COLUMNS[1:]}
+    if instruments is not None:  # the simulated channels as the recording's logger records them
+        cols = instruments.apply(cols, float(np.median(np.diff(t_sim))))
     out = {"time": t_rec}
     for col in OUTPUT_COLUMNS[1:]:
-        out[col] = np.interp(tr, t_sim, sim[col].to_numpy(dtype=float))
+        out[col] = np.interp(tr, t_sim, cols[col])
     frame = pd.DataFrame(out)
     frame.attrs.update(mode=mode, noise_replay=noise_used, overrides=dict(overrides),
                        conditions=_replay_conditions(run_cfg, init, load, overrides))

@@ -46,16 +46,55 @@ def resample_uniform(time: np.ndarray, values: np.ndarray, step: float | None = 
 
 
 HELD_COLUMNS = ("reference", "valve_command")  # written by the controller: constant between its samples
-MAX_LOG_INTERVAL = 4.0  # controller periods; a coarser log cannot show the loop's transients
+MAX_LOG_INTERVAL = 10.0  # controller periods (100 Hz for a 1 kHz controller): a coarser log cannot show the loop's transients
+CLOCK_TOLERANCE = 1e-6  # share of a controller period within which two instants are the same (parsed time stamps)
+
+
+def logged_indices(time: np.ndarray, ts: float) -> np.ndarray:
+    """Controller periods (from the first sample) at which the logger wrote a sample.
+
+    Parameters
+    ----------
+    time : ndarray
+        Logged time stamps [s], strictly increasing.
+    ts : float
+        Controller sample time [s].
+
+    Returns
+    -------
+    ndarray of int
+        Index of the controller instant nearest each logged sample (unique, increasing).
+    """
+    t = np.asarray(time, dtype=float)
+    return np.unique(np.rint((t - t[0]) / ts).astype(np.int64))
+
+
+def _held_reference(t: np.ndarray, v: np.ndarray, grid: np.ndarray, held: np.ndarray) -> np.ndarray:
+    """The controller's set-point between logged samples: a step holds, a ramp keeps ramping.
+
+    A logged change that its neighbours do not continue is a step (the controller jumped once,
+    somewhere in the interval: held at the last logged value); a change continued by the next or
+    previous interval is a ramp or a sine the controller advanced every period (interpolated).
+    """
+    out = v[held]
+    if v.size < 3:
+        return out
+    moved = np.abs(np.diff(v)) > 1e-12 * max(1.0, float(np.max(np.abs(v))))
+    smooth = moved & (np.concatenate(([False], moved[:-1])) | np.concatenate((moved[1:], [False])))
+    seg = np.clip(np.searchsorted(t, grid, side="right") - 1, 0, t.size - 2)
+    ramp = smooth[seg]
+    out[ramp] = np.interp(grid[ramp], t, v)
+    return out
 
 
 def on_controller_clock(frame: pd.DataFrame, ts: float, where: str) -> tuple[pd.DataFrame, str | None]:
     """The recording on the controller's clock t_0 + k*ts (a replay needs one sample per period).
 
     Measured signals (position, pressures) are interpolated linearly at the controller's
-    instants; the set-point and the valve command, which the controller holds over its period,
-    take the last logged value at or before each instant. A recording already on the clock
-    is returned unchanged.
+    instants; the valve command, which the controller holds over its period, takes the last
+    logged value at or before each instant, and so does a set-point step (a ramp keeps
+    ramping: ``_held_reference``). A recording already on the clock is returned unchanged.
+    Which controller instants carry a logged sample: ``logged_indices``.
 
     Parameters
     ----------
@@ -74,29 +113,33 @@ def on_controller_clock(frame: pd.DataFrame, ts: float, where: str) -> tuple[pd.
     Raises
     ------
     InputError
-        The log is coarser than ``MAX_LOG_INTERVAL`` controller periods.
+        The log is coarser than ``MAX_LOG_INTERVAL`` controller periods (to ``CLOCK_TOLERANCE``).
     """
     t = frame["time"].to_numpy(dtype=float)
     if is_uniform(t, ts):
         return frame, None
     dt = np.diff(t)
     med = float(np.median(dt))
-    if med > MAX_LOG_INTERVAL * ts:
+    if med > MAX_LOG_INTERVAL * ts * (1.0 + CLOCK_TOLERANCE):
         raise InputError(
-            f"{where}: time: logged every {med*1e3:.3g} ms (median); replaying the {ts*1e3:g} ms controller needs at "
-            f"least one sample per {MAX_LOG_INTERVAL:g} controller periods"
+            f"{where}: time: logged every {med*1e3:.3g} ms (median), slower than {1.0/(MAX_LOG_INTERVAL*ts):.4g} Hz; "
+            f"replaying the {ts*1e3:g} ms controller needs at least one sample per {MAX_LOG_INTERVAL:g} controller periods"
         )
-    n = int(math.floor((t[-1] - t[0]) / ts + 1e-9)) + 1
+    n = int(math.floor((t[-1] - t[0]) / ts + CLOCK_TOLERANCE)) + 1
     grid = t[0] + ts * np.arange(n)
-    held = np.clip(np.searchsorted(t, grid + 1e-6 * ts, side="right") - 1, 0, t.size - 1)
+    held = np.clip(np.searchsorted(t, grid + CLOCK_TOLERANCE * ts, side="right") - 1, 0, t.size - 1)
     out = {"time": grid}
     for col in frame.columns:
         if col == "time":
             continue
         v = frame[col].to_numpy(dtype=float)
-        out[col] = v[held] if col in HELD_COLUMNS else np.interp(grid, t, v)
+        if col == "reference":
+            out[col] = _held_reference(t, v, grid, held)
+        else:
+            out[col] = v[held] if col in HELD_COLUMNS else np.interp(grid, t, v)
     note = (f"resampled onto the {ts*1e3:g} ms controller clock: {t.size} samples at {dt.min()*1e3:.3g}..{dt.max()*1e3:.3g} ms "
-            f"-> {n}; measured signals interpolated, set-point and command held")
+            f"-> {n}; measured signals interpolated, command and set-point steps held, set-point ramps interpolated; "
+            f"compared at the logged instants only")
     return pd.DataFrame(out), note
 
 

@@ -229,7 +229,7 @@ def test_small_benchmark_runs_and_scores(cfg):
 
 
 def test_replay_setup_puts_a_recording_on_the_controller_clock(cfg):
-    """A log at 2 ms is resampled onto the 1 ms clock (noted); one coarser than 4 periods is refused."""
+    """A log at 2 ms is resampled onto the 1 ms clock (noted); one coarser than 10 periods (100 Hz) is refused."""
     frame, meta = _recording(cfg)
     thin = frame.iloc[::2].reset_index(drop=True)
     setup = prepare_replay(cfg, thin, meta)
@@ -238,8 +238,9 @@ def test_replay_setup_puts_a_recording_on_the_controller_clock(cfg):
     k = 2 * 4321  # a logged sample: interpolation returns it exactly, the set-point is held
     assert setup.recorded["position"][k] == pytest.approx(frame["position"].iloc[k], abs=1e-12)
     assert setup.reference[k + 1] == frame["reference"].iloc[k]
-    with pytest.raises(InputError, match="logged every 5 ms"):
-        prepare_replay(cfg, frame.iloc[::5].reset_index(drop=True), meta)
+    assert np.array_equal(setup.logged[:3], [0, 2, 4])  # compared at the logged instants only
+    with pytest.raises(InputError, match="logged every 12 ms"):
+        prepare_replay(cfg, frame.iloc[::12].reset_index(drop=True), meta)
     assert dataclasses.is_dataclass(prepare_replay(cfg, frame, meta))
 
 
@@ -260,6 +261,17 @@ def test_diagnosis_of_a_recording_with_jittered_time_stamps(cfg):
     assert d.winner == "heat_transfer"
     assert d.fits["heat_transfer"].value("heat_transfer.conductance") == pytest.approx(12.0, rel=0.25)
     assert any("resampled" in n for n in d.notes)
+
+
+@pytest.mark.slow
+def test_a_100_hz_log_of_a_recording_still_names_its_effect(cfg):
+    """Every 10th sample of a 1 kHz recording (a 100 Hz trend log of the 1 kHz controller): the
+    controller is replayed at its own period between the logged samples and compared at them."""
+    frame, meta = _recording(cfg, {"heat_transfer": {"conductance": 12.0}}, noise=PRACTICE_NOISE)
+    thin = frame.iloc[::10].reset_index(drop=True)
+    d = diagnose(cfg, thin, meta, effects=["heat_transfer", "internal_leakage", "valve_dynamics"], jobs=1, recalibrate=False)
+    assert d.verdict == "missing_physics" and d.winner == "heat_transfer"
+    assert d.fits["heat_transfer"].value("heat_transfer.conductance") == pytest.approx(12.0, rel=0.35)
 
 
 def test_resets_in_motion_start_a_lagged_sensor_where_the_motion_left_it(cfg):
