@@ -198,6 +198,22 @@ for cid, c, frag in [
     case(cid, MAT, frag, {"bad.mat": (lambda ws, c=c: W.write_mat(ws / "bad.mat", c)), "bad.toml": W.SIDECAR})
 case("mat-not-a-mat-file", MAT, "bad.mat", {"bad.mat": b"this is not MATLAB"})
 
+
+def mat_structs(*names):
+    """A .mat file holding the good recording once per struct name (two runs saved together)."""
+    def write(ws):
+        from scipy.io import savemat
+
+        savemat(ws / "bad.mat", {n: {k: v.reshape(-1, 1) for k, v in W.recording_columns().items()} for n in names})
+    return write
+
+
+case("mat-two-structs", MAT, "2 structs hold recording fields ('run1', 'run2')",
+     {"bad.mat": mat_structs("run1", "run2"), "bad.toml": W.SIDECAR})
+case("mat-two-structs-hint", MAT, 'column = "run1.time"', {"bad.mat": mat_structs("run1", "run2"), "bad.toml": W.SIDECAR})
+case("mat-char-variable", MAT, "variable 'position' is text ('eighty mm')",
+     {"bad.mat": (lambda ws: W.write_mat(ws / "bad.mat", cols(position=np.array("eighty mm")))), "bad.toml": W.SIDECAR})
+
 PQ = "validate plant.toml bad.parquet --json out/v.json"
 for cid, c, frag in [
     ("parquet-nan", cols(position=nan_at), "NaN"),
