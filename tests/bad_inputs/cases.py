@@ -318,6 +318,36 @@ case("char-valve-volume-unit", "characterise valve rec.csv --volume 1kg", "--vol
 case("char-valve-even-window", "characterise valve rec.csv --volume 1L --window 4", "--window")
 case("char-valve-unknown-law", "characterise valve rec.csv --volume 1L --laws magic", "magic")
 case("char-valve-not-charging", "characterise valve rec.csv --volume 1L --supply-pressure '8 bar abs' --json out/c.json".split(" ", 6)[:6] + ["8 bar abs", "--json", "out/c.json"], "rec.csv")
+def charging_csv(name, columns=("time", "pressure_a"), **kw):
+    """A 0.6 s charging (or discharging) record of a 0.5 L volume through plant A's valve (synthetic)."""
+    def write(ws):
+        from compliance.characterise.charging import synthetic_charging
+
+        opts = dict(volume=5e-4, supply_pressure=8e5, initial_pressure=101325.0, duration=0.6, sample_time=1e-3,
+                    delay=0.05, noise_std=300.0, seed=5) | kw
+        synthetic_charging("iso6358", {"conductance": 2.33e-8, "critical_ratio": 0.3}, **opts)[list(columns)].to_csv(ws / name, index=False)
+    return write
+
+
+CHARGING = {"charge.csv": charging_csv("charge.csv"),
+            "discharge.csv": charging_csv("discharge.csv", initial_pressure=8e5, mode="discharge"),
+            "late.csv": charging_csv("late.csv", delay=0.45)}
+for cid, argv, frag in [
+    ("char-valve-supply-below-chamber", ["charge.csv", "--supply-pressure", "8 psi abs"],
+     "above the supply 0.552 bar abs (--supply-pressure)"),
+    ("char-valve-exhaust-above-chamber", ["discharge.csv", "--exhaust-pressure", "9 bar abs"],
+     "the exhaust 9 bar abs (--exhaust-pressure) is above 'pressure_a'"),
+    ("char-valve-mode-contradicts", ["charge.csv", "--mode", "discharge", "--supply-pressure", "8 bar abs"],
+     "give --mode charge"),
+    ("char-valve-mode-contradicts-discharge", ["discharge.csv", "--mode", "charge", "--supply-pressure", "8 bar abs"],
+     "give --mode discharge"),
+    ("char-valve-window-swallows-opening", ["late.csv", "--window", "201", "--supply-pressure", "8 bar abs"],
+     "the derivative window of 201 samples leaves no samples after the valve opening (t = 0.45 s)"),
+    ("char-valve-pressure-column-not-pressure", ["charge.csv", "--pressure-column", "time", "--supply-pressure", "8 bar abs"],
+     "'time' is not a pressure"),
+]:
+    case(cid, ["characterise", "valve", *argv[:1], "--volume", "0.5 L", *argv[1:], "--json", "out/c.json"], frag, CHARGING)
+
 case("char-friction-negative-window", "characterise friction rec.csv --window=-1s --area=1e-3m^2", "--window")
 case("char-friction-no-force", ["characterise", "friction", "rec.csv", "--area", "1000 mm^2"], "force")
 case("diag-unknown-effect", "diagnose plant.toml rec.csv --effects warp_drive -q", "warp_drive")

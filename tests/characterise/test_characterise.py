@@ -146,6 +146,25 @@ def test_valve_bad_input():
         characterise_valve(data, 1e-3, supply_pressure=8e5, laws=("sanvile",))
 
 
+def test_valve_wrong_options_name_their_cause():
+    data = synthetic_charging("iso6358", ISO_TRUE, **CHARGE).drop(columns="supply_pressure")
+    # the good twin: the right supply pressure fits
+    assert characterise_valve(data, CHARGE["volume"], supply_pressure=8e5).fits
+    # a supply given in psi where bar was meant: 8 psi = 0.552 bar abs, below the 8 bar recorded
+    with pytest.raises(InputError, match=r"above the supply 0.552 bar abs \(--supply-pressure\)"):
+        characterise_valve(data, CHARGE["volume"], supply_pressure=8 * 6894.757)
+    with pytest.raises(InputError, match="give --mode charge"):
+        characterise_valve(data, CHARGE["volume"], supply_pressure=8e5, mode="discharge")
+    with pytest.raises(InputError, match=r"the exhaust 9 bar abs \(--exhaust-pressure\)"):
+        falling = synthetic_charging("iso6358", ISO_TRUE, **(CHARGE | dict(initial_pressure=8e5)), mode="discharge")
+        characterise_valve(falling, CHARGE["volume"], exhaust_pressure=9e5)
+    with pytest.raises(InputError, match="leaves no samples after the valve opening"):
+        late = synthetic_charging("iso6358", ISO_TRUE, **(CHARGE | dict(duration=1.0, delay=0.8)))
+        characterise_valve(late, CHARGE["volume"], window=401)
+    with pytest.raises(InputError, match="'time' is not a pressure"):
+        characterise_valve(data, CHARGE["volume"], supply_pressure=8e5, pressure_column="time")
+
+
 # ----------------------------------------------------------------------------- friction
 def test_vectorised_map_is_the_plant_map():
     v = np.array([-0.05, -0.004, -0.0005, 0.0005, 0.004, 0.05])
