@@ -545,6 +545,8 @@ case("check-epoch-year-10000", "check plant.toml -r req.toml --json out/r.json -
      env={"SOURCE_DATE_EPOCH": "253402300800"})
 case("sweep-scheduler-no-port", ["sweep", "bad-sweep.toml", "--scheduler", "127.0.0.1", "--out", "new-out"], "--scheduler",
      {"bad-sweep.toml": SWEEP})
+case("sweep-scheduler-refused", ["sweep", "bad-sweep.toml", "--scheduler", "tcp://127.0.0.1:1", "--out", "new-out"],
+     "cannot reach the Dask scheduler at 127.0.0.1:1 (Connection refused)", {"bad-sweep.toml": SWEEP})
 case("report-text-where-value-belongs", "report bad.json --report out/r.html", "where a number",
      {"bad.json": lambda ws: W.damaged_results(ws / "bad.json")})
 case("bench-seed-negative", "diagnose-benchmark --seed -1 --cases 1", "--seed")
