@@ -350,6 +350,10 @@ for cid, argv, frag in [
 
 case("char-friction-negative-window", "characterise friction rec.csv --window=-1s --area=1e-3m^2", "--window")
 case("char-friction-no-force", ["characterise", "friction", "rec.csv", "--area", "1000 mm^2"], "force")
+case("char-friction-min-speed-above-runs",
+     ["characterise", "friction", str(W.REPO / "tests" / "data" / "zillen" / "O-ring257_1bar_head1000.csv"),
+      "--column-map", "zillen-friction", "--min-speed", "1 m/s", "--json", "out/f.json"],
+     "--min-speed 1000 mm/s is above every constant-speed part of the runs")
 case("diag-unknown-effect", "diagnose plant.toml rec.csv --effects warp_drive -q", "warp_drive")
 case("diag-save-model-exists", "diagnose plant.toml rec.csv --save-model rec.toml", "exists already")
 case("diag-save-model-is-the-plant", "diagnose plant.toml rec.csv --save-model plant.toml", "is an input of this run ([CONFIG] RECORDING)")

@@ -14,6 +14,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 from scipy.signal import savgol_filter
 
@@ -234,6 +235,20 @@ def test_no_populated_bins_is_an_input_error():
     bins = bin_friction(np.full(50, 1e-5), np.zeros(50), np.zeros(50), np.zeros(50))
     with pytest.raises(InputError, match="no populated"):
         fit_friction_map(bins)
+
+
+def test_min_speed_above_every_run_is_named():
+    runs = _zillen_runs()[:1]
+    assert characterise_friction(runs, v_min=1e-3).fits  # the good twin: 1 mm/s leaves map points
+    # Zillen's fastest constant-speed stroke is ~16 mm/s; 1 m/s (a unit slip for 1 mm/s) leaves none
+    with pytest.raises(InputError, match=r"--min-speed 1000 mm/s is above every constant-speed part .*fastest 1[0-9]\.?\d* mm/s"):
+        characterise_friction(runs, v_min=1.0)
+    # a run that accelerates throughout (x = a t^2 / 2, a = 0.05 m/s^2) has no constant-speed part
+    t = np.arange(2000) * 1e-3
+    ramp = pd.DataFrame({"time": t, "position": 0.025 * t**2, "pressure_a": np.full(t.size, 2e5),
+                         "force": np.full(t.size, 50.0)})
+    with pytest.raises(InputError, match="no constant-speed part in the runs"):
+        characterise_friction([prepare_run("ramp", ramp, 5e-4, window_s=0.2)])
 
 
 def _zillen_runs():
