@@ -177,17 +177,8 @@ def characterise_valve(
     factor, t_gas = _flow_factor(p, volume, temperature, mode)
     q = factor * np.sum(w_deriv * p_raw[idx], axis=1)
     sigma_p = noise_std(t, p_raw, window, DERIVATIVE_ORDER, weights=(idx, w_value, w_deriv))
-    if mode == "charge":
-        if "supply_pressure" in frame.columns:
-            p_up, other = frame["supply_pressure"].to_numpy(dtype=float), "the supply_pressure column"
-        elif supply_pressure is not None:
-            p_up, other = np.full_like(p, float(supply_pressure)), "--supply-pressure"
-        else:
-            raise InputError(f"{source}: charging needs the supply pressure: a 'supply_pressure' column or --supply-pressure")
-        p_down, t_up = p, t_gas
-    else:
-        p_up, p_down, t_up = p, np.full_like(p, float(exhaust_pressure)), t_gas
-        other = "--exhaust-pressure"
+    p_up, p_down, other = _ends(frame, p, mode, supply_pressure, exhaust_pressure, source)
+    t_up = t_gas
     _check_upstream(p_up, p_down, sigma_p, mode, f"'{pressure_column}'", other, source)
     used = _fitted_span(q, p_down / p_up, window, max_ratio, source, mode=mode, t=t)
     flow_noise = (idx[used], factor[used, None] * w_deriv[used], sigma_p)
@@ -227,6 +218,17 @@ def _mode_and_window(t, p_raw, mode: str, window: int | None, pressure_column: s
             f"the recording ({t.size} samples)"
         )
     return mode, window
+
+
+def _ends(frame, p, mode: str, supply_pressure, exhaust_pressure, source: str):
+    """Upstream and downstream pressure [Pa abs] of the valve, and where the other one came from."""
+    if mode == "discharge":
+        return p, np.full_like(p, float(exhaust_pressure)), "--exhaust-pressure"
+    if "supply_pressure" in frame.columns:
+        return frame["supply_pressure"].to_numpy(dtype=float), p, "the supply_pressure column"
+    if supply_pressure is not None:
+        return np.full_like(p, float(supply_pressure)), p, "--supply-pressure"
+    raise InputError(f"{source}: charging needs the supply pressure: a 'supply_pressure' column or --supply-pressure")
 
 
 def _check_upstream(p_up, p_down, sigma_p: float, mode: str, chamber: str, other: str, source: str) -> None:
