@@ -197,10 +197,48 @@ def _dask_client(kind: str, target):
             cluster = LocalCluster(n_workers=target, threads_per_worker=1, processes=True, host="127.0.0.1",
                                    dashboard_address="127.0.0.1:0")
         return Client(cluster), cluster
+    _refuse_unreachable(target)
     try:
         return Client(target, timeout=30), None
     except OSError as exc:
         raise InputError(f"--scheduler {target}: cannot reach the Dask scheduler ({exc})") from None
+    except Exception as exc:  # a service that is not Dask answers with bytes Dask's handshake cannot read
+        raise InputError(f"--scheduler {target}: something answers there, but not as a Dask scheduler "
+                         f"({exc.__class__.__name__}: {str(exc)[:120]})") from None
+
+
+CONNECT_TIMEOUT = 5.0  # [s] a TCP connect to a live scheduler takes milliseconds; our choice of margin
+
+
+def _refuse_unreachable(target: str) -> None:
+    """Fail fast on a TCP scheduler address nothing listens on (Dask's Client retries for 30 s).
+
+    One plain TCP connect, ``CONNECT_TIMEOUT`` at most: a refused connection (nothing on that
+    port, loopback answers at once), an unknown host or a silent address is an
+    :class:`InputError`. Other transports (``inproc``, ``ucx``, ...) are left to Dask.
+    """
+    import socket
+
+    from distributed.comm.addressing import parse_address, parse_host_port
+
+    scheme, location = parse_address(target)
+    if scheme not in ("tcp", "tls"):
+        return
+    try:
+        host, port = parse_host_port(location, default_port=8786)
+    except ValueError as exc:
+        raise InputError(f"--scheduler {target}: not a host:port address ({exc})") from None
+    try:
+        with socket.create_connection((host, port), timeout=CONNECT_TIMEOUT):
+            return
+    except socket.timeout:
+        why = f"no answer within {CONNECT_TIMEOUT:g} s"
+    except OSError as exc:
+        why = exc.strerror or str(exc)
+    raise InputError(
+        f"--scheduler {target}: cannot reach the Dask scheduler at {host}:{port} ({why}); start one there "
+        f"(dask scheduler --port {port}) or use --scheduler local:N"
+    )
 
 
 @contextmanager

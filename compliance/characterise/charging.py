@@ -21,9 +21,12 @@ import pandas as pd
 from scipy.integrate import solve_ivp
 
 from compliance.errors import InputError
+from compliance.recordings.column_map import CANONICAL_UNITS
 from compliance.units import ATMOSPHERE_PA
 from compliance.characterise.derivative import noise_std, odd_window, savgol_weights, smoothed_derivative
 from compliance.characterise.flow_law import GAMMA, LAWS, R_AIR, T0, FlowFit, rank_flow_laws
+
+PRESSURE_COLUMNS = tuple(name for name, unit in CANONICAL_UNITS.items() if unit == "Pa")
 
 DERIVATIVE_ORDER = 3  # cubic Savitzky-Golay: same centre-point noise as quadratic, smaller bias
 
@@ -160,6 +163,9 @@ def characterise_valve(
     """
     if not volume > 0:
         raise InputError(f"{source}: volume must be > 0 m^3, got {volume}")
+    if pressure_column not in PRESSURE_COLUMNS:
+        raise InputError(f"{source}: --pressure-column '{pressure_column}' is not a pressure; expected one of "
+                         f"{', '.join(PRESSURE_COLUMNS)}")
     for col in ("time", pressure_column):
         if col not in frame.columns:
             raise InputError(f"{source}: needs a '{col}' column; has {', '.join(frame.columns)}")
@@ -171,17 +177,10 @@ def characterise_valve(
     factor, t_gas = _flow_factor(p, volume, temperature, mode)
     q = factor * np.sum(w_deriv * p_raw[idx], axis=1)
     sigma_p = noise_std(t, p_raw, window, DERIVATIVE_ORDER, weights=(idx, w_value, w_deriv))
-    if mode == "charge":
-        if "supply_pressure" in frame.columns:
-            p_up = frame["supply_pressure"].to_numpy(dtype=float)
-        elif supply_pressure is not None:
-            p_up = np.full_like(p, float(supply_pressure))
-        else:
-            raise InputError(f"{source}: charging needs the supply pressure: a 'supply_pressure' column or --supply-pressure")
-        p_down, t_up = p, t_gas
-    else:
-        p_up, p_down, t_up = p, np.full_like(p, float(exhaust_pressure)), t_gas
-    used = _fitted_span(q, p_down / p_up, window, max_ratio, source)
+    p_up, p_down, other = _ends(frame, p, mode, supply_pressure, exhaust_pressure, source)
+    t_up = t_gas
+    _check_upstream(p_up, p_down, sigma_p, mode, f"'{pressure_column}'", other, source)
+    used = _fitted_span(q, p_down / p_up, window, max_ratio, source, mode=mode, t=t)
     flow_noise = (idx[used], factor[used, None] * w_deriv[used], sigma_p)
     fits = rank_flow_laws(
         p_up[used], p_down[used], t_up[used], q[used], laws, correlation_length=float(window), flow_noise=flow_noise
@@ -195,13 +194,19 @@ def characterise_valve(
 
 def _mode_and_window(t, p_raw, mode: str, window: int | None, pressure_column: str, source: str) -> tuple[str, int]:
     """Charge or discharge (``auto``: whether the pressure rises) and the derivative window [samples]."""
+    k = max(3, t.size // 50)
+    rise = np.median(p_raw[-k:]) - np.median(p_raw[:k])  # [Pa] from the first to the last 2 % of samples
     if mode == "auto":
-        k = max(3, t.size // 50)
-        mode = "charge" if np.median(p_raw[-k:]) > np.median(p_raw[:k]) else "discharge"
+        mode = "charge" if rise > 0 else "discharge"
     change = np.abs(p_raw - p_raw[0])
     total = np.max(change)
     if not total > 0:
         raise InputError(f"{source}: pressure '{pressure_column}' never changes; not a charging/discharging record")
+    if (mode == "charge" and rise < -0.5 * total) or (mode == "discharge" and rise > 0.5 * total):
+        raise InputError(
+            f"{source}: --mode {mode}, but '{pressure_column}' {'falls' if rise < 0 else 'rises'} by "
+            f"{abs(rise) * 1e-5:.3g} bar over the record; give --mode {'discharge' if rise < 0 else 'charge'} (or auto)"
+        )
     if window is None:
         transient = np.count_nonzero((change > 0.05 * total) & (change < 0.95 * total))
         window = odd_window(max(7, 0.04 * transient), DERIVATIVE_ORDER)
@@ -215,18 +220,57 @@ def _mode_and_window(t, p_raw, mode: str, window: int | None, pressure_column: s
     return mode, window
 
 
-def _fitted_span(q, ratio, window: int, max_ratio: float, source: str) -> slice:
+def _ends(frame, p, mode: str, supply_pressure, exhaust_pressure, source: str):
+    """Upstream and downstream pressure [Pa abs] of the valve, and where the other one came from."""
+    if mode == "discharge":
+        return p, np.full_like(p, float(exhaust_pressure)), "--exhaust-pressure"
+    if "supply_pressure" in frame.columns:
+        return frame["supply_pressure"].to_numpy(dtype=float), p, "the supply_pressure column"
+    if supply_pressure is not None:
+        return np.full_like(p, float(supply_pressure)), p, "--supply-pressure"
+    raise InputError(f"{source}: charging needs the supply pressure: a 'supply_pressure' column or --supply-pressure")
+
+
+def _check_upstream(p_up, p_down, sigma_p: float, mode: str, chamber: str, other: str, source: str) -> None:
+    """Refuse an upstream pressure below the downstream one: gas flows from high to low pressure.
+
+    A tolerance of 2 % of the highest upstream pressure plus 5 noise standard deviations (our
+    choice) lets a chamber settle onto its supply or exhaust without a false refusal.
+    """
+    excess = p_down - p_up
+    worst = int(np.argmax(excess))
+    if excess[worst] <= 0.02 * np.max(p_up) + 5.0 * sigma_p:
+        return
+    bar = 1e-5
+    if mode == "charge":
+        what = (f"{chamber} reaches {p_down[worst] * bar:.3g} bar abs, above the supply {p_up[worst] * bar:.3g} bar abs "
+                f"({other}): a volume cannot charge above its supply; check that pressure's value and unit")
+    else:
+        what = (f"the exhaust {p_down[worst] * bar:.3g} bar abs ({other}) is above {chamber} "
+                f"({p_up[worst] * bar:.3g} bar abs): a volume cannot discharge below its exhaust; check that "
+                f"pressure's value and unit, or --mode")
+    raise InputError(f"{source}: {what}")
+
+
+def _fitted_span(q, ratio, window: int, max_ratio: float, source: str, *, mode: str = "charge", t=None) -> slice:
     """Samples to fit: from the valve opening (past the smeared edge) to the pressure ratio ``max_ratio``."""
     n = q.size
     half = window // 2
-    start = int(np.argmax(q >= 0.5 * np.max(q))) + half  # valve open, past the smeared opening edge
+    opening = int(np.argmax(q >= 0.5 * np.max(q)))
+    start = opening + half  # valve open, past the smeared opening edge
+    if start >= n - half - 10:
+        at = f" (t = {t[opening]:.4g} s)" if t is not None else ""
+        raise InputError(
+            f"{source}: the derivative window of {window} samples leaves no samples after the valve opening{at}: "
+            f"{n - opening} samples follow it; give a smaller --window (or none for the default)"
+        )
     beyond = np.flatnonzero(ratio[start:] > max_ratio)
     stop = start + int(beyond[0]) if beyond.size else n - half
     used = slice(start, min(stop, n - half))
     if used.stop - used.start < 10:
         raise InputError(
             f"{source}: only {max(used.stop - used.start, 0)} samples between the valve opening and the pressure ratio "
-            f"{max_ratio}; record faster or a larger volume"
+            f"{max_ratio} (ratio {ratio[start]:.3g} at the opening); record faster or a larger volume"
         )
     return used
 

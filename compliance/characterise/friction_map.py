@@ -324,6 +324,7 @@ def characterise_friction(runs, *, asymmetric=True, v_min=1e-3, bins_per_decade=
     p = np.concatenate([r.pressure_gauge for r in runs])
     g = np.concatenate([np.full(r.velocity.size, i) for i, r in enumerate(runs)])
     steady = np.concatenate([r.steady for r in runs])
+    _check_speeds(np.abs(v), steady, v_min)
     opts = dict(v_min=v_min, bins_per_decade=bins_per_decade, min_count=min_count, min_fraction=min_fraction)
     bins = bin_friction(v, f, p, g, steady=steady, **opts)
     fits = {"pressure-independent": fit_friction_map(bins, asymmetric=asymmetric, samples=(v, f, p))}
@@ -337,3 +338,14 @@ def characterise_friction(runs, *, asymmetric=True, v_min=1e-3, bins_per_decade=
         per_run.append((r.name, r.mean_pressure_gauge, fit))
     bins["run"] = [runs[int(i)].name for i in bins["group"]]
     return FrictionCharacterisation(runs[0].area, fits, tuple(per_run), bins, tuple(runs))
+
+
+def _check_speeds(speed, steady, v_min: float) -> None:
+    """Name the option that leaves no map point: no constant-speed part, or all below ``v_min``."""
+    if not np.any(steady & (speed > 0)):
+        raise InputError("no constant-speed part in the runs: the speed changes by more than 10 % over every "
+                         "velocity window; the map needs strokes at constant speed (a shorter --window may find them)")
+    fastest = float(np.max(speed[steady]))
+    if fastest < v_min:
+        raise InputError(f"--min-speed {v_min * 1e3:g} mm/s is above every constant-speed part of the runs "
+                         f"(fastest {fastest * 1e3:.3g} mm/s); give a lower --min-speed")

@@ -198,6 +198,22 @@ for cid, c, frag in [
     case(cid, MAT, frag, {"bad.mat": (lambda ws, c=c: W.write_mat(ws / "bad.mat", c)), "bad.toml": W.SIDECAR})
 case("mat-not-a-mat-file", MAT, "bad.mat", {"bad.mat": b"this is not MATLAB"})
 
+
+def mat_structs(*names):
+    """A .mat file holding the good recording once per struct name (two runs saved together)."""
+    def write(ws):
+        from scipy.io import savemat
+
+        savemat(ws / "bad.mat", {n: {k: v.reshape(-1, 1) for k, v in W.recording_columns().items()} for n in names})
+    return write
+
+
+case("mat-two-structs", MAT, "2 structs hold recording fields ('run1', 'run2')",
+     {"bad.mat": mat_structs("run1", "run2"), "bad.toml": W.SIDECAR})
+case("mat-two-structs-hint", MAT, 'column = "run1.time"', {"bad.mat": mat_structs("run1", "run2"), "bad.toml": W.SIDECAR})
+case("mat-char-variable", MAT, "variable 'position' is text ('eighty mm')",
+     {"bad.mat": (lambda ws: W.write_mat(ws / "bad.mat", cols(position=np.array("eighty mm")))), "bad.toml": W.SIDECAR})
+
 PQ = "validate plant.toml bad.parquet --json out/v.json"
 for cid, c, frag in [
     ("parquet-nan", cols(position=nan_at), "NaN"),
@@ -302,8 +318,42 @@ case("char-valve-volume-unit", "characterise valve rec.csv --volume 1kg", "--vol
 case("char-valve-even-window", "characterise valve rec.csv --volume 1L --window 4", "--window")
 case("char-valve-unknown-law", "characterise valve rec.csv --volume 1L --laws magic", "magic")
 case("char-valve-not-charging", "characterise valve rec.csv --volume 1L --supply-pressure '8 bar abs' --json out/c.json".split(" ", 6)[:6] + ["8 bar abs", "--json", "out/c.json"], "rec.csv")
+def charging_csv(name, columns=("time", "pressure_a"), **kw):
+    """A 0.6 s charging (or discharging) record of a 0.5 L volume through plant A's valve (synthetic)."""
+    def write(ws):
+        from compliance.characterise.charging import synthetic_charging
+
+        opts = dict(volume=5e-4, supply_pressure=8e5, initial_pressure=101325.0, duration=0.6, sample_time=1e-3,
+                    delay=0.05, noise_std=300.0, seed=5) | kw
+        synthetic_charging("iso6358", {"conductance": 2.33e-8, "critical_ratio": 0.3}, **opts)[list(columns)].to_csv(ws / name, index=False)
+    return write
+
+
+CHARGING = {"charge.csv": charging_csv("charge.csv"),
+            "discharge.csv": charging_csv("discharge.csv", initial_pressure=8e5, mode="discharge"),
+            "late.csv": charging_csv("late.csv", delay=0.45)}
+for cid, argv, frag in [
+    ("char-valve-supply-below-chamber", ["charge.csv", "--supply-pressure", "8 psi abs"],
+     "above the supply 0.552 bar abs (--supply-pressure)"),
+    ("char-valve-exhaust-above-chamber", ["discharge.csv", "--exhaust-pressure", "9 bar abs"],
+     "the exhaust 9 bar abs (--exhaust-pressure) is above 'pressure_a'"),
+    ("char-valve-mode-contradicts", ["charge.csv", "--mode", "discharge", "--supply-pressure", "8 bar abs"],
+     "give --mode charge"),
+    ("char-valve-mode-contradicts-discharge", ["discharge.csv", "--mode", "charge", "--supply-pressure", "8 bar abs"],
+     "give --mode discharge"),
+    ("char-valve-window-swallows-opening", ["late.csv", "--window", "201", "--supply-pressure", "8 bar abs"],
+     "the derivative window of 201 samples leaves no samples after the valve opening (t = 0.45 s)"),
+    ("char-valve-pressure-column-not-pressure", ["charge.csv", "--pressure-column", "time", "--supply-pressure", "8 bar abs"],
+     "'time' is not a pressure"),
+]:
+    case(cid, ["characterise", "valve", *argv[:1], "--volume", "0.5 L", *argv[1:], "--json", "out/c.json"], frag, CHARGING)
+
 case("char-friction-negative-window", "characterise friction rec.csv --window=-1s --area=1e-3m^2", "--window")
 case("char-friction-no-force", ["characterise", "friction", "rec.csv", "--area", "1000 mm^2"], "force")
+case("char-friction-min-speed-above-runs",
+     ["characterise", "friction", str(W.REPO / "tests" / "data" / "zillen" / "O-ring257_1bar_head1000.csv"),
+      "--column-map", "zillen-friction", "--min-speed", "1 m/s", "--json", "out/f.json"],
+     "--min-speed 1000 mm/s is above every constant-speed part of the runs")
 case("diag-unknown-effect", "diagnose plant.toml rec.csv --effects warp_drive -q", "warp_drive")
 case("diag-save-model-exists", "diagnose plant.toml rec.csv --save-model rec.toml", "exists already")
 case("diag-save-model-is-the-plant", "diagnose plant.toml rec.csv --save-model plant.toml", "is an input of this run ([CONFIG] RECORDING)")
@@ -499,6 +549,8 @@ case("check-epoch-year-10000", "check plant.toml -r req.toml --json out/r.json -
      env={"SOURCE_DATE_EPOCH": "253402300800"})
 case("sweep-scheduler-no-port", ["sweep", "bad-sweep.toml", "--scheduler", "127.0.0.1", "--out", "new-out"], "--scheduler",
      {"bad-sweep.toml": SWEEP})
+case("sweep-scheduler-refused", ["sweep", "bad-sweep.toml", "--scheduler", "tcp://127.0.0.1:1", "--out", "new-out"],
+     "cannot reach the Dask scheduler at 127.0.0.1:1 (Connection refused)", {"bad-sweep.toml": SWEEP})
 case("report-text-where-value-belongs", "report bad.json --report out/r.html", "where a number",
      {"bad.json": lambda ws: W.damaged_results(ws / "bad.json")})
 case("bench-seed-negative", "diagnose-benchmark --seed -1 --cases 1", "--seed")

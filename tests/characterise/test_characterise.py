@@ -14,6 +14,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 from scipy.signal import savgol_filter
 
@@ -146,6 +147,25 @@ def test_valve_bad_input():
         characterise_valve(data, 1e-3, supply_pressure=8e5, laws=("sanvile",))
 
 
+def test_valve_wrong_options_name_their_cause():
+    data = synthetic_charging("iso6358", ISO_TRUE, **CHARGE).drop(columns="supply_pressure")
+    # the good twin: the right supply pressure fits
+    assert characterise_valve(data, CHARGE["volume"], supply_pressure=8e5).fits
+    # a supply given in psi where bar was meant: 8 psi = 0.552 bar abs, below the 8 bar recorded
+    with pytest.raises(InputError, match=r"above the supply 0.552 bar abs \(--supply-pressure\)"):
+        characterise_valve(data, CHARGE["volume"], supply_pressure=8 * 6894.757)
+    with pytest.raises(InputError, match="give --mode charge"):
+        characterise_valve(data, CHARGE["volume"], supply_pressure=8e5, mode="discharge")
+    with pytest.raises(InputError, match=r"the exhaust 9 bar abs \(--exhaust-pressure\)"):
+        falling = synthetic_charging("iso6358", ISO_TRUE, **(CHARGE | dict(initial_pressure=8e5)), mode="discharge")
+        characterise_valve(falling, CHARGE["volume"], exhaust_pressure=9e5)
+    with pytest.raises(InputError, match="leaves no samples after the valve opening"):
+        late = synthetic_charging("iso6358", ISO_TRUE, **(CHARGE | dict(duration=1.0, delay=0.8)))
+        characterise_valve(late, CHARGE["volume"], window=401)
+    with pytest.raises(InputError, match="'time' is not a pressure"):
+        characterise_valve(data, CHARGE["volume"], supply_pressure=8e5, pressure_column="time")
+
+
 # ----------------------------------------------------------------------------- friction
 def test_vectorised_map_is_the_plant_map():
     v = np.array([-0.05, -0.004, -0.0005, 0.0005, 0.004, 0.05])
@@ -215,6 +235,20 @@ def test_no_populated_bins_is_an_input_error():
     bins = bin_friction(np.full(50, 1e-5), np.zeros(50), np.zeros(50), np.zeros(50))
     with pytest.raises(InputError, match="no populated"):
         fit_friction_map(bins)
+
+
+def test_min_speed_above_every_run_is_named():
+    runs = _zillen_runs()[:1]
+    assert characterise_friction(runs, v_min=1e-3).fits  # the good twin: 1 mm/s leaves map points
+    # Zillen's fastest constant-speed stroke is ~16 mm/s; 1 m/s (a unit slip for 1 mm/s) leaves none
+    with pytest.raises(InputError, match=r"--min-speed 1000 mm/s is above every constant-speed part .*fastest 1[0-9]\.?\d* mm/s"):
+        characterise_friction(runs, v_min=1.0)
+    # a run that accelerates throughout (x = a t^2 / 2, a = 0.05 m/s^2) has no constant-speed part
+    t = np.arange(2000) * 1e-3
+    ramp = pd.DataFrame({"time": t, "position": 0.025 * t**2, "pressure_a": np.full(t.size, 2e5),
+                         "force": np.full(t.size, 50.0)})
+    with pytest.raises(InputError, match="no constant-speed part in the runs"):
+        characterise_friction([prepare_run("ramp", ramp, 5e-4, window_s=0.2)])
 
 
 def _zillen_runs():

@@ -139,6 +139,35 @@ def test_mat_plain_variables_struct_and_matrix(tmp_path):
     np.testing.assert_allclose(df["valve_command"], t * 7, rtol=1e-12)
 
 
+def test_mat_two_structs_refused_unless_a_map_picks_one(tmp_path):
+    t = np.arange(5) * 0.01
+    path = tmp_path / "two.mat"
+    scipy.io.savemat(path, {"run1": {"time": t, "position": t * 2, "valve_command": t}, "run2": {"time": t, "position": t * 3, "valve_command": -t},
+                            "info": {"operator": "A. N. Other"}, "description": "two runs"})
+    with pytest.raises(InputError, match=r"2 structs hold recording fields \('run1', 'run2'\)"):
+        read_recording(path)
+    cmap = {"columns": {"time": {"column": "run2.time"}, "position": {"column": "run2.position"},
+                        "valve_command": {"column": "run2.valve_command"}}}
+    df, _ = read_recording(path, cmap)
+    np.testing.assert_allclose(df["position"], t * 3, rtol=1e-12)
+    # one struct of recording fields beside a struct and a char variable of other facts: read as before
+    one = tmp_path / "one.mat"
+    scipy.io.savemat(one, {"run1": {"time": t, "position": t * 2, "valve_command": t}, "info": {"operator": "A"}, "description": "x"})
+    df, _ = read_recording(one)
+    np.testing.assert_allclose(df["position"], t * 2, rtol=1e-12)
+
+
+def test_mat_char_in_a_recording_variable_is_named(tmp_path):
+    t = np.arange(5) * 0.01
+    path = tmp_path / "char.mat"
+    scipy.io.savemat(path, {"time": t, "position": "80 mm"})
+    with pytest.raises(InputError, match=r"variable 'position' is text \('80 mm'\)"):
+        read_recording(path)
+    scipy.io.savemat(path, {"rec": {"time": t, "position": "80 mm"}})
+    with pytest.raises(InputError, match=r"variable 'rec.position' is text"):
+        read_recording(path)
+
+
 def test_mat_dspace_signal_records(tmp_path):
     t = np.arange(6) * 1e-3
     y = np.zeros((1, 2), dtype=[("Name", "O"), ("Data", "O")])

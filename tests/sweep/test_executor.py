@@ -52,6 +52,23 @@ def test_scheduler_addresses():
     assert parse_scheduler("tcp://10.0.0.5:8786") == ("dask", "tcp://10.0.0.5:8786")
 
 
+def test_unreachable_scheduler_is_refused_at_once():
+    import socket
+    import time
+
+    from compliance.campaign.executor import CONNECT_TIMEOUT
+    from compliance.errors import InputError
+
+    with socket.socket() as s:  # a loopback port that was free a moment ago: nothing listens there
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    t0 = time.perf_counter()
+    with pytest.raises(InputError, match=f"cannot reach the Dask scheduler at 127.0.0.1:{port} \\(Connection refused\\)"):
+        map_tasks(abs, None, [1, 2], scheduler=f"tcp://127.0.0.1:{port}", progress=False)
+    # loopback refuses within milliseconds; Dask's own client would retry for its 30 s timeout
+    assert time.perf_counter() - t0 < CONNECT_TIMEOUT
+
+
 @pytest.mark.parametrize("workers", [1, 2])
 def test_failed_task_is_retried_and_counted_locally(tmp_path, workers):
     out, stats = map_tasks(_fail_first, str(tmp_path), list(range(6)), workers=workers, progress=False)
