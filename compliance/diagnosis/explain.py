@@ -157,6 +157,21 @@ def _split_words(d, fp) -> str:
     return text
 
 
+def explain_with_table(d, before: dict, after: dict) -> str:
+    """The paragraph with its before/after residuals and fits taken from the validation tables the report prints.
+
+    ``before`` / ``after``: signal -> ``fit_metrics.signal_fit`` rows (``rms_error``, ``nrmse``, ``fit_percent``)
+    of the model as configured and of the fitted model, so the text and the table quote one number.
+    """
+    import dataclasses
+
+    def rows(fits, own):
+        return {k: {**v, **({"rms": fits[k]["rms_error"], "nrmse": fits[k]["nrmse"], "fit_percent": fits[k]["fit_percent"]}
+                            if k in fits and fits[k].get("fit_percent") is not None else {})} for k, v in (own or {}).items()}
+
+    return explain(dataclasses.replace(d, fit_before=rows(before, d.fit_before), fit_after=rows(after, d.fit_after)))
+
+
 def explain(d) -> str:
     """The paragraph for ``engine.Diagnosis`` ``d``."""
     text = _explain_core(d)

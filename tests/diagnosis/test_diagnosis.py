@@ -150,6 +150,13 @@ def test_a_miscalibrated_valve_is_called_parameters_only(cfg):
     quoted = [s for s in d.fit_before if f"(fit {fmt_num(d.fit_before[s]['fit_percent'], 3)} % \u2192" in d.explanation]
     assert quoted, d.explanation
     assert d.fit_before[quoted[0]]["fit_percent"] == pytest.approx(table[quoted[0]]["fit_percent"], abs=0.05)
+    # the report's text quotes the fitted model's own validation table, before and after, digit for digit
+    from compliance.diagnosis.explain import explain_with_table
+
+    after = validate(d.fitted_cfg, frame, meta, ValidationSettings(modes=("closed_loop",)))["modes"]["closed_loop"]["fits"]
+    s = quoted[0]
+    text = explain_with_table(d, table, after)
+    assert f"(fit {fmt_num(table[s]['fit_percent'], 3)} % \u2192 {fmt_num(after[s]['fit_percent'], 3)} %)" in text, text
 
 
 def test_physics_outside_the_library_is_called_unexplained(cfg):
