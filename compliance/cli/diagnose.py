@@ -165,6 +165,10 @@ def _render_servo_report(cfg, frame, meta, diag, data: dict, args) -> None:
     diag_entry = {"explanation": data["explanation"], "verdict": data["verdict"], "added": [], "effects_ranked": data["effects"]}
     if diag.fitted_cfg is not None:
         diag_entry["after"] = validate(diag.fitted_cfg, frame, meta, settings)
+        from compliance.diagnosis.explain import explain_with_table
+
+        mode = settings.modes[0]  # the explanation quotes the fits of the table printed beside it
+        diag_entry["explanation"] = explain_with_table(diag, result["modes"][mode]["fits"], diag_entry["after"]["modes"][mode]["fits"])
         winner = next(e for e in data["effects"] if e["name"] == data["winner"])
         groups: dict[str, list] = {}
         for p in winner["parameters"]:

@@ -6,7 +6,7 @@ from compliance.effects import EFFECTS
 from compliance.diagnosis.candidates import FRICTION_LEVEL
 from compliance.diagnosis.friction_form import form_words
 from compliance.diagnosis.instrument_candidates import PREFIX, finding_words, is_instrument
-from compliance.units.formatting import format_value
+from compliance.units.formatting import fmt_dbic, fmt_num, fmt_si
 
 # how each effect reads in words, with its main fitted value ({v} is filled in): ``Effect.explanation``
 PHYSICS = {name: eff.explanation for name, eff in EFFECTS.items()}
@@ -17,11 +17,27 @@ REGIME_WORDS = {"step": "after the set-point steps", "hold": "while the position
                 "open_loop": "over the run"}
 
 
+def effect_words(key: str | None) -> str:
+    """An effect (or ``a+b`` set) in the words of its declaration: ``heat_transfer`` -> "chambers exchange heat with the walls"."""
+    if not key:
+        return "none"
+    if key == "base":
+        return "recalibrating the base parameters"
+    # the declaration's meaning up to its colon (the rest is the mechanism, which the signature already gives)
+    return " together with ".join(EFFECTS[k].meaning.split(":")[0].strip() if k in EFFECTS else k.replace("_", " ")
+                                  for k in key.split("+"))
+
+
+def _param_words(fp) -> str:
+    """A fitted parameter in words: ``valve_dynamics.natural_frequency`` -> "natural frequency", base keys in full."""
+    return (fp.name if fp.kind == "effect" else fp.key.replace(".", " ")).replace("_", " ")
+
+
 def _pm(value, err, unit) -> str:
-    """Value with its statistical standard error (which does not cover model-structure error)."""
+    """Value with its statistical standard error (which does not cover model-structure error), SI prefixes."""
     if err is None or not (err == err) or err <= 0 or err > 10 * abs(value):
-        return format_value(value, unit)
-    return f"{format_value(value, unit)} (standard error {format_value(err, unit)})"
+        return fmt_si(value, unit)
+    return f"{fmt_si(value, unit)} (standard error {fmt_si(err, unit)})"
 
 
 def _signal_change(d, signals) -> str:
@@ -41,9 +57,10 @@ def _signal_change(d, signals) -> str:
     s = best[1]
     b, a = d.fit_before[s], d.fit_after[s]
     unit = {"position": "m", "valve_command": "V"}.get(s, "Pa")
-    txt = f"the {SIGNAL_WORDS[s]} residual falls from {format_value(b['rms'], unit)} to {format_value(a['rms'], unit)}"
-    if b.get("nrmse") == b.get("nrmse") and a.get("nrmse") == a.get("nrmse"):
-        txt += f" (NRMSE {100*b['nrmse']:.2g} % -> {100*a['nrmse']:.2g} %)"
+    txt = f"the {SIGNAL_WORDS[s]} residual falls from {fmt_si(b['rms'], unit)} to {fmt_si(a['rms'], unit)} RMS"
+    if b.get("fit_percent") == b.get("fit_percent") and a.get("fit_percent") == a.get("fit_percent"):
+        # the fit of the validation table (100 (1 - NRMSE)), formatted as its Fit columns
+        txt += f" (fit {fmt_num(b['fit_percent'], 3)} % \u2192 {fmt_num(a['fit_percent'], 3)} %)"
     return txt
 
 
@@ -74,7 +91,7 @@ def _base_changes(d, fit) -> str:
             fc = d.cfg.p("friction.coulomb_force")
             parts.append(f"friction levels scaled by {v:.3g} (static {fs:.0f} -> {fs*v:.0f} N, Coulomb {fc:.0f} -> {fc*v:.0f} N)")
         else:
-            parts.append(f"{fp.key} refitted from {format_value(fp.nominal, fp.unit)} to {_pm(v, e, fp.unit)}")
+            parts.append(f"{_param_words(fp)} refitted from {fmt_si(fp.nominal, fp.unit)} to {_pm(v, e, fp.unit)}")
     return "; ".join(parts)
 
 
@@ -82,7 +99,7 @@ def _library(d) -> str:
     """What was tried: the whole effect library or the --effects subset, and the recalibration."""
     tried = [k for k in d.fits if k in EFFECTS]
     what = (f"the {len(EFFECTS)} declared effects" if len(tried) == len(EFFECTS)
-            else f"the {len(tried)} effects tried ({', '.join(tried)})")
+            else f"the {len(tried)} effects tried ({'; '.join(effect_words(k) for k in tried)})")
     return what + (" and the recalibrated base parameters" if "base" in d.fits else "")
 
 
@@ -102,7 +119,7 @@ def _empirical(d) -> str:
 def _contribution_words(d) -> str:
     if len(d.contributions) < 2:
         return ""
-    parts = [f"{e.replace('_', ' ')} {100*c['share_of_excess']:.0f} %" for e, c in d.contributions.items()]
+    parts = [f"{effect_words(e)} {100*c['share_of_excess']:.0f} %" for e, c in d.contributions.items()]
     return (" Each effect's own contribution (share of the nominal excess lost when it alone is switched off): "
             + ", ".join(parts) + ".")
 
@@ -110,7 +127,7 @@ def _contribution_words(d) -> str:
 def _ambiguity_words(d) -> str:
     if len(d.ambiguous) < 2:
         return ""
-    alts = ", ".join(a.replace("_", " ") for a in d.ambiguous[1:])
+    alts = "; ".join(effect_words(a) for a in d.ambiguous[1:])
     text = f" This recording cannot tell it from {alts} (information criteria within the ambiguity margin)."
     t = d.suggested_test
     if t and t.get("recommended"):
@@ -126,19 +143,34 @@ def _split_words(d, fp) -> str:
     sp = getattr(d, "split", None)
     if not sp or sp["parameter"] != fp.key:
         return ""
-    lo, hi = (format_value(v, fp.unit) for v in sp["interval"])
+    lo, hi = (fmt_si(v, fp.unit) for v in sp["interval"])
     if sp["pinned"]:
-        out = [format_value(v, fp.unit) for v in sp.get("bracket", []) if v is not None]
-        return (f" Along that valley the recording pins {fp.name.replace('_', ' ')} near {lo if lo == hi else f'{lo} - {hi}'}"
+        out = [fmt_si(v, fp.unit) for v in sp.get("bracket", []) if v is not None]
+        return (f" Along that valley the recording pins {_param_words(fp)} near {lo if lo == hi else f'{lo} - {hi}'}"
                 + (f" (the scan's {' and '.join(out)} fit worse)." if out else "."))
-    text = (f" Along that valley every {fp.name.replace('_', ' ')} from {lo} to {hi} explains the recording as well as the "
+    text = (f" Along that valley every {_param_words(fp)} from {lo} to {hi} explains the recording as well as the "
             f"pooled fit (total lag within 4 % of its fit): the pooled fit does not determine the split, only the total.")
     est = sp.get("estimate")
     if est:
-        text += (f" The re-synchronised segments agree best at {format_value(est['value'], fp.unit)} (least trimmed squares: "
+        text += (f" The re-synchronised segments agree best at {fmt_si(est['value'], fp.unit)} (least trimmed squares: "
                  f"the worst fifth of the segments, where a stick-slip event can decide, left out; trimmed chi2/N "
                  f"{est['trimmed']:.2f} against {est['trimmed_fit']:.2f}), the value given above.")
     return text
+
+
+def explain_with_table(d, before: dict, after: dict) -> str:
+    """The paragraph with its before/after residuals and fits taken from the validation tables the report prints.
+
+    ``before`` / ``after``: signal -> ``fit_metrics.signal_fit`` rows (``rms_error``, ``nrmse``, ``fit_percent``)
+    of the model as configured and of the fitted model, so the text and the table quote one number.
+    """
+    import dataclasses
+
+    def rows(fits, own):
+        return {k: {**v, **({"rms": fits[k]["rms_error"], "nrmse": fits[k]["nrmse"], "fit_percent": fits[k]["fit_percent"]}
+                            if k in fits and fits[k].get("fit_percent") is not None else {})} for k, v in (own or {}).items()}
+
+    return explain(dataclasses.replace(d, fit_before=rows(before, d.fit_before), fit_after=rows(after, d.fit_after)))
 
 
 def explain(d) -> str:
@@ -158,10 +190,10 @@ def _explain_core(d) -> str:
                 f"measured signal (the largest residual is {worst:.2f} times its noise floor, on the {SIGNAL_WORDS[worst_sig]}). "
                 f"No physics is missing and no parameter needs refitting.")
     if d.verdict == "unexplained" or d.winner is None:
-        best = d.winner or (d.runner_up or "none")
+        best = d.winner or d.runner_up
         share = d.scores[best].explained * 100 if best in d.scores else 0.0
         return (f"The model misses the recording {_where(d)} (the {SIGNAL_WORDS[worst_sig]} residual is {worst:.1f} times its "
-                f"noise floor), and nothing in the library explains it: the best candidate, {best}, removes only "
+                f"noise floor), and nothing in the library explains it: the best candidate ({effect_words(best)}) removes only "
                 f"{share:.0f} % of the excess. The physics behind it is outside {_library(d)}; look at the located windows.")
     fit = d.fits[d.winner]
     change = _signal_change(d, list(d.fit_before))
@@ -180,9 +212,9 @@ def _explain_core(d) -> str:
     main = next(i for i, fp in enumerate(fit.params) if fp.kind == "effect")
     fp = fit.params[main]
     phys = PHYSICS.get(effect, eff.meaning + " ({v})").format(v=_pm(fit.values[main], fit.stderr[main], fp.unit))
-    others = [f"{q.name} {_pm(v, e, q.unit)}" for q, v, e in zip(fit.params, fit.values, fit.stderr) if q.kind == "effect" and q is not fp]
+    others = [f"{_param_words(q)} {_pm(v, e, q.unit)}" for q, v, e in zip(fit.params, fit.values, fit.stderr) if q.kind == "effect" and q is not fp]
     text = (f"The model misses the recording {_where(d)} (the {SIGNAL_WORDS[worst_sig]} residual is {worst:.1f} times its noise "
-            f"floor) the way {effect.replace('_', ' ')} does: {eff.signature}. The explanation: {phys}")
+            f"floor) in the pattern of one declared effect, {effect_words(effect)}: {eff.signature}. The explanation: {phys}")
     if others:
         text += "; also fitted: " + ", ".join(others)
     text += "."
@@ -200,11 +232,11 @@ def _explain_core(d) -> str:
     if d.runner_up and d.runner_up in d.scores:
         ru, w = d.scores[d.runner_up], d.scores[d.winner]
         if ru.chi2 < ALMOST_AS_WELL * w.chi2:
-            alt = "recalibrating base parameters" if d.runner_up == "base" else d.runner_up.replace("_", " ")
+            alt = effect_words(d.runner_up)
             text += (f" Caution: {alt} explains the recording almost as well (residual {ru.chi2 / w.chi2:.2f} times the "
                      f"winner's); a test at another operating point (supply pressure, load) tells them apart.")
         else:
-            text += f" The runner-up, {d.runner_up}, fits worse by {ru.bic - w.bic:.0f} in BIC."
+            text += f" The runner-up ({effect_words(d.runner_up)}) fits worse by {fmt_dbic(ru.bic - w.bic)} in BIC."
     return text
 
 
@@ -213,8 +245,8 @@ def _explain_set(d, fit, worst_sig, worst, change) -> str:
     effects = [e for e in d.winner.split("+") if e in EFFECTS]
     parts = []
     for e in effects:
-        vals = [f"{q.name} {_pm(v, err, q.unit)}" for q, v, err in zip(fit.params, fit.values, fit.stderr) if q.effect == e]
-        parts.append(f"{e.replace('_', ' ')} ({', '.join(vals)})")
+        vals = [f"{_param_words(q)} {_pm(v, err, q.unit)}" for q, v, err in zip(fit.params, fit.values, fit.stderr) if q.effect == e]
+        parts.append(f"{effect_words(e)} ({', '.join(vals)})")
     text = (f"The model misses the recording {_where(d)} (the {SIGNAL_WORDS[worst_sig]} residual is {worst:.1f} times its noise "
             f"floor), and no single effect explains it; {len(effects)} effects together do: " + "; ".join(parts) + ".")
     base = _base_changes(d, fit)

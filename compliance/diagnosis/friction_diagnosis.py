@@ -55,8 +55,8 @@ UNITS = {"bias": "N", "bias_per_pressure": "N/Pa", "coulomb": "N", "static": "N"
 MEANING = {
     "bias": "force-sensor zero (direction-independent)",
     "bias_per_pressure": "piston-area error: direction-independent force per Pa of chamber pressure",
-    "coulomb": "Coulomb friction F_C0 (at 0 bar gauge)",
-    "static": "static friction F_S0 (at 0 bar gauge)",
+    "coulomb": "Coulomb friction F_C0 (at zero gauge pressure)",
+    "static": "static friction F_S0 (at zero gauge pressure)",
     "stribeck_velocity": "Stribeck velocity v_s",
     "viscous": "viscous coefficient b",
     "pressure_coefficient": "rise of F_C and F_S per Pa of chamber gauge pressure, k_p",

@@ -7,7 +7,9 @@ import math
 import numpy as np
 
 from compliance.diagnosis.friction_fit import PRESSURE_EFFECT
+from compliance.diagnosis.friction_position import POSITION_FRICTION
 from compliance.diagnosis.friction_models import core_equivalent
+from compliance.units.formatting import fmt_si
 
 
 def explain_friction(d) -> str:
@@ -17,15 +19,15 @@ def explain_friction(d) -> str:
     runs = d.runs
     lo, hi = int(np.argmin([r.pressure for r in runs])), int(np.argmax([r.pressure for r in runs]))
     bp = base.params
-    text = (f"Seal {d.seal}: a pressure-independent Stribeck law (F_C {bp['coulomb']:.2f} N, F_S {bp['static']:.2f} N, "
-            f"b {bp['viscous']:.0f} N*s/m) leaves an RMS friction error of {np.mean(rb):.2f} N over the {len(runs)} runs "
-            f"({math.sqrt(base.chi2 / base.n):.0f} times the force noise of {d.noise_floor:.2f} N).")
+    text = (f"Seal {d.seal}: a pressure-independent Stribeck law (F_C {fmt_si(bp['coulomb'], 'N')}, F_S {fmt_si(bp['static'], 'N')}, "
+            f"b {fmt_si(bp['viscous'], 'N*s/m')}) leaves an RMS friction error of {fmt_si(np.mean(rb), 'N')} over the {len(runs)} runs "
+            f"({math.sqrt(base.chi2 / base.n):.0f} times the force noise of {fmt_si(d.noise_floor, 'N')}).")
     loc = d.located
     trend = loc.get("pressure_trend")
     if trend:
-        text += (f" Where it fails: in steady sliding the seal rubs {abs(trend['per_bar']):.2f} N per bar "
-                 f"{'harder' if trend['per_bar'] > 0 else 'less'} than the law says as the pressure rises "
-                 f"({trend['span']:+.2f} N across the pressures)")
+        text += (f" Where it fails: in steady sliding the seal rubs {fmt_si(abs(trend['slope']), 'N/Pa')} of pressure "
+                 f"{'harder' if trend['slope'] > 0 else 'less'} than the law says as the pressure rises "
+                 f"({'+' if trend['span'] >= 0 else ''}{fmt_si(trend['span'], 'N')} across the pressures)")
     else:
         text += " Where it fails:"
     if loc.get("reversal_excess"):
@@ -43,22 +45,23 @@ def explain_friction(d) -> str:
     p = w.params
     parts = []
     if "pressure_coefficient" in p:
-        parts.append(f"seal friction that rises with the chamber pressure (k_p = {p['pressure_coefficient']*1e5:.2f} N/bar "
+        parts.append(f"seal friction that rises with the chamber pressure (k_p = {fmt_si(p['pressure_coefficient'], 'N/Pa')} "
                      f"on F_C and F_S{core_equivalent(p)})")
     if "bristle_stiffness" in p:
         pm = float(np.mean([r.pressure for r in runs]))
         fc = p["coulomb"] + p.get("pressure_coefficient", 0.0) * pm
-        parts.append(f"pre-sliding hysteresis at reversals (LuGre bristles, sigma0 = {p['bristle_stiffness']/1e3:.3g} N/mm: "
-                     f"the friction builds up over a pre-sliding distance F_C/sigma0 of about {fc/p['bristle_stiffness']*1e3:.2f} mm "
-                     f"at {pm/1e5:.1f} bar)")
+        parts.append(f"pre-sliding hysteresis at reversals (LuGre bristles, \u03c3\u2080 = {fmt_si(p['bristle_stiffness'], 'N/m')}: "
+                     f"the friction builds up over a pre-sliding distance F_C/\u03c3\u2080 of about "
+                     f"{fmt_si(fc / p['bristle_stiffness'], 'm')} at {fmt_si(pm, 'Pa')} gauge)")
     if "position_gradient" in p:
-        parts.append(f"friction that changes along the stroke (levels x (1 {p['position_gradient']*1e-3:+.3f}/mm (x - x_r) "
-                     f"{p['position_curvature']*1e-6:+.4f}/mm^2 (x - x_r)^2), x_r = {p['reference_position']*1e3:.1f} mm; "
-                     f"declared effect position_dependent_friction, kept because it predicts held-out runs better)")
+        parts.append(f"friction that changes along the stroke (levels \u00d7 (1 + a (x \u2212 x_r) + c (x \u2212 x_r)\u00b2), "
+                     f"a = {fmt_si(p['position_gradient'], '1/m')}, c = {fmt_si(p['position_curvature'], '1/m^2')}, "
+                     f"x_r = {fmt_si(p['reference_position'], 'm')}; the bench effect \u201c{POSITION_FRICTION.meaning}\u201d, "
+                     "kept because it predicts held-out runs better)")
     ra = w.rms_per_run()
-    text += (f" The missing physics: {' and '.join(parts)}. Adding it cuts the RMS friction error from {np.mean(rb):.2f} N to "
-             f"{np.mean(ra):.2f} N ({rb[lo]:.2f} -> {ra[lo]:.2f} N at {runs[lo].pressure/1e5:.1f} bar, "
-             f"{rb[hi]:.2f} -> {ra[hi]:.2f} N at {runs[hi].pressure/1e5:.1f} bar).")
+    text += (f" The missing physics: {' and '.join(parts)}. Adding it cuts the RMS friction error from {fmt_si(np.mean(rb), 'N')} "
+             f"to {fmt_si(np.mean(ra), 'N')} ({fmt_si(rb[lo], 'N')} \u2192 {fmt_si(ra[lo], 'N')} at {fmt_si(runs[lo].pressure, 'Pa')} gauge, "
+             f"{fmt_si(rb[hi], 'N')} \u2192 {fmt_si(ra[hi], 'N')} at {fmt_si(runs[hi].pressure, 'Pa')} gauge).")
     if d.verdict == "unexplained":
         text += " It still leaves most of the error: the rest is physics outside these candidates (e.g. position-dependent friction)."
     return text

@@ -28,6 +28,8 @@ import numpy as np
 
 from compliance.files.jsonable import json_number
 from compliance.diagnosis.friction_fit import LawFit, fit_law, predict, start_from
+from compliance.diagnosis.friction_position import POSITION_FRICTION
+from compliance.units.formatting import fmt_si
 
 MIN_RUNS = 3  # fit on at least two pressures, predict a third
 RATIO_TARGET = 1.5  # median held-out error within this multiple of the in-sample error (issue 24)
@@ -100,10 +102,10 @@ def holdout_words(table: dict, seal: str) -> str:
     rows = table["runs"]
     worst = max(rows, key=lambda r: r["ratio"])
     return (f" Out of sample (each pressure predicted by the law fitted on the others): median held-out error "
-            f"{table['median_held_out_rms']:.2f} N against {table['median_in_sample_rms']:.2f} N in sample "
-            f"(median ratio {table['median_ratio']:.2f}, target <= {table['ratio_target']:g}; worst "
-            f"{worst['ratio']:.2f} at {worst['pressure_gauge']/1e5:.1f} bar); the held-out runs' own force zeros "
-            f"differ from the others' bias line by up to {max(abs(r['held_out_offset']) for r in rows):.2f} N "
+            f"{fmt_si(table['median_held_out_rms'], 'N')} against {fmt_si(table['median_in_sample_rms'], 'N')} in sample "
+            f"(median ratio {table['median_ratio']:.2f}, target \u2264 {table['ratio_target']:g}; worst "
+            f"{worst['ratio']:.2f} at {fmt_si(worst['pressure_gauge'], 'Pa')} gauge); the held-out runs' own force zeros "
+            f"differ from the others' bias line by up to {fmt_si(max(abs(r['held_out_offset']) for r in rows), 'N')} "
             f"(a bench finding: the sensor zero moves between runs of {seal}, not friction physics); without each "
             f"run's own offset the median ratio is {table['median_ratio_without_offset']:.2f}.")
 
@@ -145,8 +147,9 @@ def position_words(position: dict | None) -> str:
     if not position:
         return ""
     verdict = "kept" if position["earned"] else "not kept"
-    return (f" position_dependent_friction (declared): median held-out error {position['median_held_out_rms_without']:.2f} N "
-            f"without it, {position['median_held_out_rms_with']:.2f} N with it, lower in {position['runs_improved']} of "
+    return (f" {POSITION_FRICTION.meaning[0].upper() + POSITION_FRICTION.meaning[1:]} , a declared bench effect: median "
+            f"held-out error {fmt_si(position['median_held_out_rms_without'], 'N')} without it, "
+            f"{fmt_si(position['median_held_out_rms_with'], 'N')} with it, lower in {position['runs_improved']} of "
             f"{position['runs']} held-out runs: {verdict} (rule: {position['rule']}).")
 
 

@@ -128,9 +128,12 @@ def core_equivalent(p: dict) -> str:
     The core scales both levels by 1 + k p_mean (p_mean the mean chamber gauge pressure; this
     single-acting cylinder has its rod side vented, so p_mean = p_g / 2): k = 2 k_p / F_0 per level.
     """
-    rel = [f"{2e5 * p['pressure_coefficient'] / p[level]:.3g} per bar on {name}"
+    from compliance.diagnosis.explain import effect_words
+    from compliance.units.formatting import fmt_si
+
+    rel = [f"{fmt_si(2.0 * p['pressure_coefficient'] / p[level], '1/Pa')} on {name}"
            for level, name in (("coulomb", "F_C"), ("static", "F_S")) if p[level] > 1e-3]
     if not rel:
         return ""
-    return ("; the core's pressure_dependent_friction, which scales both levels by 1 + k x the mean chamber gauge "
-            f"pressure, would need k = {' and '.join(rel)}")
+    return (f"; the plant model's declared effect \u201c{effect_words('pressure_dependent_friction')}\u201d, which scales both "
+            f"levels by 1 + k \u00d7 the mean chamber gauge pressure, would need k = {' and '.join(rel)}")

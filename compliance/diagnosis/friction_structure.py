@@ -25,6 +25,7 @@ import math
 import numpy as np
 
 from compliance.diagnosis.empirical import sparse_fit
+from compliance.units.formatting import fmt_si
 
 POSITION_BINS = 8  # hat functions along the travelled range
 V_REF = 0.01  # m/s; reference speed of the velocity shapes
@@ -59,7 +60,7 @@ def _features(runs) -> tuple[dict[str, np.ndarray], dict[str, str]]:
     feats["speed_squared"] = sgn * (v / V_REF) ** 2
     words["speed_squared"] = f"friction {{sign}} with the square of speed ({{size}} at {V_REF*1e3:.0f} mm/s)"
     feats["pressure_squared"] = sgn * (p / BAR) ** 2
-    words["pressure_squared"] = "friction {sign} with the square of the pressure ({size} at 1 bar, x 49 at 7 bar)"
+    words["pressure_squared"] = "friction {sign} with the square of the gauge pressure ({size} at 100 kPa, \u00d7 49 at 700 kPa)"
     start = 0
     for r in runs:
         m = int(r.valid.sum())
@@ -79,7 +80,8 @@ def _features(runs) -> tuple[dict[str, np.ndarray], dict[str, str]]:
 
 
 def _words(template: str, c: float) -> str:
-    return template.format(sign="higher" if c > 0 else "lower", size=f"{abs(c):.2g} N", value=f"{c:+.2g} N")
+    return template.format(sign="higher" if c > 0 else "lower", size=fmt_si(abs(c), "N", digits=2),
+                           value=("+" if c >= 0 else "") + fmt_si(c, "N", digits=2))
 
 
 def friction_structure(runs, law_fit) -> dict:
@@ -106,8 +108,8 @@ def friction_structure(runs, law_fit) -> dict:
     noise = float(np.median([r.floor for r in runs]))
     text = ("; ".join(t["words"] for t in fit["terms"]) if fit["terms"] else "no simple structure")
     return {"label": "empirical suggestion, not a declared effect", "terms": fit["terms"],
-            "words": (f"What the law leaves: {text}. Modelled, the residual falls from {fit['rms_before']:.2f} N to "
-                      f"{fit['rms_after']:.2f} N ({fit['rms_after'] / noise:.1f} times the force noise)."),
+            "words": (f"What the law leaves: {text}. Modelled, the residual falls from {fmt_si(fit['rms_before'], 'N')} to "
+                      f"{fmt_si(fit['rms_after'], 'N')} ({fit['rms_after'] / noise:.1f} times the force noise)."),
             "rms_before": fit["rms_before"], "rms_after": fit["rms_after"], "improvement": fit["improvement"],
             "rms_after_in_noise": fit["rms_after"] / noise if noise > 0 else math.inf}
 

@@ -89,7 +89,7 @@ def instrumented(setup, params, values):
 
 def finding_words(fit) -> str:
     """The instrumentation finding of a fit (an instrumentation candidate, or a plant explanation with one on top) in words."""
-    from compliance.units.formatting import format_value
+    from compliance.units.formatting import fmt_si
 
     pairs = [(fp, v) for fp, v in zip(fit.params, fit.values) if fp.kind == KIND]
     if not pairs:
@@ -98,7 +98,7 @@ def finding_words(fit) -> str:
     if what == "pressure_gain":
         v = ", ".join(f"{fp.name} x {val:.4f} ({100 * (val - 1):+.2f} % on gauge pressure)" for fp, val in pairs)
     else:
-        v = format_value(pairs[0][1], "s")
+        v = fmt_si(pairs[0][1], "s")
     return MEANING.get(what, what).format(v=v)
 
 

@@ -21,6 +21,7 @@ from compliance.errors import InputError, SimulationError
 from compliance.diagnosis.noise_floor import QUANTISED_SHARE, sensor_noise_std
 from compliance.diagnosis.operating_point import load_at_start
 from compliance.diagnosis.replay_fit import ReplaySetup, run_replay
+from compliance.validation.fit_metrics import nrmse
 
 # lowest floors we accept (instrument resolution a logger rarely beats): keeps one signal from
 # dominating when its noise estimate comes out implausibly small
@@ -282,7 +283,7 @@ def signal_fit(model: ResidualModel, sim: dict | None, mask: np.ndarray | None =
     Returns
     -------
     dict
-        signal -> {rms [SI], rms_normalised [-], nrmse [-] (rms / recorded range),
+        signal -> {rms [SI], rms_normalised [-], nrmse [-] (|r| / |y - mean y|, the validation table's NRMSE),
         fit_percent (100 * (1 - |r| / |y - mean y|), the NRMSE fit of system identification)}.
     """
     out = {}
@@ -296,12 +297,7 @@ def signal_fit(model: ResidualModel, sim: dict | None, mask: np.ndarray | None =
         m = sim[s] if mask is None else sim[s][mask]
         r = y - m
         rms = float(np.sqrt(np.mean(r * r)))
-        spread = float(np.linalg.norm(y - y.mean()))
-        rng = float(np.ptp(y))
-        out[s] = {
-            "rms": rms,
-            "rms_normalised": rms / model.floors[s],
-            "nrmse": rms / rng if rng > 0 else float("nan"),
-            "fit_percent": 100.0 * (1.0 - float(np.linalg.norm(r)) / spread) if spread > 0 else float("nan"),
-        }
+        e = nrmse(y, m)  # the validation table's definition, so text and table quote one number
+        e = float("nan") if e is None else e
+        out[s] = {"rms": rms, "rms_normalised": rms / model.floors[s], "nrmse": e, "fit_percent": 100.0 * (1.0 - e)}
     return out

@@ -116,12 +116,12 @@ def _param_rows(params: list) -> list[dict]:
 
 def _seal_context(seal, sd: dict, index: int) -> dict:
     """What the report shows of one seal: finding, parameters with errors (SI prefixes), ranked laws, residual remarks."""
-    from compliance.units.formatting import fmt_num, fmt_si, fmt_value
+    from compliance.units.formatting import fmt_dbic, fmt_num, fmt_si, fmt_value
 
     win = next((e for e in sd["effects"] if e["name"] == sd["winner"]), None) if sd["winner"] else None
     params = _param_rows((win or {}).get("parameters") or [])
     ranked = [{"name": e["name"].replace("+", " + ").replace("_", " "), "k": e["k"], "chi2": fmt_num(e.get("chi2_per_residual"), 3),
-               "dbic": _dbic(e.get("delta_bic")), "explained": fmt_value(100 * (e.get("explained_fraction") or 0), "%", 3),
+               "dbic": fmt_dbic(e.get("delta_bic")), "explained": fmt_value(100 * (e.get("explained_fraction") or 0), "%", 3),
                "params": "; ".join(f"{p['name'].replace('_', ' ')} {fmt_si(p['value'], p.get('unit') or '')}"
                                    for p in e["parameters"] if p.get("value") is not None)} for e in sd["effects"]]
     floor = (sd.get("noise_floor") or {}).get("value")
@@ -165,13 +165,6 @@ def _holdout_context(h: dict | None) -> dict | None:
             "The run offset is the held-out run's force zero against the other runs' bias line: a bench finding "
             "(the sensor zero moves between runs), not friction physics.")
     return {"rows": rows, "note": note}
-
-
-def _dbic(v) -> str:
-    """A BIC difference: whole numbers with thin-space thousands ("6 102 968"), small ones to one decimal."""
-    if v is None:
-        return "\u2013"
-    return f"{v:.1f}" if abs(v) < 100 else f"{v:,.0f}".replace(",", "\u2009")
 
 
 BENCH_FIELDS = (("rig", "Test rig"), ("seal", "Seal"), ("bore", "Bore"), ("temperature", "Temperature"),

@@ -2,31 +2,45 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
+from compliance.units.formatting import fmt_margin_pct, fmt_num, si_prefix, unit_text
+
 __all__ = ["remedies_markdown", "summary_markdown", "yield_markdown"]
 
 
-def _g(v) -> str:
-    return "-" if v is None else f"{v:.4g}"
+def _g(v, unit: str = "") -> str:
+    """A parameter value with its unit: SI prefix, 4 significant digits without padding zeros, typeset unit
+    (``8e+05 Pa`` -> ``800 kPa``, ``9.271e-09 m^3/(s*Pa)`` -> ``9.271×10⁻⁹ m³/(s·Pa)``)."""
+    if v is None:
+        return "-"
+    scale, shown = si_prefix(float(v), unit or "")
+    return f"{fmt_num(float(v) * scale, 4)} {unit_text(shown)}".strip()
 
 
 def _pct(v) -> str:
-    return "-" if v is None else f"{v:+.1f} %"
+    return "-" if v is None else f"{v:+.1f} %".replace("-", "\u2212")
+
+
+def _margin(v) -> str:
+    """A margin in per cent of its limit, capped as in the report (beyond ±100 % it says far beyond/inside)."""
+    return fmt_margin_pct(v) or "-"
 
 
 def remedies_markdown(rem: dict) -> str:
     """The remedies section: status, sensitivities of each failed requirement, the change or the closest candidate."""
     lines = ["## What would make it pass", "", rem.get("note", ""), ""]
     for s in rem.get("sensitivities", []):
-        lines.append(f"- **{s['requirement']}** (margin {_pct(s['margin_pct'])}) moves with, per 10 % of each range:")
+        lines.append(f"- **{s['requirement']}** (margin {_margin(s['margin_pct'])}) moves with, per 10 % of each range:")
         for b in s["by_parameter"][:4]:
-            lines.append(f"  - {b['path']} +{_g(b['step'])} {b['unit']}: {_pct(b['delta_margin_pct'])} points")
+            lines.append(f"  - {b['path']} +{_g(b['step'], b['unit'])}: {_pct(b['delta_margin_pct'])} points")
     pick = rem.get("remedy") or rem.get("closest")
     if pick:
         title = "Smallest verified change" if rem.get("remedy") else "Closest candidate (does not pass)"
         lines += ["", f"**{title}** (normalised change {pick['change']:.3f}; binding {pick['binding']} "
-                      f"{_pct(pick['binding_margin_pct'])}):", ""]
-        lines += ["| parameter | from | to | unit |", "|---|---|---|---|"]
-        lines += [f"| {c['path']} | {_g(c['from'])} | {_g(c['to'])} | {c['unit']} |" for c in pick["changes"]]
+                      f"{_margin(pick['binding_margin_pct'])}):", ""]
+        lines += ["| parameter | from | to |", "|---|---|---|"]
+        lines += [f"| {c['path']} | {_g(c['from'], c['unit'])} | {_g(c['to'], c['unit'])} |" for c in pick["changes"]]
         if pick.get("hardware"):
             lines.append("\nHardware: " + "; ".join(f"{h['title']} (cost {h['cost']:g})" for h in pick["hardware"]))
         if pick.get("failed_mandatory"):
@@ -58,28 +72,37 @@ def summary_markdown(s: dict) -> str:
     """The sweep summary as Markdown."""
     ex = s.get("executor") or {}
     lines = [f"# Sweep {s['name']}: {s['title']}", "",
-             f"- file: `{s['sweep_file']}`; method {s['method']} (seed {s['seed']}); {s['candidates']} candidates",
-             f"- **{s['passing']} of {s['candidates']} pass** every mandatory requirement; by status: "
-             + ", ".join(f"{k} {v}" for k, v in sorted(s["counts"].items())),
-             f"- executor: {ex.get('backend')} x {ex.get('workers')}; done {ex.get('done')}, failed {ex.get('failed')}, "
-             f"retried {ex.get('retried')} (tasks); wall {s['wall']:.0f} s", ""]
+             f"- method {s['method']} (random-number start {s['seed']}); "
+             f"{s['candidates']} candidates drawn from the declared ranges",
+             f"- **{s['passing']} of the {s['candidates']} drawn candidates pass** every mandatory requirement; by status: "
+             + ", ".join(f"{k} {v}" for k, v in sorted(s["counts"].items()))]
+    judged = (s.get("remedies") or {}).get("evaluated")
+    if judged:
+        found = 1 if (s["remedies"].get("remedy")) else 0
+        # a different count from the drawn candidates above: the search starts from them and adds its own steps
+        lines.append(f"- the remedy search, started from these {s['candidates']}, judged {judged} candidate settings in all "
+                     "(its own search steps and verification runs counted); "
+                     + ("a verified change passes" if found else "none passes"))
+    lines += [f"- executor: {ex.get('backend')} \u00d7 {ex.get('workers')} workers; {ex.get('done')} tasks done, "
+              f"{ex.get('failed')} failed, {ex.get('retried')} retried; wall time {fmt_num(s['wall'], 3)} s", ""]
     par = s["pareto"]
     if len(par["requirements"]) == 2:
         a, b = par["requirements"]
         lines += [f"## Pareto front of the two tightest requirements: {a} x {b}", "",
                   f"| candidate | status | {a} margin | {b} margin | change |", "|---|---|---|---|---|"]
-        lines += [f"| {c['candidate']} | {c['status']} | {_pct(c[a + '.margin_pct'])} | {_pct(c[b + '.margin_pct'])} | "
+        lines += [f"| {c['candidate']} | {c['status']} | {_margin(c[a + '.margin_pct'])} | {_margin(c[b + '.margin_pct'])} | "
                   f"{c['change']:.3f} |" for c in par["candidates"]]
         lines.append("")
     b = s.get("best")
     if b:
         lines += [f"## Best candidate: #{b['candidate']} ({b['status']}; full campaign: {b['verified_status']})", "",
-                  "| parameter | value | unit | base |", "|---|---|---|---|"]
+                  "| parameter | value | base |", "|---|---|---|"]
         for p in s["parameters"]:
-            lines.append(f"| {p['path']} | {_g(b['values'][p['path']])} | {p['unit']} | {_g(p['base'])} |")
+            lines.append(f"| {p['path']} | {_g(b['values'][p['path']], p['unit'])} | {_g(p['base'], p['unit'])} |")
         if b["failed_mandatory"]:
             lines.append(f"\nStill failing: {', '.join(b['failed_mandatory'])}")
-        lines.append(f"\nFull results: `{b['results_file']}` (`govcheck report` renders it)\n")
+        lines.append(f"\nFull results: {Path(b['results_file']).name}, written next to this summary "
+                     "(`govcheck report` renders it)\n")
     if s.get("remedies"):
         lines.append(remedies_markdown(s["remedies"]))
     return "\n".join(lines) + "\n"
@@ -90,7 +113,7 @@ def yield_markdown(y: dict) -> str:
     a = y["all_mandatory"]
     conf = int(round(100 * y["confidence"]))
     lines = [f"# Tolerance yield of {y['name']} candidate '{y['label']}'", "",
-             f"- {y['units']} units (seed {y['seed']}); {y['valid']} valid, {y['invalid']} invalid draws, "
+             f"- {y['units']} units (random-number start {y['seed']}); {y['valid']} valid, {y['invalid']} invalid draws, "
              f"{y['failed_tasks']} lost",
              f"- **all mandatory requirements: {a['pass']} / {y['valid']} = {100 * (a['fraction'] or 0):.1f} %** "
              f"({conf} % CI {100 * a['ci'][0]:.1f} - {100 * a['ci'][1]:.1f} %)", "",
@@ -100,5 +123,5 @@ def yield_markdown(y: dict) -> str:
         lines.append(f"| {r['requirement']} | {r['severity']} | {r['pass']}/{r['units']} | {f} | "
                      f"{100 * r['ci'][0]:.1f} - {100 * r['ci'][1]:.1f} % | {_pct(r['margin_pct_median'])} |")
     lines += ["", "Drivers (Spearman rank correlation with the worst mandatory margin):", ""]
-    lines += [f"- {d['path']}: {_g(d['worst_margin'])}" for d in y["drivers"]]
+    lines += [f"- {d['path']}: {fmt_num(d['worst_margin'], 3)}" for d in y["drivers"]]
     return "\n".join(lines) + "\n"

@@ -17,7 +17,7 @@ import datetime as _dt
 import math
 
 __all__ = ["STATUS_WORD", "status_word", "fmt_num", "fmt_value", "fmt_margin_pct", "unit_text", "fmt_date",
-           "RESOLUTION"]
+           "fmt_si", "si_prefix", "fmt_dbic", "RESOLUTION"]
 
 # requirement / verdict states -> the word shown to a reader (one table for every output)
 STATUS_WORD = {"pass": "PASS", "fail": "FAIL", "not_evaluated": "NOT EVALUATED", "open": "OPEN",
@@ -135,24 +135,6 @@ def fmt_date(iso: str | None) -> str:
     return d.strftime("%Y-%m-%d %H:%M")
 
 
-# SI unit -> (factor, unit an engineer reads) for fitted parameters and explanations
-_ENGINEERING = {"m^3": (1e3, "L"), "m": (1e3, "mm"), "Pa": (1e-3, "kPa"), "N/m": (1e-3, "kN/m"),
-                "N/Pa": (1e5, "N/bar"), "1/Pa": (1e5, "per bar"), "m^3/(s*Pa)": (1e8, "dm^3/(s*bar)")}
-
-
-def format_value(value: float, unit: str) -> str:
-    """An SI value in the unit an engineer reads it in: "12 ms", "50 kN/m", "1.5e-10 kg/(s*Pa)", "6.1 W/K"."""
-    v = float(value)
-    if unit == "s":
-        return f"{v*1e3:.3g} ms" if abs(v) < 1 else f"{v:.3g} s"
-    if unit in _ENGINEERING:
-        factor, shown = _ENGINEERING[unit]
-        return f"{v * factor:.3g} {shown}"
-    if unit == "kg/(s*Pa)":
-        return f"{v:.2g} {unit}"
-    return f"{v:.3g} {unit}" if unit else f"{v:.3g}"
-
-
 _PREFIXES = ((1e9, "G"), (1e6, "M"), (1e3, "k"), (1.0, ""), (1e-3, "m"), (1e-6, "\u00b5"), (1e-9, "n"), (1e-12, "p"))
 
 
@@ -187,3 +169,10 @@ def fmt_si(value, unit: str, stderr=None, digits: int = 3) -> str:
     if stderr is not None and math.isfinite(float(stderr)):
         text += f" \u00b1 {fmt_num(float(stderr) * scale, 2)}"
     return f"{text} {unit_text(shown)}".replace("-", "\u2212").strip()
+
+
+def fmt_dbic(v) -> str:
+    """A BIC difference: whole numbers with thin-space thousands ("6 102 968"), small ones to one decimal."""
+    if v is None or not math.isfinite(float(v)):
+        return _DASH
+    return f"{v:.1f}" if abs(v) < 100 else f"{v:,.0f}".replace(",", "\u2009")

@@ -141,6 +141,22 @@ def test_a_miscalibrated_valve_is_called_parameters_only(cfg):
     assert d.winner == "base"
     assert d.fits["base"].value("valve.sonic_conductance") == pytest.approx(1.5 * c0, rel=0.05)
     assert "No physics is missing" in d.explanation
+    assert "valve sonic conductance refitted" in d.explanation and "valve.sonic_conductance" not in d.explanation
+    # the fit the text quotes is the validation table's (one NRMSE definition), same replay, same number
+    from compliance.units.formatting import fmt_num
+    from compliance.validation.validate import ValidationSettings, validate
+
+    table = validate(cfg, frame, meta, ValidationSettings(modes=("closed_loop",)))["modes"]["closed_loop"]["fits"]
+    quoted = [s for s in d.fit_before if f"(fit {fmt_num(d.fit_before[s]['fit_percent'], 3)} % \u2192" in d.explanation]
+    assert quoted, d.explanation
+    assert d.fit_before[quoted[0]]["fit_percent"] == pytest.approx(table[quoted[0]]["fit_percent"], abs=0.05)
+    # the report's text quotes the fitted model's own validation table, before and after, digit for digit
+    from compliance.diagnosis.explain import explain_with_table
+
+    after = validate(d.fitted_cfg, frame, meta, ValidationSettings(modes=("closed_loop",)))["modes"]["closed_loop"]["fits"]
+    s = quoted[0]
+    text = explain_with_table(d, table, after)
+    assert f"(fit {fmt_num(table[s]['fit_percent'], 3)} % \u2192 {fmt_num(after[s]['fit_percent'], 3)} %)" in text, text
 
 
 def test_physics_outside_the_library_is_called_unexplained(cfg):
@@ -152,6 +168,9 @@ def test_physics_outside_the_library_is_called_unexplained(cfg):
     assert d.winner is None
     assert d.windows
     assert "outside the 2 effects tried (" in d.explanation
+    # effects named in their declaration's words, never by id
+    assert "laminar leak from each chamber to atmosphere" in d.explanation
+    assert "external_leakage" not in d.explanation and "valve_offset" not in d.explanation
 
 
 def test_cli_writes_json_and_a_fitted_model_with_provenance(cfg, tmp_path):
@@ -213,6 +232,12 @@ def test_friction_diagnosis_names_pressure_dependence_on_synthetic_runs():
     assert seal.fits[seal.winner].params["pressure_coefficient"] == pytest.approx(2e-6, rel=0.05)
     data = d.to_dict()
     assert data["kind"] == "friction" and data["seals"][0]["fit_after"]
+    # the explanation in SI with prefixes: k_p = 2e-6 N/Pa reads "2.0x µN/Pa", no N/bar, no snake_case ids
+    text = seal.explanation
+    kp = seal.fits[seal.winner].params["pressure_coefficient"]
+    assert f"k_p = {kp * 1e6:.2f} \u00b5N/Pa" in text, text
+    assert "bar" not in text and "pressure_dependent_friction" not in text
+    assert "100 kPa gauge" in text and "700 kPa gauge" in text
 
 
 def test_small_benchmark_runs_and_scores(cfg):

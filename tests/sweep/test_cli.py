@@ -45,6 +45,28 @@ def test_sweep_writes_table_summary_and_best_results(swept):
     assert res["summary"]["status"] == "pass" and res["sweep"]["candidate"] == best["candidate"]
 
 
+def test_summary_text_reads_as_a_document(swept):
+    """The Markdown summary: counts say what they count, values carry prefixed typeset units, no "seed",
+    and every file it points at is one the sweep wrote next to it."""
+    import re
+
+    from compliance.report.text_check import repository_names, text_problems
+
+    _, _, out = swept
+    s = json.loads((out / "summary.json").read_text())
+    md = (out / "summary.md").read_text()
+    assert f"**{s['passing']} of the {s['candidates']} drawn candidates pass**" in md
+    assert not re.search(r"\bseeds?\b", md, re.I) and "random-number start" in md
+    assert not re.search(r"\d[eE][+-]\d", md) and "^" not in md and "*(" not in md  # no 8e+05, m^3, V*s
+    for p in s["parameters"]:  # each parameter's value printed with its unit
+        assert f"| {p['path']} |" in md
+    assert "V/m" in md  # controller.kp in V/m, typeset
+    named = re.findall(r"[\w.-]+\.(?:json|csv|parquet|md|html)\b", md)
+    assert named and all((out / n).exists() for n in named), named
+    heads = [line.lstrip("# ") for line in md.splitlines() if line.startswith("#")]
+    assert text_problems(md, heads, repo_names=repository_names(Path(__file__).resolve().parents[2])) == []
+
+
 def test_yield_of_best_is_seeded_and_bounded(swept):
     _, f, out = swept
     assert main(["sweep", str(f), "--out", str(out), "--yield", "best", "-q", "-j", "2"]) == 0

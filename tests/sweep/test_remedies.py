@@ -52,6 +52,19 @@ def test_no_remedy_in_the_space_names_the_binding_requirement(write_sweep, reqse
     assert rem["status"] == "none_found" and rem["remedy"] is None
     assert rem["closest"]["binding"] == "TC" and rem["closest"]["binding_margin_pct"] < 0
     assert "not a proof" in rem["note"]
+    # the summary of this search: the judged count stated as such, kp in V/m with its unit, no raw floats
+    import re
+
+    from compliance.sweep.summary_text import summary_markdown
+
+    summary = {"name": "s", "title": "t", "sweep_file": "s.toml", "method": "optimise", "seed": 1, "candidates": 8,
+               "counts": {"fail": 8}, "passing": 0, "executor": None, "wall": 1.0,
+               "pareto": {"requirements": [], "candidates": []}, "best": None, "parameters": [], "remedies": rem}
+    md = summary_markdown(summary)
+    assert f"judged {rem['evaluated']} candidate settings in all" in md and "0 of the 8 drawn candidates pass" in md
+    step = rem["sensitivities"][0]["by_parameter"][0]["step"]  # 10 % of the 150-260 V/m range: 11 V/m
+    assert f"controller.kp +{step:.4g} V/m: " in md, md
+    assert not re.search(r"\d[eE][+-]\d", md) and "seed" not in md
 
 
 def test_check_remedies_cli_writes_the_section(tmp_path, capsys):
