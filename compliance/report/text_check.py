@@ -60,6 +60,8 @@ def repository_names(root) -> set[str]:
     for folder in ("docs", "compliance", "models", "requirements", "tests", "benchmarks", "reports"):
         for f in (root / folder).rglob("*"):
             if f.is_file() and f.suffix in _EXTENSIONS and "__pycache__" not in f.parts:
+                if folder == "reports" and f.suffix != ".py":
+                    continue  # generated outputs: a report may name its own sibling outputs
                 names.add(f.name)
     names.update(n for n in ("README.md", "pyproject.toml") if (root / n).exists())
     return names
