@@ -18,7 +18,7 @@ from typing import Literal, Union
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from compliance.errors import InputError, did_you_mean
-from compliance.sweep.parameter_paths import ParamPath, describe
+from compliance.sweep.candidates.parameter_paths import ParamPath, describe
 from compliance.units import parse_quantity
 
 __all__ = ["Adjustable", "SweepSpec", "Uncertain", "load_sweep", "SCHEMA"]

@@ -1,21 +1,21 @@
 """The end of a remedies search: never worse than as given, the remedy's yield, or why none exists.
 
 - The configuration as given is judged beside the candidates: a closest candidate that ranks
-  after it (``sweep.ranking``) is not reported; the configuration as given is.
+  after it (``sweep.candidates.ranking``) is not reported; the configuration as given is.
 - A remedy found (verified by a full campaign) gets its tolerance yield: ``units`` delivered
-  units drawn around it (``yield_mc``); it meets the acceptance statement when the one-sided
+  units drawn around it (``tolerance.yield_mc``); it meets the acceptance statement when the one-sided
   exact lower bound of the pass fraction is >= ``YIELD_TARGET`` at ``CONFIDENCE``; otherwise the
   section says how close it gets.
-- When nothing passes, the binding requirement is explained physically (``binding_physics``),
+- When nothing passes, the binding requirement is explained physically (``remedies.binding_physics``),
   and the catalogue's unmodelled hardware is named.
 """
 
 from __future__ import annotations
 
-from compliance.sweep.binding_physics import explain_closest
-from compliance.sweep.ranking import SETTINGS_COST, candidate_passes, rank_key
-from compliance.sweep.remedies import describe_candidate
-from compliance.sweep.runner import run_candidates
+from compliance.sweep.remedies.binding_physics import explain_closest
+from compliance.sweep.candidates.ranking import SETTINGS_COST, candidate_passes, rank_key
+from compliance.sweep.remedies.smallest_change import describe_candidate
+from compliance.sweep.candidates.runner import run_candidates
 
 __all__ = ["CONFIDENCE", "YIELD_TARGET", "as_given", "finish", "remedy_configuration", "remedy_values"]
 
@@ -54,7 +54,7 @@ def _never_worse(rem, given) -> None:
 
 
 def _yield(rem, ctx, cfg, uncertain, run_kw, units):
-    from compliance.sweep.yield_mc import run_yield
+    from compliance.sweep.tolerance.yield_mc import run_yield
 
     y, _, _, _ = run_yield(ctx, cfg, remedy_values(rem), uncertain, units=units, seed=YIELD_SEED, confidence=CONFIDENCE,
                            run_kw={**run_kw, "label": "tolerance yield"})
@@ -72,7 +72,7 @@ def _yield(rem, ctx, cfg, uncertain, run_kw, units):
 
 def _closest_configuration(cfg, ctx, closest):
     """``cfg`` with the closest candidate's hardware and settings: its binding physics is told with its own numbers."""
-    from compliance.sweep.parameter_paths import apply_values
+    from compliance.sweep.candidates.parameter_paths import apply_values
 
     values = {**closest.get("hardware_values", {}), **closest.get("values", {})}
     return apply_values(cfg, ctx.paths, {k: v for k, v in values.items() if k in ctx.paths})
@@ -106,7 +106,7 @@ def finish(rem, given, ctx, cfg, reqset, uncertain, catalogue, *, run_kw, yield_
 
 def remedy_configuration(cfg, rem, paths):
     """The configuration with the remedy applied, named ``<name>-remedy`` (for ``--save-remedy``)."""
-    from compliance.sweep.parameter_paths import apply_values
+    from compliance.sweep.candidates.parameter_paths import apply_values
 
     values = remedy_values(rem)
     changed = apply_values(cfg, paths, values)

@@ -15,7 +15,7 @@
    the others; it is named in the result as out of reach.
 4. If nothing passes, the closest candidate judged and the requirement that binds it are
    reported: evidence, not a proof, that the declared space holds no pass. Closest =
-   ``sweep.ranking``: fewest failing mandatory requirements, then the smallest sum of
+   ``sweep.candidates.ranking``: fewest failing mandatory requirements, then the smallest sum of
    shortfalls, then the smallest change; the configuration as given is among the judged, so
    the closest never fails more mandatory requirements than it.
 
@@ -28,10 +28,10 @@ import math
 
 import numpy as np
 
-from compliance.sweep.results import change
-from compliance.sweep.ranking import SETTINGS_COST, candidate_passes, failing_mandatory, rank_key
-from compliance.sweep.runner import run_candidates, shortfall
-from compliance.sweep.sampling import from_normalised, to_normalised
+from compliance.sweep.candidates.results import change
+from compliance.sweep.candidates.ranking import SETTINGS_COST, candidate_passes, failing_mandatory, rank_key
+from compliance.sweep.candidates.runner import run_candidates, shortfall
+from compliance.sweep.candidates.sampling import from_normalised, to_normalised
 
 __all__ = ["STEP", "TARGET", "binding", "closeness", "describe_candidate", "find_remedy", "mandatory_margins", "unreachable"]
 
@@ -102,7 +102,7 @@ def _least_change(ubase, u0, m0, J, radius):
 
 
 def closeness(row: dict, values: dict, adjust, start: dict, cost: float = 0.0) -> tuple:
-    """Ranking key of a candidate (smaller is closer to passing; ``sweep.ranking.rank_key``)."""
+    """Ranking key of a candidate (smaller is closer to passing; ``sweep.candidates.ranking.rank_key``)."""
     return rank_key(row, cost + SETTINGS_COST * change(adjust, start, values))
 
 
@@ -148,7 +148,7 @@ def find_remedy(ctx, adjust, base: dict, *, verify, iterations: int = 4, seeds=(
 
     Parameters
     ----------
-    ctx : compliance.sweep.evaluate.Context
+    ctx : compliance.sweep.candidates.evaluate.Context
     adjust : tuple of Adjustable
     base : dict
         path -> SI value of the configuration as it is (clamped into the declared box).
@@ -159,7 +159,7 @@ def find_remedy(ctx, adjust, base: dict, *, verify, iterations: int = 4, seeds=(
     seeds : list of (settings, row)
         Candidates already judged (a sweep's samples): the search may start from the closest.
     run_kw : dict
-        Passed to :func:`~compliance.sweep.runner.run_candidates` (scheduler, workers, progress, client).
+        Passed to :func:`~compliance.sweep.candidates.runner.run_candidates` (scheduler, workers, progress, client).
     fixed : dict
         path -> SI value set on every candidate (hardware options); ``verify`` receives them too.
     cost : float

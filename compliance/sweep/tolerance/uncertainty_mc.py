@@ -13,11 +13,11 @@ from __future__ import annotations
 import numpy as np
 
 from compliance.campaign.uncertainty import _targets, apply_band, ranged_parameters, top_assumptions
-from compliance.sweep.evaluate import make_context
-from compliance.sweep.parameter_paths import describe
-from compliance.sweep.runner import run_candidates
-from compliance.sweep.sampling import latin_hypercube
-from compliance.sweep.spec import Adjustable
+from compliance.sweep.candidates.evaluate import make_context
+from compliance.sweep.candidates.parameter_paths import describe
+from compliance.sweep.candidates.runner import run_candidates
+from compliance.sweep.candidates.sampling import latin_hypercube
+from compliance.sweep.candidates.spec import Adjustable
 
 __all__ = ["monte_carlo_bands"]
 

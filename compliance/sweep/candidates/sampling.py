@@ -11,7 +11,7 @@ import itertools
 
 import numpy as np
 
-from compliance.sweep.spec import Adjustable, Uncertain
+from compliance.sweep.candidates.spec import Adjustable, Uncertain
 
 __all__ = ["grid", "latin_hypercube", "to_normalised", "from_normalised", "draw_units"]
 

@@ -12,8 +12,8 @@ competing with it. The box spans 0.8-1.2 times those rates and 0.5-10 % of the s
 
 from __future__ import annotations
 
-from compliance.sweep.parameter_paths import describe
-from compliance.sweep.spec import Adjustable
+from compliance.sweep.candidates.parameter_paths import describe
+from compliance.sweep.candidates.spec import Adjustable
 
 __all__ = ["LIMITER_PATHS", "limiter_space", "limiter_stage_start", "limiter_start"]
 

@@ -5,7 +5,7 @@ the requirement set and the planned runs (sent once), applies each candidate's s
 runs every planned procedure x operating point in turn without plot traces, and judges the
 requirements with the campaign's own :func:`~compliance.campaign.judge.judge`. What comes back
 is small: per requirement the worst value, margin, margin % and status, and the basis the judge
-gives it (a pass by construction is no pass: ``sweep.ranking``, as the campaign's own verdict).
+gives it (a pass by construction is no pass: ``sweep.candidates.ranking``, as the campaign's own verdict).
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from compliance.errors import GovcheckError
 from compliance.procedures.outcomes import traces_off
 from compliance.procedures.registry import run as run_procedure
 from compliance.requirements.verdict import DISABLED, FAIL, NOT_EVALUATED, OPEN, PASS, overall_status
-from compliance.sweep.parameter_paths import apply_values
+from compliance.sweep.candidates.parameter_paths import apply_values
 
 __all__ = ["Context", "INVALID", "evaluate_batch", "evaluate_one", "make_context", "sweep_requirements"]
 

@@ -1,6 +1,6 @@
 """Throttles of a sized servo refined by simulation: the full stroke's 25-75 % time on target.
 
-The steady rule of ``sizing`` ignores the pressure transients of a stroke; here each meter-out
+The steady rule of ``sizing.size_servo`` ignores the pressure transients of a stroke; here each meter-out
 conductance is corrected by a secant on log C until the simulated full stroke at the set-up
 point (flow-control valves in) takes the target time (within ``TOLERANCE``). This is how plant
 A's own throttles were derived (models/plant-a.toml, ``derived_for``: 5.0 s at 5.7 kN).

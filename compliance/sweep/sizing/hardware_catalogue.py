@@ -18,9 +18,9 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from compliance.effects import EFFECTS
 from compliance.errors import InputError
-from compliance.sweep.data_file import read_validated
+from compliance.sweep.sizing.data_file import read_validated
 from compliance.physics.valve_rating import NL_MIN, conductance_of_rating
-from compliance.sweep.parameter_paths import describe
+from compliance.sweep.candidates.parameter_paths import describe
 from compliance.units import parse_quantity
 
 __all__ = ["Catalogue", "HardwareOption", "load_catalogue", "DEFAULT_CATALOGUE"]

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 
 from compliance.campaign.executor import map_tasks, warm_up
-from compliance.sweep.evaluate import Context, evaluate_batch
+from compliance.sweep.candidates.evaluate import Context, evaluate_batch
 
 __all__ = ["batch_size", "run_candidates", "shortfall", "total_shortfall"]
 
@@ -27,7 +27,7 @@ def run_candidates(ctx: Context, candidates: list[dict], *, scheduler=None, work
 
     A candidate whose task failed every retry gets a row with status ``failed`` so that the
     table still has one row per candidate and the summary counts it. With a ``store``
-    (:class:`~compliance.sweep.candidate_store.CandidateStore`) candidates judged before are
+    (:class:`~compliance.sweep.candidates.candidate_store.CandidateStore`) candidates judged before are
     not judged again and the new ones are kept.
     """
     if store is not None:

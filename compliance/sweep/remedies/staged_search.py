@@ -1,11 +1,11 @@
 """The staged remedies search: settings (and the governor's rate limiter), then catalogue hardware.
 
-Stages, cheapest first (costs: ``sweep.ranking``; a hardware option costs its catalogue weight):
+Stages, cheapest first (costs: ``sweep.candidates.ranking``; a hardware option costs its catalogue weight):
 
-1. The on-site settings: :func:`~compliance.sweep.remedies.find_remedy`.
+1. The on-site settings: :func:`~compliance.sweep.remedies.smallest_change.find_remedy`.
 2. For a PID governor without one, the same settings plus its set-point rate limiter, from the
    closest settings of stage 1 and the limiter start a commissioning engineer would set
-   (``limiter_space``).
+   (``remedies.limiter_space``).
 3. Each catalogue option that applies, alone, at the best settings of stage 1 (one candidate
    each), ranked; the best-ranked option gets its own settings search; then the best two
    options of different groups together.
@@ -18,10 +18,10 @@ the remedy (a cheaper stage's pass is never passed over for hardware).
 
 from __future__ import annotations
 
-from compliance.sweep.limiter_space import limiter_stage_start
-from compliance.sweep.ranking import SETTINGS_COST, candidate_passes, failing_mandatory, rank_key
-from compliance.sweep.remedies import find_remedy
-from compliance.sweep.runner import run_candidates
+from compliance.sweep.remedies.limiter_space import limiter_stage_start
+from compliance.sweep.candidates.ranking import SETTINGS_COST, candidate_passes, failing_mandatory, rank_key
+from compliance.sweep.remedies.smallest_change import find_remedy
+from compliance.sweep.candidates.runner import run_candidates
 
 __all__ = ["staged_search"]
 
@@ -67,11 +67,11 @@ def staged_search(ctx, cfg, adjust, base, catalogue, *, verify, run_kw, iteratio
 
     Parameters
     ----------
-    ctx : compliance.sweep.evaluate.Context
+    ctx : compliance.sweep.candidates.evaluate.Context
         Its ``paths`` cover the settings, the limiter and every catalogue option's parameters.
     adjust, base : tuple of Adjustable, dict
         The settings space and the configuration's values.
-    catalogue : compliance.sweep.hardware.Catalogue or None
+    catalogue : compliance.sweep.sizing.hardware_catalogue.Catalogue or None
     verify : callable
         values dict -> results of a full campaign.
     limiter : tuple or None

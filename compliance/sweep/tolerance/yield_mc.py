@@ -1,7 +1,7 @@
 """Tolerance yield: Monte Carlo over the uncertain parameters of one candidate, seeded.
 
 Each manufactured unit is the candidate with its uncertain parameters drawn around their
-nominal values (``sampling.draw_units``, one ``default_rng(seed)`` in the parent). Each unit
+nominal values (``candidates.sampling.draw_units``, one ``default_rng(seed)`` in the parent). Each unit
 is judged by the full campaign. Reported: the fraction of units passing each requirement and
 all mandatory ones, with Wilson score intervals (Wilson 1927, the usual interval for a binomial
 proportion that stays inside [0, 1] near 0 or 1); Spearman rank correlations of each
@@ -16,9 +16,9 @@ import math
 
 import numpy as np
 
-from compliance.sweep.ranking import candidate_passes
-from compliance.sweep.runner import run_candidates, shortfall
-from compliance.sweep.sampling import draw_units
+from compliance.sweep.candidates.ranking import candidate_passes
+from compliance.sweep.candidates.runner import run_candidates, shortfall
+from compliance.sweep.candidates.sampling import draw_units
 
 __all__ = ["lower_bound", "nominal_values", "run_yield", "wilson"]
 

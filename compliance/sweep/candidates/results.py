@@ -3,7 +3,7 @@
 Table columns (Parquet and CSV): ``candidate``; one column per adjusted (or drawn) parameter
 path in SI; per requirement ``ID.value``, ``ID.margin``, ``ID.margin_pct``, ``ID.status``;
 ``status`` (pass / fail / incomplete / invalid / failed), ``failing`` (mandatory requirements
-not passing, ``sweep.ranking``), ``shortfall`` (worst mandatory
+not passing, ``sweep.candidates.ranking``), ``shortfall`` (worst mandatory
 margin short of passing, in fractions of its limit; 0 passes), ``total_shortfall`` (their
 sum), ``change`` (distance from the
 base settings in normalised units) and ``error``.
@@ -18,8 +18,8 @@ import numpy as np
 import pandas as pd
 
 from compliance.files.atomic import write_bytes_atomic, write_text_atomic
-from compliance.sweep.ranking import rank_key
-from compliance.sweep.runner import shortfall, total_shortfall
+from compliance.sweep.candidates.ranking import rank_key
+from compliance.sweep.candidates.runner import shortfall, total_shortfall
 
 __all__ = ["best_index", "change", "pareto_front", "table", "tightest", "write_table"]
 
@@ -89,7 +89,7 @@ def pareto_front(df: pd.DataFrame, a: str, b: str) -> list[int]:
 def best_index(df: pd.DataFrame) -> int | None:
     """A passing candidate with the smallest change, else the closest to passing.
 
-    Ranked as the remedies search ranks (``sweep.ranking``): fewest failing mandatory
+    Ranked as the remedies search ranks (``sweep.candidates.ranking``): fewest failing mandatory
     requirements, then the smallest sum of shortfalls, then the smallest change.
     """
     if df.empty:

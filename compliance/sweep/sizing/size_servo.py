@@ -109,7 +109,7 @@ def time_constant_target(reqset) -> float:
 def size_servo(duty, template, tau: float | None = None) -> tuple:
     """(sized configuration, sizing record) for ``duty`` on ``template`` (steady throttle rule).
 
-    The throttles are the steady first guess; :func:`compliance.sweep.sizing_tune.tune_throttles`
+    The throttles are the steady first guess; :func:`compliance.sweep.sizing.throttle_tuning.tune_throttles`
     refines them by simulation.
     """
     atm = template.params["air.atmospheric_pressure"]

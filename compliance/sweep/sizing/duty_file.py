@@ -16,7 +16,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from compliance.errors import InputError
 from compliance.model.config_fields import load_curve_field
-from compliance.sweep.data_file import read_validated
+from compliance.sweep.sizing.data_file import read_validated
 from compliance.units import parse_quantity
 
 __all__ = ["Duty", "load_duty"]
