@@ -255,7 +255,8 @@ def param_handle(path: str, where: str) -> ParamHandle:
         return _effect_handle(path, parts[0], parts[1], where)
     spec = BASE_BY_KEY.get(path)
     if spec is None:
-        raise InputError(f"{where}: '{path}' is not a known parameter path{did_you_mean(path, BASE_BY_KEY)} "
+        known = [*BASE_BY_KEY, *(f"{EFFECTS_PREFIX}{e.name}.{q.name}" for e in EFFECTS.values() for q in e.params)]
+        raise InputError(f"{where}: '{path}' is not a known parameter path{did_you_mean(path, known)} "
                          "(docs/physics.md lists the parameters; effect parameters are effects.NAME.PARAM)")
     if spec.unit == "number":
         raise InputError(f"{where}: '{path}' is a bare power-law coefficient; sweep a parameter with a unit")

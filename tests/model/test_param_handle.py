@@ -84,6 +84,7 @@ def test_prior_and_standard_error_follow_the_scale():
     ("effects.internal_leakge.conductance", "did you mean 'internal_leakage'"),
     ("internal_leakage.conductanse", "effect internal_leakage has no parameter 'conductanse'"),
     ("controller.kpp", "did you mean 'controller.kp'"),
+    ("internal_leakge.conductance", "did you mean 'effects.internal_leakage.conductance'"),
     ("valve.power_law_c1", "bare power-law coefficient"),
 ])
 def test_a_wrong_path_is_one_message_naming_where(path, words):
