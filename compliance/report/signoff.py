@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections import Counter
 
+from compliance.campaign.coverage import case_coverage, case_coverage_text
 from compliance.report.requirement_pages import limit_text, metric_text
 from compliance.units.formatting import fmt_margin_pct, fmt_si
 
@@ -170,15 +171,19 @@ def failures(results: dict) -> list[dict]:
 
 
 def not_evaluated(results: dict) -> dict:
-    """Test cases (requirement x procedure x operating point) not evaluated, counted by reason."""
-    total, reasons = 0, Counter()
+    """Judged test cases not evaluated, counted by reason, on the basis of the terminal and JSON summaries
+    (:func:`compliance.campaign.coverage.case_coverage`)."""
+    cov = case_coverage(results["requirements"])
+    reasons = Counter()
     for e in results["requirements"]:
+        if e.get("limit") is None:
+            continue
         for r in e["rows"]:
-            total += 1
             if r.get("status") == "not_evaluated":
                 reasons[(e["id"], str(r.get("reason") or "no value").split(":")[0].split(";")[0].strip())] += 1
     items = [{"requirement": rid, "reason": why, "count": n} for (rid, why), n in reasons.most_common()]
-    return {"cases": total, "count": sum(reasons.values()), "reasons": items,
+    return {"cases": cov["rows"], "count": cov["not_evaluated"], "evaluated": cov["evaluated"], "basis": cov["basis"],
+            "text": case_coverage_text(cov), "reasons": items,
             "requirements": (results["summary"].get("counts") or {}).get("not_evaluated", 0)}
 
 
