@@ -9,6 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 from xml.sax.saxutils import escape, quoteattr
 
+from compliance.campaign.basis import verdict_qualifier
 from compliance.campaign.coverage import CASES_BASIS, case_coverage_text
 from compliance.errors import InputError
 from compliance.files.atomic import write_text_atomic
@@ -166,7 +167,8 @@ def summary_lines(results: dict) -> list[str]:
         out.append("  assumptions that matter most: " + "; ".join(f"{a['parameter']} ({a['why']})" for a in top))
     for n in s.get("notes", []):
         out.append(f"  {n}")
-    out.append(f"VERDICT: {s['status'].upper()}"
+    qualifier = s.get("qualifier", verdict_qualifier(results))
+    out.append(f"VERDICT: {s['status'].upper()}" + (f" ({qualifier})" if qualifier else "")
                + (f" (mandatory failures: {', '.join(s['failed_mandatory'])})" if s.get("failed_mandatory") else ""))
     return out
 

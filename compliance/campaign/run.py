@@ -29,6 +29,7 @@ from compliance.errors import InputError
 from compliance.requirements.consistency import consistency_findings
 from compliance.requirements.tightening import check_tightening
 from compliance.requirements.requirement_set import RequirementSet
+from compliance.campaign.basis import verdict_qualifier
 from compliance.campaign.coverage import case_coverage, unjudged
 from compliance.campaign.uncertainty import local_bands, ranged_parameters
 from compliance.requirements.verdict import DISABLED, FAIL, NOT_EVALUATED, OPEN, PASS, UNCERTAIN, overall_status
@@ -188,7 +189,7 @@ def run_campaign(cfg, reqset: RequirementSet, *, workers: int | None = None, pro
             "marks": o.marks,
             "wall_time": o.wall_time,
         })
-    return {
+    results = {
         "schema": RESULTS_SCHEMA,
         "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         "command_line": command_line,
@@ -204,3 +205,5 @@ def run_campaign(cfg, reqset: RequirementSet, *, workers: int | None = None, pro
         "timing": {"wall": time.perf_counter() - t0, "runs": len(jobs), "workers": used,
                    "run_wall_sum": sum(o.wall_time for o in outcomes)},
     }
+    results["summary"]["qualifier"] = verdict_qualifier(results)
+    return results

@@ -155,6 +155,23 @@ def pdf_problems(path) -> list[str]:
     return out
 
 
+BODY_PAGES_MAX = 25  # the plant-A body (sign-off page to the signatures of section 7), issue 25
+
+
+def body_pages(path) -> dict:
+    """Pages of a compliance report PDF: ``{"body", "appendix", "total"}``.
+
+    The body ends before the page whose text has the heading "Appendix" on a line of its own
+    (a report without an appendix is all body).
+    """
+    import pdfplumber
+
+    with pdfplumber.open(str(path)) as pdf:
+        texts = [p.extract_text() or "" for p in pdf.pages]
+    body = next((i for i, t in enumerate(texts) if re.search(r"^\s*Appendix\s*$", t, re.M)), len(texts))
+    return {"body": body, "appendix": len(texts) - body, "total": len(texts)}
+
+
 def _overprints(chars: list) -> list[str]:
     """Pairs of characters on different text lines or far apart in one line that overlap."""
     grid: dict = {}
