@@ -51,7 +51,7 @@ def test_identity_and_a_document_number_remove_the_draft_mark(report, tmp_path):
     res = json.loads(FIXTURE.read_text(encoding="utf-8"))  # no [identity]: a draft, whatever the number
     render_report(res, tmp_path / "d.html", appendix="none", document={"number": "QA-GOV-0001"})
     draft = (tmp_path / "d.html").read_text(encoding="utf-8")
-    assert 'class="draft-svg"' in draft and "no [identity] table in the configuration" in draft
+    assert 'class="draft-svg"' in draft and "the site, the unit and the equipment are not identified" in draft
 
 
 def _svg(draw) -> str:
