@@ -49,6 +49,8 @@ def test_plant_a_body_is_at_most_25_pages_with_every_section(plant_a):
     body = pages[:n["body"]]
     for heading in SECTIONS:
         assert any(re.search(rf"^\s*{re.escape(heading)}\s*$", p, re.M) for p in body), heading
+    # no developer instruction in what the signer reads: no documentation path, TOML table or option
+    assert not re.search(r"docs/|\[identity\]|\s--[a-z]", "\n".join(body))
     # no page of the body ends on a heading with nothing under it (the footer line "Page n of m" excepted)
     for i, p in enumerate(body, 1):
         lines = [ln for ln in p.splitlines() if ln.strip() and not re.search(r"Page \d+ of \d+\s*$", ln)]
