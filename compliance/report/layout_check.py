@@ -191,3 +191,27 @@ def _overprints(chars: list) -> list[str]:
                 if _overlap(box(ci), box(cj)) > 0.35:
                     out.append(f"'{ci['text']}' at ({ci['x0']:.0f}, {ci['top']:.0f}) overprints '{cj['text']}'")
     return out[:20]
+
+
+def main(argv=None) -> int:
+    """``python -m compliance.report.layout_check REPORT.html|REPORT.pdf ...``: print the problems; exit 1 if any."""
+    import argparse
+    from pathlib import Path
+
+    ap = argparse.ArgumentParser(description="Clipped or overprinted text in rendered reports (HTML figures, PDF pages); "
+                                             "for a PDF also its body and appendix pages.")
+    ap.add_argument("reports", nargs="+", type=Path, metavar="REPORT", help="an .html or .pdf report")
+    n = 0
+    for path in ap.parse_args(argv).reports:
+        if path.suffix == ".pdf":
+            problems = pdf_problems(path)
+            print(f"{path}: " + ", ".join(f"{k} {v}" for k, v in body_pages(path).items()) + " pages")
+        else:
+            problems = html_problems(path.read_text(encoding="utf-8"))
+        n += len(problems)
+        print("\n".join(f"{path}: {p}" for p in problems) or f"{path}: clean")
+    return 1 if n else 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -80,6 +80,21 @@ def test_a_label_below_the_figure_is_found():
     assert any("'time [s]' outside the viewBox" in p for p in problems), problems
 
 
+def test_the_command_line_names_a_clipped_label_and_exits_1(tmp_path, capsys):
+    from compliance.report.layout_check import main as layout_main
+
+    def draw(fig, ax):
+        ax.set_xlabel("time [s]")
+        fig.subplots_adjust(bottom=0.02)
+
+    bad, good = tmp_path / "bad.html", tmp_path / "good.html"
+    bad.write_text(f"<html><body><figure>{_svg(draw)}</figure></body></html>", encoding="utf-8")
+    good.write_text("<html><body><p>no figure</p></body></html>", encoding="utf-8")
+    assert layout_main([str(good)]) == 0
+    assert layout_main([str(good), str(bad)]) == 1
+    assert "'time [s]' outside the viewBox" in capsys.readouterr().out
+
+
 def test_two_labels_drawn_over_each_other_are_found():
     def draw(fig, ax):
         ax.text(0.5, 0.5, "command [V]", transform=ax.transAxes)
