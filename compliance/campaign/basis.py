@@ -129,12 +129,13 @@ def verdict_qualifier(results: dict) -> str | None:
     parameters the selected model uses are assumed; both joined when both hold. One wording for the
     terminal summary, the results JSON (``summary.qualifier``) and page 1 of the report.
     """
-    if results["summary"].get("status") != "pass":
+    if (results.get("summary") or {}).get("status") != "pass":
         return None
     words = []
-    if any(e.get("limit_assumed") and e["status"] == PASS and e["severity"] == "mandatory" for e in results["requirements"]):
+    if any(e.get("limit_assumed") and e.get("status") == PASS and e.get("severity") == "mandatory"
+           for e in results.get("requirements") or []):
         words.append("against assumed targets")
-    plant = results["plant"]
+    plant = results.get("plant") or {}
     options = plant.get("options") or {}
     used = [p for p in plant.get("parameters") or [] if isinstance(p, dict) and used_by_model(str(p.get("key")), options)]
     if used and sum(1 for p in used if (p.get("source") or "assumed") == "assumed") > len(used) / 2:

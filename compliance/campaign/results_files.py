@@ -167,7 +167,7 @@ def summary_lines(results: dict) -> list[str]:
         out.append("  assumptions that matter most: " + "; ".join(f"{a['parameter']} ({a['why']})" for a in top))
     for n in s.get("notes", []):
         out.append(f"  {n}")
-    qualifier = s.get("qualifier", verdict_qualifier(results))
+    qualifier = s["qualifier"] if "qualifier" in s else verdict_qualifier(results)
     out.append(f"VERDICT: {s['status'].upper()}" + (f" ({qualifier})" if qualifier else "")
                + (f" (mandatory failures: {', '.join(s['failed_mandatory'])})" if s.get("failed_mandatory") else ""))
     return out

@@ -184,7 +184,8 @@ def qualified_verdict(results: dict) -> dict:
     class is ``warn`` and the qualifier is printed under the word.
     """
     status = results["summary"]["status"]
-    qualifier = results["summary"].get("qualifier", verdict_qualifier(results)) if status == "pass" else None
+    summary = results["summary"]
+    qualifier = (summary["qualifier"] if "qualifier" in summary else verdict_qualifier(results)) if status == "pass" else None
     if not qualifier:
         return {"status": status, "qualifier": None, "css": None, "why": None}
     b = basis(results)
