@@ -317,3 +317,35 @@ OPTION_DEFAULTS: dict[str, str] = {
     "controller.feedforward": "false",
 }
 SOURCES = ("paper", "assumed", "derived", "user")
+
+
+# parameters read only under one option value (assembly.py: the flow law, the friction law and the
+# controller type pick their own parameters; the others are not read at all)
+_ONLY_WHEN = (
+    (("valve.sonic_conductance", "valve.critical_pressure_ratio", "air.reference_density", "air.reference_temperature",
+      "flow_control."), "valve.flow_law", ("iso6358",)),
+    (("valve.effective_area",), "valve.flow_law", ("sanville",)),
+    (("valve.bobrow_coefficient",), "valve.flow_law", ("bobrow",)),
+    (("valve.power_law_",), "valve.flow_law", ("power_law",)),
+    (("friction.bristle_",), "friction.model", ("lugre",)),
+    (("friction.limit_velocity",), "friction.model", ("variable_viscous", "piecewise_stribeck")),
+    (("friction.static_force", "friction.coulomb_force", "friction.stribeck_velocity", "friction.viscous_coefficient"),
+     "friction.model", ("lugre", "variable_viscous")),
+    (("friction.breakaway_force", "friction.low_speed_coefficient", "friction.critical_velocity",
+      "friction.high_speed_coefficient"), "friction.model", ("piecewise_stribeck",)),
+    (("controller.closed_loop_", "controller.acceleration_observer", "controller.friction_observer",
+      "controller.velocity_filter"), "controller.type", ("state_feedback",)),
+    (("controller.kp", "controller.ki", "controller.kd", "controller.filter_cutoff", "controller.compensation_"),
+     "controller.type", ("pid",)),
+)
+
+
+def used_by_model(key: str, options: dict) -> bool:
+    """Whether the selected model (its flow law, friction law, controller) reads parameter ``key``.
+
+    ``options``: the configuration's option values by key (``valve.flow_law`` ...), as strings.
+    """
+    for prefixes, option, values in _ONLY_WHEN:
+        if any(key == p or (p.endswith(("_", ".")) and key.startswith(p)) for p in prefixes):
+            return str(options.get(option, "")) in values
+    return True
