@@ -2,7 +2,9 @@
 
 This is the one place where the physics functions are composed. ``plant_rhs`` is the single
 source of truth used by the simulator, the linearisation (trim + Jacobian) and the
-diagnosis (through the simulator). Its parameter vector comes from
+diagnosis (through the simulator). The effects' terms enter through the hooks of
+``compliance.effects.catalogue`` (each the chain of the declared terms, in declared order);
+effects that change the model's structure are composed here from their modules' kernels. Its parameter vector comes from
 ``compliance.model.plant_vector.parameter_vector``; the states of a servo at rest from
 ``compliance.model.rest_state``.
 """
@@ -72,12 +74,12 @@ def _path_flow(P, opening, throttle, p_up, p_down, t_up):
 @njit(cache=True, error_model="numpy", inline="always")
 def _body_friction(P, v, z, applied, fs, fc, rise, n):
     """Friction force on one body [N] and bristle rate; ``applied`` is the net non-friction force,
-    ``rise`` the pressure factor already applied to ``fs`` and ``fc``."""
+    ``rise`` the effects' friction-level factor already applied to ``fs`` and ``fc``."""
     if P[P_FRM] == 0.0:
         dz = lugre_bristle_rate(v, z, P[P_SIG0], fs, fc, P[P_VS])  # LuGre (Canudas de Wit 1995)
         return n * lugre_force(v, z, dz, P[P_SIG0], P[P_SIG1], P[P_BV]), dz, False
     if P[P_FRM] == 2.0:
-        fj = P[P_FJ] * rise  # pressure-dependent friction scales F_j like F_S and F_C
+        fj = P[P_FJ] * rise  # the friction-level effects scale F_j like F_S and F_C
         f = n * piecewise_stribeck_friction(v, applied / n, fj, P[P_KV1], P[P_VD], P[P_KV2], P[P_VLIM])  # seed 001 eq. (8)
         stuck = abs(v) < P[P_VLIM] and abs(applied) <= n * fj
         return f, 0.0, stuck
