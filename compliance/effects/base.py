@@ -95,8 +95,8 @@ class Effect:
         The benchmark flips the sign of the first parameter's draw half of the time.
     terms : dict
         Hook name (``catalogue.HOOKS``) -> the effect's compiled term for it. ``plant_rhs`` calls
-        each hook once, as the chain of the declared terms in declared order; a term returns its
-        inputs unchanged while its effect is off (one compiled branch).
+        each hook once, as the chain of the declared terms in declared order; the chain calls a
+        term only while its effect's flag is set (an effect that is off costs one compiled branch).
     """
 
     name: str

@@ -14,25 +14,9 @@ P_EL_K = 59
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def chamber_leaks(P, pa, pb, ta, tb, ts, patm, qin_a, hin_a, qout_a, qin_b, hin_b, qout_b):
-    """Hook ``chamber_leaks``: each chamber's leak to atmosphere (air drawn back in enters at the supply temperature).
-
-    Pressures [Pa abs], temperatures [K], flows [kg/s].
-    """
-    if P[P_EL_ON] != 0.0:
-        q_ea = laminar_leak(P[P_EL_K], pa, patm)  # to atmosphere (Hagen-Poiseuille, physics.leakage)
-        q_eb = laminar_leak(P[P_EL_K], pb, patm)
-        if q_ea >= 0.0:
-            qout_a += q_ea
-        else:
-            qin_a -= q_ea
-            hin_a -= q_ea * ts
-        if q_eb >= 0.0:
-            qout_b += q_eb
-        else:
-            qin_b -= q_eb
-            hin_b -= q_eb * ts
-    return qin_a, hin_a, qout_a, qin_b, hin_b, qout_b
+def vent_leak(P, p, patm, q):
+    """Hook ``vent_leak``: ``q`` plus the laminar leak from a chamber at ``p`` to atmosphere [kg/s] (pressures [Pa abs])."""
+    return q + laminar_leak(P[P_EL_K], p, patm)  # Hagen-Poiseuille through fittings and rod seals (physics.leakage)
 
 
 EFFECT = Effect(
@@ -47,5 +31,5 @@ EFFECT = Effect(
     explanation="both chambers leak to atmosphere through fittings or rod seals (laminar leak {v} per side)",
     fit_grid={"conductance": (3e-12, 1e-11, 3e-11, 1e-10, 3e-10, 1e-9)},
     draw={"conductance": (3e-11, 3e-10, True)},
-    terms={"chamber_leaks": chamber_leaks},
+    terms={"vent_leak": vent_leak},
 )

@@ -14,22 +14,9 @@ P_IL_K = 57
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def chamber_leaks(P, pa, pb, ta, tb, ts, patm, qin_a, hin_a, qout_a, qin_b, hin_b, qout_b):
-    """Hook ``chamber_leaks``: the seal leak A -> B added to each chamber's inflow, inflow*temperature, outflow.
-
-    Pressures [Pa abs], temperatures [K], flows [kg/s]; gas leaves a chamber at its own temperature.
-    """
-    if P[P_IL_ON] != 0.0:
-        q_il = laminar_leak(P[P_IL_K], pa, pb)  # A -> B across the piston seals (Hagen-Poiseuille, physics.leakage)
-        if q_il >= 0.0:
-            qout_a += q_il
-            qin_b += q_il
-            hin_b += q_il * ta
-        else:
-            qin_a -= q_il
-            hin_a -= q_il * tb
-            qout_b -= q_il
-    return qin_a, hin_a, qout_a, qin_b, hin_b, qout_b
+def seal_leak(P, pa, pb, q):
+    """Hook ``seal_leak``: ``q`` plus the laminar leak across the piston seals from A to B [kg/s] (pressures [Pa abs])."""
+    return q + laminar_leak(P[P_IL_K], pa, pb)  # Hagen-Poiseuille through the seal gap (physics.leakage)
 
 
 EFFECT = Effect(
@@ -44,5 +31,5 @@ EFFECT = Effect(
     explanation="air leaks across the piston seals from side A to side B (laminar leak {v})",
     fit_grid={"conductance": (3e-12, 1e-11, 3e-11, 1e-10, 3e-10, 1e-9)},
     draw={"conductance": (5e-11, 5e-10, True)},
-    terms={"chamber_leaks": chamber_leaks},
+    terms={"seal_leak": seal_leak},
 )

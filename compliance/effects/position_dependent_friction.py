@@ -38,9 +38,7 @@ def squeeze_factor(gradient, offset):
 @njit(cache=True, error_model="numpy", inline="always")
 def friction_level(P, position, mean_pressure, atmosphere, stroke, factor):
     """Hook ``friction_level``: ``factor`` times the squeeze factor at the piston ``position`` [m] (stroke [m])."""
-    if P[P_XF_ON] != 0.0:
-        return factor * squeeze_factor(P[P_XF_GRAD], position - 0.5 * stroke)  # about mid-stroke
-    return factor
+    return factor * squeeze_factor(P[P_XF_GRAD], position - 0.5 * stroke)  # about mid-stroke
 
 
 EFFECT = Effect(

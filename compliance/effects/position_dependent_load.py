@@ -15,9 +15,7 @@ P_PL_K = 72
 @njit(cache=True, error_model="numpy", inline="always")
 def load_force(P, position, stroke, force):
     """Hook ``load_force``: the closing force [N] plus the load stiffness about mid-stroke (positions [m])."""
-    if P[P_PL_ON] != 0.0:
-        return force + P[P_PL_K] * (position - 0.5 * stroke)  # load stiffness about mid-stroke
-    return force
+    return force + P[P_PL_K] * (position - 0.5 * stroke)  # load stiffness about mid-stroke
 
 
 EFFECT = Effect(

@@ -27,9 +27,7 @@ def pressure_friction_factor(coefficient, mean_chamber_pressure, atmosphere):
 @njit(cache=True, error_model="numpy", inline="always")
 def friction_level(P, position, mean_pressure, atmosphere, stroke, factor):
     """Hook ``friction_level``: ``factor`` times the pressure factor (pressures [Pa abs])."""
-    if P[P_PF_ON] != 0.0:
-        return factor * pressure_friction_factor(P[P_PF_COEF], mean_pressure, atmosphere)  # Belforte et al. 2003
-    return factor
+    return factor * pressure_friction_factor(P[P_PF_COEF], mean_pressure, atmosphere)  # Belforte et al. 2003
 
 
 EFFECT = Effect(

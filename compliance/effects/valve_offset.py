@@ -15,9 +15,7 @@ P_VO_OFF = 70
 @njit(cache=True, error_model="numpy", inline="always")
 def valve_command(P, u):
     """Hook ``valve_command``: the command the valve acts on [V], shifted by the null offset."""
-    if P[P_VO_ON] != 0.0:
-        return u + P[P_VO_OFF]  # valve null shift
-    return u
+    return u + P[P_VO_OFF]  # valve null shift
 
 
 EFFECT = Effect(

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from numba import njit
 
-from compliance.effects.catalogue import CHAMBER_LEAKS, FRICTION_LEVEL, LOAD_FORCE, VALVE_COMMAND
+from compliance.effects.catalogue import FRICTION_LEVEL, LOAD_FORCE, SEAL_LEAK, VALVE_COMMAND, VENT_LEAK
 from compliance.effects.heat_transfer import P_HT_HA, P_HT_ON, S_TA, S_TB, wall_heat_flow
 from compliance.effects.line_dynamics import P_LD_COND, P_LD_ON, P_LD_VOL, S_PLA, S_PLB, hose_node
 from compliance.effects.linkage_compliance import P_LK_C, P_LK_K, P_LK_ON, S_V2, S_X2, link_force
@@ -210,8 +210,30 @@ def plant_rhs(y, P, u_valve, load_xs, load_ys, dy, aux):
         hin_b += feeds_b * ts
     else:
         qout_b -= feeds_b
-    qin_a, hin_a, qout_a, qin_b, hin_b, qout_b = CHAMBER_LEAKS(P, pa, pb, ta, tb, ts, patm, qin_a, hin_a, qout_a, qin_b,
-                                                               hin_b, qout_b)  # the effects' leaks (internal, external)
+    # the effects' leaks; gas leaves a chamber at its own temperature, air drawn in from atmosphere enters at T_s
+    q_il = SEAL_LEAK(P, pa, pb, 0.0)  # A -> B across the piston seals
+    if q_il != 0.0:
+        if q_il >= 0.0:
+            qout_a += q_il
+            qin_b += q_il
+            hin_b += q_il * ta
+        else:
+            qin_a -= q_il
+            hin_a -= q_il * tb
+            qout_b -= q_il
+    q_ea = VENT_LEAK(P, pa, patm, 0.0)  # to atmosphere
+    q_eb = VENT_LEAK(P, pb, patm, 0.0)
+    if q_ea != 0.0 or q_eb != 0.0:
+        if q_ea >= 0.0:
+            qout_a += q_ea
+        else:
+            qin_a -= q_ea
+            hin_a -= q_ea * ts
+        if q_eb >= 0.0:
+            qout_b += q_eb
+        else:
+            qin_b -= q_eb
+            hin_b -= q_eb * ts
     tin_a = hin_a / qin_a if qin_a > 0.0 else ts
     tin_b = hin_b / qin_b if qin_b > 0.0 else ts
     qh_a = wall_heat_flow(P[P_HT_HA], ts, ta) if heat else 0.0  # Newton's law of cooling (heat_transfer)

@@ -11,12 +11,13 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
+from types import SimpleNamespace
 
 import pytest
 
 from compliance.effects import EFFECTS
 from compliance.effects.base import Effect
-from compliance.effects.catalogue import ALL_EFFECTS, EFFECT_MODULES, compose
+from compliance.effects.catalogue import ALL_EFFECTS, EFFECT_MODULES, HOOKS, MODULES, compose
 from compliance.model import vector_slots as vs
 
 
@@ -51,5 +52,13 @@ def test_every_effect_is_registered_once_under_its_module():
 def test_a_term_for_an_unknown_hook_is_refused():
     bad = Effect(name="x", meaning="m", short="xx", params=(), states=(), signature="s", signals=(), explanation="{v}",
                  fit_grid={}, draw={}, terms={"frictoin_level": lambda: None})
-    with pytest.raises(ValueError, match="unknown hooks"):
-        compose("friction_level", (*ALL_EFFECTS, bad))
+    with pytest.raises(ValueError, match="effect x: terms for unknown hooks \\['frictoin_level'\\]"):
+        compose("friction_level", (*MODULES, SimpleNamespace(EFFECT=bad, P_XX_ON=0)))
+
+
+def test_every_declared_term_is_chained_into_its_hook():
+    for name, module in EFFECT_MODULES.items():
+        assert set(module.EFFECT.terms) <= set(HOOKS), name
+    users = {hook: [e.name for e in ALL_EFFECTS if hook in e.terms] for hook in HOOKS}
+    assert users["friction_level"] == ["pressure_dependent_friction", "position_dependent_friction"]  # declared order
+    assert users["seal_leak"] == ["internal_leakage"] and users["vent_leak"] == ["external_leakage"]
