@@ -4,9 +4,9 @@ This is the one place where the physics functions are composed. ``plant_rhs`` is
 source of truth used by the simulator, the linearisation (trim + Jacobian) and the
 diagnosis (through the simulator). The effects' terms enter through the hooks of
 ``compliance.effects.catalogue`` (each the chain of the declared terms, in declared order);
-effects that change the model's structure are composed here from their modules' kernels. Its parameter vector comes from
-``compliance.model.plant_vector.parameter_vector``; the states of a servo at rest from
-``compliance.model.rest_state``.
+effects that change the model's structure are composed here from their modules' kernels.
+Its parameter vector comes from ``compliance.model.plant_vector.parameter_vector``; the
+states of a servo at rest from ``compliance.model.rest_state``.
 """
 
 from __future__ import annotations
