@@ -1,8 +1,10 @@
 """Declared optional physics: one declaration read by the simulator, linearisation, diagnosis and report.
 
 Each effect has a name, a one-line physical meaning, parameters with SI units, defaults and
-bounds, the states it adds, and the signature it leaves in recorded data. An effect is
-switched on in a configuration with an ``[effects.NAME]`` table.
+bounds, the states it adds, and the signature it leaves in recorded data. Each effect is one
+module, ``compliance.effects.<name>``: its declaration, its slot constants in the compiled core
+and its compiled terms; ``catalogue`` registers them in order. An effect is switched on in a
+configuration with an ``[effects.NAME]`` table.
 """
 
 from __future__ import annotations

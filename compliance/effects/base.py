@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from compliance.effects.param import Param
 
@@ -93,6 +93,10 @@ class Effect:
         Parameter -> (low, high, log) range the diagnosis benchmark draws concealed cases from.
     draw_signed : bool
         The benchmark flips the sign of the first parameter's draw half of the time.
+    terms : dict
+        Hook name (``catalogue.HOOKS``) -> the effect's compiled term for it. ``plant_rhs`` calls
+        each hook once, as the chain of the declared terms in declared order; the chain calls a
+        term only while its effect's flag is set (an effect that is off costs one compiled branch).
     """
 
     name: str
@@ -112,6 +116,7 @@ class Effect:
     output_delay: str | None = None
     plant_b: bool = True
     draw_signed: bool = False
+    terms: dict[str, Callable] = field(default_factory=dict)
 
     def param(self, name: str) -> Param:
         """Return the declared parameter ``name``."""

@@ -43,7 +43,7 @@ class GovernorModel:
     Tg_linear: float | None  # [s] the linear model at the same point
     Tg_source: str
     dead_time: float | None  # [s] mean dead time of the steps
-    steady_error: dict  # direction -> [m] dead-zone stall band (model.dead_zone_stall)
+    steady_error: dict  # direction -> [m] dead-zone stall band (model.pid_controller.stall_error)
     point: dict  # position [m], load, load_force [N]
     stroke_load: object  # load of the large moves: N, "curve" or None
     flow_control: bool | None

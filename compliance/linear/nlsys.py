@@ -26,8 +26,9 @@ from compliance.model.assembly import plant_rhs
 from compliance.model.config import PlantConfig
 from compliance.model.plant_vector import load_curve_arrays, parameter_vector
 from compliance.model.rest_state import initial_state
+from compliance.effects.linkage_compliance import S_V2, S_X2
 from compliance.model.vector_slots import (AUX_NAMES, EFFECT_SLOTS, N_AUX, N_STATES, P_FRM, P_UCEN, PARAM_NAMES,
-                                           S_PA, S_PB, S_V, S_V2, S_X, S_X2, S_Z1, S_Z2, STATE_NAMES)
+                                           S_PA, S_PB, S_V, S_X, S_Z1, S_Z2, STATE_NAMES)
 
 __all__ = ["INPUT", "OPENING_INPUT", "OUTPUTS", "STATE_UNITS", "active_states", "labelled", "operating_point",
            "to_nlsys", "to_statespace", "valve_command_for_opening"]

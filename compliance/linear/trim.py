@@ -23,8 +23,16 @@ import numpy as np
 from compliance.effects.catalogue import ALL_EFFECTS
 from compliance.model.config import PlantConfig
 from compliance.errors import InputError
-from compliance.model.vector_slots import *  # noqa: F403 - index constants
-from compliance.model.vector_slots import EFFECT_SLOTS, N_AUX, N_STATES, STATE_NAMES
+from compliance.effects.heat_transfer import S_TA, S_TB
+from compliance.effects.line_dynamics import S_PLA, S_PLB
+from compliance.effects.linkage_compliance import P_LK_K, P_LK_ON, S_V2, S_X2
+from compliance.effects.pressure_dependent_friction import P_PF_ON
+from compliance.effects.supply_droop import S_PSUP
+from compliance.effects.valve_dynamics import P_VD_ON, P_VD_WN, S_SP, S_SV
+from compliance.effects.valve_offset import P_VO_OFF, P_VO_ON
+from compliance.model.vector_slots import (EFFECT_SLOTS, N_AUX, N_STATES, P_AREA_CAP, P_AREA_ROD, P_ARR, P_BV, P_DZN, P_DZP,
+                                           P_FC, P_FRM, P_FS, P_GAMMA, P_KV2, P_PATM, P_PS, P_STROKE, P_TS, P_UCEN, P_USAT,
+                                           P_V0, P_VD_STAGE, P_VLIM, S_PA, S_PB, S_V, S_X, S_Z1, S_Z2, STATE_NAMES)
 from compliance.model.assembly import plant_rhs
 from compliance.model.plant_vector import load_curve_arrays, parameter_vector
 from compliance.model.rest_state import initial_state, load_force

@@ -2,25 +2,38 @@
 
 This is the one place where the physics functions are composed. ``plant_rhs`` is the single
 source of truth used by the simulator, the linearisation (trim + Jacobian) and the
-diagnosis (through the simulator). Its parameter vector comes from
-``compliance.model.plant_vector.parameter_vector``; the states of a servo at rest from
-``compliance.model.rest_state``.
+diagnosis (through the simulator). The effects' terms enter through the hooks of
+``compliance.effects.catalogue`` (each the chain of the declared terms, in declared order);
+effects that change the model's structure are composed here from their modules' kernels.
+Its parameter vector comes from ``compliance.model.plant_vector.parameter_vector``; the
+states of a servo at rest from ``compliance.model.rest_state``.
 """
 
 from __future__ import annotations
 
 from numba import njit
 
-from compliance.model.vector_slots import *  # noqa: F403 - index constants are the core's vocabulary
-from compliance.physics.chamber import chamber_pressure_rate, chamber_temperature_rate, wall_heat_flow
+from compliance.effects.catalogue import FRICTION_LEVEL, LOAD_FORCE, SEAL_LEAK, VALVE_COMMAND, VENT_LEAK
+from compliance.effects.heat_transfer import P_HT_HA, P_HT_ON, S_TA, S_TB, wall_heat_flow
+from compliance.effects.line_dynamics import P_LD_COND, P_LD_ON, P_LD_VOL, S_PLA, S_PLB, hose_node
+from compliance.effects.linkage_compliance import P_LK_C, P_LK_K, P_LK_ON, S_V2, S_X2, link_force
+from compliance.effects.supply_droop import P_SD_COND, P_SD_ON, P_SD_VOL, S_PSUP, reservoir_pressure_rate
+from compliance.effects.valve_dynamics import P_VD_ON, P_VD_WN, P_VD_Z, S_SP, S_SV, spool_acceleration
+from compliance.effects.valve_null_flow import P_NF_A0, P_NF_ON, P_NF_W, leaky_openings
+from compliance.model.vector_slots import (
+    A_FP, A_FRIC, A_LOAD, A_OPEN, A_QA, A_QB, A_QS, P_AREA_CAP, P_AREA_ROD, P_ARR, P_B, P_BOB, P_BV, P_C,
+    P_CSTOP, P_DZN, P_DZP, P_EFFA, P_FC, P_FC_CLOSE, P_FC_ON, P_FC_OPEN, P_FJ, P_FRM, P_FS, P_GAMMA, P_KSTOP,
+    P_KV1, P_KV2, P_LAW, P_LOAD, P_LOADMODE, P_MASS, P_NFR, P_PATM, P_POW1, P_POW2, P_POWE, P_PS, P_R,
+    P_RHO0, P_SIG0, P_SIG1, P_SLN, P_SLP, P_STROKE, P_T0, P_TS, P_UCEN, P_USAT, P_V0, P_VD, P_VD_STAGE,
+    P_VLIM, P_VS, S_PA, S_PB, S_V, S_X, S_Z1, S_Z2,
+)
+from compliance.physics.chamber import chamber_pressure_rate, chamber_temperature_rate
 from compliance.physics.friction import (
     lugre_bristle_rate,
     lugre_force,
     piecewise_stribeck_friction,
-    pressure_friction_factor,
     variable_viscous_friction,
 )
-from compliance.physics.leakage import laminar_leak, reservoir_pressure_rate
 from compliance.physics.mechanics import (
     end_stop_force,
     interp_curve,
@@ -34,7 +47,7 @@ from compliance.physics.valve_flow import (
     sanville_mass_flow,
     series_conductance,
 )
-from compliance.physics.valve_opening import land_leak_openings, openings_from_signed, signed_opening, valve_openings
+from compliance.physics.valve_opening import openings_from_signed, signed_opening, valve_openings
 
 STICK_TIME_CONSTANT = 1e-3  # s; variable-viscous model: how fast a stuck body's residual speed is removed
 
@@ -61,12 +74,12 @@ def _path_flow(P, opening, throttle, p_up, p_down, t_up):
 @njit(cache=True, error_model="numpy", inline="always")
 def _body_friction(P, v, z, applied, fs, fc, rise, n):
     """Friction force on one body [N] and bristle rate; ``applied`` is the net non-friction force,
-    ``rise`` the pressure factor already applied to ``fs`` and ``fc``."""
+    ``rise`` the effects' friction-level factor already applied to ``fs`` and ``fc``."""
     if P[P_FRM] == 0.0:
         dz = lugre_bristle_rate(v, z, P[P_SIG0], fs, fc, P[P_VS])  # LuGre (Canudas de Wit 1995)
         return n * lugre_force(v, z, dz, P[P_SIG0], P[P_SIG1], P[P_BV]), dz, False
     if P[P_FRM] == 2.0:
-        fj = P[P_FJ] * rise  # pressure-dependent friction scales F_j like F_S and F_C
+        fj = P[P_FJ] * rise  # the friction-level effects scale F_j like F_S and F_C
         f = n * piecewise_stribeck_friction(v, applied / n, fj, P[P_KV1], P[P_VD], P[P_KV2], P[P_VLIM])  # seed 001 eq. (8)
         stuck = abs(v) < P[P_VLIM] and abs(applied) <= n * fj
         return f, 0.0, stuck
@@ -77,11 +90,9 @@ def _body_friction(P, v, z, applied, fs, fc, rise, n):
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _gate_load(P, x, load_xs, load_ys):
-    """Closing force of the gate ring at position ``x`` [N]: constant or load curve, plus load stiffness."""
+    """Closing force of the gate ring at position ``x`` [N]: constant or load curve, plus the effects' load terms."""
     f = interp_curve(x, load_xs, load_ys) if P[P_LOADMODE] == 1.0 else P[P_LOAD]
-    if P[P_PL_ON] != 0.0:
-        f += P[P_PL_K] * (x - 0.5 * P[P_STROKE])  # load stiffness about mid-stroke
-    return f
+    return LOAD_FORCE(P, x, P[P_STROKE], f)  # the effects' load terms (position_dependent_load)
 
 
 @njit(cache=True, error_model="numpy")
@@ -90,8 +101,7 @@ def valve_lag_input(P, u_valve):
     ``valve.dynamics_stage = "opening"``, the signed relative opening it asks for [-]."""
     if P[P_VD_STAGE] != 1.0:
         return u_valve
-    off = P[P_VO_OFF] if P[P_VO_ON] != 0.0 else 0.0
-    return signed_opening(u_valve + off - P[P_UCEN], P[P_DZP], P[P_DZN], P[P_SLP], P[P_SLN], P[P_USAT])
+    return signed_opening(VALVE_COMMAND(P, u_valve) - P[P_UCEN], P[P_DZP], P[P_DZN], P[P_SLP], P[P_SLN], P[P_USAT])
 
 
 # One compiled function on purpose: split into six inline="always" kernels it was bit-identical but
@@ -145,25 +155,18 @@ def plant_rhs(y, P, u_valve, load_xs, load_ys, dy, aux):
     u = u_valve
     lag_opening = P[P_VD_ON] != 0.0 and P[P_VD_STAGE] == 1.0
     if P[P_VD_ON] != 0.0:
-        wn = P[P_VD_WN]
-        target = valve_lag_input(P, u_valve)
         dy[S_SP] = y[S_SV]
-        dy[S_SV] = wn * wn * (target - y[S_SP]) - 2.0 * P[P_VD_Z] * wn * y[S_SV]  # second-order spool (Merritt 1967)
+        dy[S_SV] = spool_acceleration(P[P_VD_WN], P[P_VD_Z], valve_lag_input(P, u_valve), y[S_SP], y[S_SV])
         u = y[S_SP]
     if lag_opening:
         a_pa, a_at, a_pb, a_bt = openings_from_signed(u)  # the lagged opening drives the ports directly
     else:
-        if P[P_VO_ON] != 0.0:
-            u = u + P[P_VO_OFF]  # valve null shift
+        u = VALVE_COMMAND(P, u)  # the effects' terms on the command the valve sees (valve_offset)
         a_pa, a_at, a_pb, a_bt = valve_openings(u - P[P_UCEN], P[P_DZP], P[P_DZN], P[P_SLP], P[P_SLN], P[P_USAT])
     if P[P_NF_ON] != 0.0:
-        # the lands leak near null (Merritt 1967 sec. 5.4), driven by the command the spool sees
-        u_null = (u if not lag_opening else u_valve + (P[P_VO_OFF] if P[P_VO_ON] != 0.0 else 0.0)) - P[P_UCEN]
-        l_pa, l_at, l_pb, l_bt = land_leak_openings(u_null, P[P_NF_A0], P[P_NF_W], P[P_DZP], P[P_DZN])
-        a_pa = min(a_pa + l_pa, 1.0)
-        a_at = min(a_at + l_at, 1.0)
-        a_pb = min(a_pb + l_pb, 1.0)
-        a_bt = min(a_bt + l_bt, 1.0)
+        # the lands leak near null, driven by the command the spool sees
+        u_null = (u if not lag_opening else VALVE_COMMAND(P, u_valve)) - P[P_UCEN]
+        a_pa, a_at, a_pb, a_bt = leaky_openings(P[P_NF_A0], P[P_NF_W], u_null, P[P_DZP], P[P_DZN], a_pa, a_at, a_pb, a_bt)
     # --- supply, port and chamber temperatures
     ps = y[S_PSUP] if P[P_SD_ON] != 0.0 else P[P_PS]
     port_a = y[S_PLA] if P[P_LD_ON] != 0.0 else pa
@@ -188,12 +191,10 @@ def plant_rhs(y, P, u_valve, load_xs, load_ys, dy, aux):
     hin_b = 0.0
     qout_b = 0.0
     if P[P_LD_ON] != 0.0:
-        # hose as a lumped volume (isothermal node at T_s) + ISO 6358 restriction to the chamber
-        cl = P[P_LD_COND]
-        q_la = iso6358_mass_flow(1.0, cl, port_a, pa, ts if port_a >= pa else ta, P[P_B], P[P_RHO0], P[P_T0])
-        q_lb = iso6358_mass_flow(1.0, cl, port_b, pb, ts if port_b >= pb else tb, P[P_B], P[P_RHO0], P[P_T0])
-        dy[S_PLA] = rg * ts / P[P_LD_VOL] * (qva - q_la)  # mass balance of the hose volume
-        dy[S_PLB] = rg * ts / P[P_LD_VOL] * (qvb - q_lb)
+        q_la, dp_la = hose_node(P[P_LD_COND], P[P_LD_VOL], port_a, pa, ts, ta, qva, P[P_B], P[P_RHO0], P[P_T0], rg)
+        q_lb, dp_lb = hose_node(P[P_LD_COND], P[P_LD_VOL], port_b, pb, ts, tb, qvb, P[P_B], P[P_RHO0], P[P_T0], rg)
+        dy[S_PLA] = dp_la
+        dy[S_PLB] = dp_lb
         feeds_a = q_la
         feeds_b = q_lb
     else:
@@ -209,8 +210,9 @@ def plant_rhs(y, P, u_valve, load_xs, load_ys, dy, aux):
         hin_b += feeds_b * ts
     else:
         qout_b -= feeds_b
-    if P[P_IL_ON] != 0.0:
-        q_il = laminar_leak(P[P_IL_K], pa, pb)  # A -> B across the piston seals
+    # the effects' leaks; gas leaves a chamber at its own temperature, air drawn in from atmosphere enters at T_s
+    q_il = SEAL_LEAK(P, pa, pb, 0.0)  # A -> B across the piston seals
+    if q_il != 0.0:
         if q_il >= 0.0:
             qout_a += q_il
             qin_b += q_il
@@ -219,9 +221,9 @@ def plant_rhs(y, P, u_valve, load_xs, load_ys, dy, aux):
             qin_a -= q_il
             hin_a -= q_il * tb
             qout_b -= q_il
-    if P[P_EL_ON] != 0.0:
-        q_ea = laminar_leak(P[P_EL_K], pa, patm)  # to atmosphere
-        q_eb = laminar_leak(P[P_EL_K], pb, patm)
+    q_ea = VENT_LEAK(P, pa, patm, 0.0)  # to atmosphere
+    q_eb = VENT_LEAK(P, pb, patm, 0.0)
+    if q_ea != 0.0 or q_eb != 0.0:
         if q_ea >= 0.0:
             qout_a += q_ea
         else:
@@ -234,7 +236,7 @@ def plant_rhs(y, P, u_valve, load_xs, load_ys, dy, aux):
             hin_b -= q_eb * ts
     tin_a = hin_a / qin_a if qin_a > 0.0 else ts
     tin_b = hin_b / qin_b if qin_b > 0.0 else ts
-    qh_a = wall_heat_flow(P[P_HT_HA], ts, ta) if heat else 0.0
+    qh_a = wall_heat_flow(P[P_HT_HA], ts, ta) if heat else 0.0  # Newton's law of cooling (heat_transfer)
     qh_b = wall_heat_flow(P[P_HT_HA], ts, tb) if heat else 0.0
     # seed 000 eqs. (4)-(5) decoded (energy equation; isentropic at T_s when heat transfer is off)
     dpa = chamber_pressure_rate(qin_a, qout_a, tin_a, ta, pa, va, dva, qh_a, gamma, rg)
@@ -247,7 +249,8 @@ def plant_rhs(y, P, u_valve, load_xs, load_ys, dy, aux):
     if P[P_SD_ON] != 0.0:
         dy[S_PSUP] = reservoir_pressure_rate(P[P_SD_COND], P[P_PS], ps, q_pa + q_pb, P[P_SD_VOL], rg, ts)
     # --- forces
-    rise = pressure_friction_factor(P[P_PF_COEF], 0.5 * (pa + pb), patm) if P[P_PF_ON] != 0.0 else 1.0
+    p_mean = 0.5 * (pa + pb)
+    rise = FRICTION_LEVEL(P, x, p_mean, patm, P[P_STROKE], 1.0)  # the effects' friction-level terms at 2A1's position
     fs = P[P_FS] * rise
     fc = P[P_FC] * rise
     f_load = _gate_load(P, x, load_xs, load_ys)
@@ -273,7 +276,7 @@ def plant_rhs(y, P, u_valve, load_xs, load_ys, dy, aux):
         # two cylinders (2A1 with the sensor, 2A2) joined by a spring-damper, each with half the moving
         # mass, its own piston force and friction and its half of the gate-ring load at its own position
         fp = f1 + f2
-        f_link = P[P_LK_K] * (x2 - x) + P[P_LK_C] * (v2 - v)
+        f_link = link_force(P[P_LK_K], P[P_LK_C], x, x2, v, v2)
         m1 = 0.5 * mass
         load1 = 0.5 * f_load
         load2 = 0.5 * _gate_load(P, x2, load_xs, load_ys)
@@ -281,7 +284,8 @@ def plant_rhs(y, P, u_valve, load_xs, load_ys, dy, aux):
         app1 = f1 + f_link - load1 + end_stop_force(x, v, P[P_STROKE], P[P_KSTOP], P[P_CSTOP])
         app2 = f2 - f_link - load2 + end_stop_force(x2, v2, P[P_STROKE], P[P_KSTOP], P[P_CSTOP])
         ff1, dz1, st1 = _body_friction(P, v, y[S_Z1], app1, fs, fc, rise, 1.0)
-        ff2, dz2, st2 = _body_friction(P, v2, y[S_Z2], app2, fs, fc, rise, 1.0)
+        rise2 = FRICTION_LEVEL(P, x2, p_mean, patm, P[P_STROKE], 1.0)  # at 2A2's own position
+        ff2, dz2, st2 = _body_friction(P, v2, y[S_Z2], app2, P[P_FS] * rise2, P[P_FC] * rise2, rise2, 1.0)
         dy[S_X] = v
         dy[S_V] = -v / STICK_TIME_CONSTANT if st1 else (app1 - ff1) / m1
         dy[S_X2] = v2
@@ -296,3 +300,16 @@ def plant_rhs(y, P, u_valve, load_xs, load_ys, dy, aux):
     aux[A_OPEN] = a_pa - a_pb
     aux[A_FP] = fp
     aux[A_QS] = q_pa + q_pb
+
+
+@njit(cache=True, error_model="numpy")
+def friction_level_at(P, x, pa, pb):
+    """Factor [-] of the effects' friction-level terms on the static and Coulomb friction of a body at ``x`` [m],
+    chamber pressures ``pa``, ``pb`` [Pa abs]: what ``plant_rhs`` applies (1.0 with no such effect on)."""
+    return FRICTION_LEVEL(P, x, 0.5 * (pa + pb), P[P_PATM], P[P_STROKE], 1.0)
+
+
+@njit(cache=True, error_model="numpy")
+def load_terms_at(P, x, force):
+    """Closing ``force`` [N] plus the effects' load terms at position ``x`` [m], as in ``plant_rhs``."""
+    return LOAD_FORCE(P, x, P[P_STROKE], force)

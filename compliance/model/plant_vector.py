@@ -12,29 +12,10 @@ import numpy as np
 
 from compliance.errors import InputError
 from compliance.model.config import PlantConfig
-from compliance.model.vector_slots import (
-    BASE_SLOTS,
-    EFFECT_SLOTS,
-    N_PARAMS,
-    P_AREA_CAP,
-    P_AREA_ROD,
-    P_ARR,
-    P_FC_ON,
-    P_FJ,
-    P_FRM,
-    P_KV1,
-    P_LAW,
-    P_LK_ON,
-    P_LOAD,
-    P_LOADMODE,
-    P_NFR,
-    P_RL_CLOSE,
-    P_RL_END_RATE,
-    P_RL_ON,
-    P_RL_OPEN,
-    P_VD,
-    P_VD_STAGE,
-)
+from compliance.effects.linkage_compliance import P_LK_ON
+from compliance.model.vector_slots import (BASE_SLOTS, EFFECT_SLOTS, N_PARAMS, P_AREA_CAP, P_AREA_ROD, P_ARR,
+                                           P_FC_ON, P_FJ, P_FRM, P_KV1, P_LAW, P_LOAD, P_LOADMODE, P_NFR, P_RL_CLOSE,
+                                           P_RL_END_RATE, P_RL_ON, P_RL_OPEN, P_VD, P_VD_STAGE)
 
 FLOW_LAWS = {"iso6358": 0, "sanville": 1, "bobrow": 2, "power_law": 3}
 FRICTION_MODELS = {"lugre": 0, "variable_viscous": 1, "piecewise_stribeck": 2}

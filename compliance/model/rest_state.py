@@ -11,21 +11,26 @@ import numpy as np
 
 from compliance.model.config import PlantConfig
 from compliance.model.plant_vector import load_curve_arrays
-from compliance.model.vector_slots import *  # noqa: F403 - index constants are the core's vocabulary
-from compliance.physics.friction import pressure_friction_factor, stribeck_magnitude
+from compliance.effects.heat_transfer import S_TA, S_TB
+from compliance.effects.line_dynamics import S_PLA, S_PLB
+from compliance.effects.linkage_compliance import P_LK_K, P_LK_ON, S_X2
+from compliance.effects.supply_droop import S_PSUP
+from compliance.model.assembly import friction_level_at, load_terms_at
+from compliance.model.vector_slots import (N_STATES, P_AREA_CAP, P_AREA_ROD, P_ARR, P_BV, P_CSTOP, P_FC, P_FRM, P_FS, P_KSTOP,
+                                           P_LOAD, P_LOADMODE, P_NFR, P_PATM, P_PS, P_SIG0, P_STROKE, P_TS, P_VS, S_PA, S_PB,
+                                           S_X, S_Z1, S_Z2)
+from compliance.physics.friction import stribeck_magnitude
 from compliance.physics.mechanics import end_stop_force, single_force
 
 
 def load_force(P: np.ndarray, x: float, lx: np.ndarray, ly: np.ndarray) -> float:
-    """Closing force on the gate at position ``x`` [N]: constant or load curve, plus load stiffness.
+    """Closing force on the gate at position ``x`` [N]: constant or load curve, plus the effects' load terms.
 
     The same law as ``plant_rhs`` (``_gate_load``; with linkage compliance each cylinder carries half
     of it, at its own position).
     """
     f = float(np.interp(x, lx, ly)) if P[P_LOADMODE] == 1.0 else float(P[P_LOAD])
-    if P[P_PL_ON]:
-        f += P[P_PL_K] * (x - 0.5 * P[P_STROKE])  # load stiffness about mid-stroke
-    return f
+    return float(load_terms_at(P, float(x), f))
 
 
 def pneumatic_forces(P: np.ndarray, pa: float, pb: float) -> tuple[float, float]:
@@ -72,17 +77,15 @@ def set_rest_internal_states(P: np.ndarray, y: np.ndarray, lx: np.ndarray, ly: n
         y[S_X2] = x2
     if not (P[P_FRM] == 0.0 and P[P_SIG0] > 0.0):
         return
-    rise = pressure_friction_factor(P[P_PF_COEF], 0.5 * (y[S_PA] + y[S_PB]), P[P_PATM]) if P[P_PF_ON] else 1.0
-    fs, fc = P[P_FS] * rise, P[P_FC] * rise
     f_load = load1 + 0.5 * load_force(P, x2, lx, ly) if linkage else load_force(P, x, lx, ly)
     net = f1 + f2 - f_load + end_stop_force(x, 0.0, P[P_STROKE], P[P_KSTOP], P[P_CSTOP])
     n = P[P_NFR] if not linkage else 2.0
-    g = stribeck_magnitude(v, fs, fc, P[P_VS])  # LuGre g(v), Canudas de Wit et al. 1995
     z = (net / n - P[P_BV] * v) / P[P_SIG0]
-    zmax = g / P[P_SIG0]
-    z = min(max(z, -zmax), zmax)
-    y[S_Z1] = z
-    y[S_Z2] = z
+    for slot, at in ((S_Z1, x), (S_Z2, x2)):  # each body's friction levels at its own position (plant_rhs)
+        rise = friction_level_at(P, float(at), float(y[S_PA]), float(y[S_PB]))
+        g = stribeck_magnitude(v, P[P_FS] * rise, P[P_FC] * rise, P[P_VS])  # LuGre g(v), Canudas de Wit et al. 1995
+        zmax = g / P[P_SIG0]
+        y[slot] = min(max(z, -zmax), zmax)
 
 
 def initial_state(cfg: PlantConfig, P: np.ndarray, x0: float, pressures: tuple[float, float] | None = None) -> np.ndarray:

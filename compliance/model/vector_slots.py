@@ -129,15 +129,13 @@ P_RL_LEAD = PI["rl_lead"]
 # base parameter key -> index: what parameter_vector copies straight from the configuration
 BASE_SLOTS = {p.name: PI[p.slot] for p in BASE_PARAMS if p.slot is not None}
 
-# effect name -> (flag index, {param name: index}) — the bridge from declarations to the core.
-# Each effect entry also gets its constant P_<SHORT>_ON / P_<SHORT>_<SLOT> (e.g. P_VO_ON, P_VO_OFF)
-# for the compiled code, named by the declaration.
-EFFECT_SLOTS: dict[str, tuple[int, dict[str, int]]] = {}
-for _e in ALL_EFFECTS:
-    EFFECT_SLOTS[_e.name] = (PI[f"{_e.short}_on"], {p.name: PI[f"{_e.short}_{p.slot}"] for p in _e.params})
-    globals()[f"P_{_e.short.upper()}_ON"] = PI[f"{_e.short}_on"]
-    for _p in _e.params:
-        globals()[f"P_{_e.short.upper()}_{_p.slot.upper()}"] = PI[f"{_e.short}_{_p.slot}"]
+# effect name -> (flag index, {param name: index}): the bridge from declarations to the core. The
+# compiled code reads an effect's entries through the constants its module writes out
+# (P_<SHORT>_ON, P_<SHORT>_<SLOT>, e.g. compliance.effects.valve_offset.P_VO_OFF);
+# tests/effects/test_effect_slots.py checks them against this layout.
+EFFECT_SLOTS: dict[str, tuple[int, dict[str, int]]] = {
+    e.name: (PI[f"{e.short}_on"], {p.name: PI[f"{e.short}_{p.slot}"] for p in e.params}) for e in ALL_EFFECTS
+}
 
 # ---- state vector ----------------------------------------------------------------------------
 # core states by index; effects declare theirs (name, constant suffix, fixed index)
@@ -154,9 +152,7 @@ if sorted(_STATE_SLOTS) != list(range(len(_STATE_SLOTS))):
 STATE_NAMES = tuple(_STATE_SLOTS[i][0] for i in range(len(_STATE_SLOTS)))
 N_STATES = len(STATE_NAMES)
 S_X, S_V, S_PA, S_PB, S_Z1, S_Z2 = 0, 1, 2, 3, 6, 7
-for _e in ALL_EFFECTS:
-    for _s in _e.states:
-        globals()[f"S_{_s.slot}"] = _s.index  # S_TA, S_SP, ...: named by the declaration
+# an effect's states: the constants S_<slot> its module writes out (e.g. compliance.effects.heat_transfer.S_TA)
 
 # ---- auxiliary outputs of the right-hand side ---------------------------------------------------
 AUX_NAMES = ("friction_force", "load_force", "flow_a", "flow_b", "opening", "pneumatic_force", "supply_flow")

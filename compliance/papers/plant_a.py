@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from compliance.model.config import PlantConfig
-from compliance.model.dead_zone_stall import stall_error
+from compliance.model.pid_controller import stall_error
 from compliance.papers.plant_a_fig8 import fig8, format_fig8
 from compliance.metrics import find_steps, speed_extremes, step_response, stroke_time
 from compliance.simulation.scenario import stroke_start_pressures

@@ -54,9 +54,3 @@ def chamber_temperature_rate(temperature, pressure, volume, dpressure_dt, dvolum
     """
     mass = pressure * volume / (r_gas * temperature)
     return temperature * (dpressure_dt / pressure + dvolume_dt / volume - q_net / mass)
-
-
-@njit(cache=True, error_model="numpy", inline="always")
-def wall_heat_flow(conductance, wall_temperature, gas_temperature):
-    """Convective heat flow from wall to gas, Q = hA*(T_w - T) [W] (Newton's law of cooling)."""
-    return conductance * (wall_temperature - gas_temperature)

@@ -80,18 +80,6 @@ def lugre_force(velocity, bristle, bristle_rate, stiffness, damping, viscous):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def pressure_friction_factor(coefficient, mean_chamber_pressure, atmosphere):
-    """Factor on the seal friction levels from the chamber pressure, 1 + k_p*(p_mean - p_atm) [-].
-
-    A lip seal's friction is the contact pressure times the contact area, and the pressure
-    behind the lip adds to the contact pressure, so both friction levels scale with it
-    (Belforte et al. 2003, "Pneumatic cylinder seal friction"); scaling F_C and F_S alike keeps
-    the Stribeck shape. ``coefficient`` is the relative rise per Pa of mean gauge pressure [1/Pa].
-    """
-    return 1.0 + coefficient * max(mean_chamber_pressure - atmosphere, 0.0)
-
-
-@njit(cache=True, error_model="numpy", inline="always")
 def piecewise_stribeck_friction(velocity, applied_force, breakaway_force, low_speed_coefficient, critical_velocity,
                                 high_speed_coefficient, limit_velocity):
     """Piecewise friction of seed 001 eq. (8) with a stick band [N].

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from compliance import metrics as M
-from compliance.model.dead_zone_stall import stall_error
+from compliance.model.pid_controller import stall_error
 from compliance.errors import InputError
 from compliance.procedures.scenarios import add_drive_samples, closed_loop_trace, full_command_stroke, start_position, stroke
 from compliance.procedures.outcomes import Sample, request_key

@@ -18,8 +18,9 @@ from compliance.model.plant_vector import load_curve_arrays, parameter_vector
 from compliance.model.rest_state import initial_state
 from compliance.model.config import PlantConfig
 from compliance.model.pid_controller import first_order_filter_gain, limiter_sample, pid_sample, saturate
-from compliance.model.vector_slots import (P_FILT, P_KD, P_KI, P_KP, P_RL_ON, P_SL_ON, P_SL_TD, P_TSAMP, P_UCEN, P_ULIM, P_VD_ON,
-                                           P_VD_TD, S_SP, S_V, S_X)
+from compliance.effects.sensor_lag import P_SL_ON, P_SL_TD
+from compliance.effects.valve_dynamics import P_VD_ON, P_VD_TD, S_SP
+from compliance.model.vector_slots import P_FILT, P_KD, P_KI, P_KP, P_RL_ON, P_TSAMP, P_UCEN, P_ULIM, S_V, S_X
 from compliance.simulation.rk4 import N_OUT, OUTPUT_COLUMNS, measured_position, non_physical, record_sample, rk4_step, rk4_workspace
 from compliance.simulation.rk4 import sensor_lag_advance, sensor_lag_coefficients, sensor_lag_start, zoh_average
 from compliance.simulation.scenario import Scenario, sample_profile

@@ -13,8 +13,11 @@ import numpy as np
 from numba import njit
 
 from compliance.model.assembly import plant_rhs
-from compliance.model.vector_slots import A_FRIC, A_LOAD, A_OPEN, A_QA, A_QB, N_AUX, N_STATES, P_HT_ON, P_PS, P_SD_ON, P_SL_TAU, P_SL_TD, P_TS
-from compliance.model.vector_slots import S_PA, S_PB, S_PSUP, S_TA, S_TB, S_V, S_X
+from compliance.effects.heat_transfer import P_HT_ON, S_TA, S_TB
+from compliance.effects.sensor_lag import P_SL_TAU, P_SL_TD
+from compliance.effects.supply_droop import P_SD_ON, S_PSUP
+from compliance.model.vector_slots import A_FRIC, A_LOAD, A_OPEN, A_QA, A_QB, N_AUX, N_STATES, P_PS, P_TS
+from compliance.model.vector_slots import S_PA, S_PB, S_V, S_X
 
 OUTPUT_COLUMNS = (
     "time", "position", "reference", "valve_command", "pressure_a", "pressure_b", "supply_pressure",

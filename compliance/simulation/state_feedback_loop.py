@@ -19,7 +19,8 @@ from compliance.effects import EFFECTS
 from compliance.model.config import PlantConfig
 from compliance.model.pid_controller import pid_sample, saturate
 from compliance.errors import InputError, SimulationError
-from compliance.model.vector_slots import N_STATES, P_UCEN, P_ULIM, P_VD_ON, S_PA, S_PB, S_SP, S_V, S_X
+from compliance.effects.valve_dynamics import P_VD_ON, S_SP
+from compliance.model.vector_slots import N_STATES, P_UCEN, P_ULIM, S_PA, S_PB, S_V, S_X
 from compliance.model.assembly import plant_rhs, valve_lag_input
 from compliance.model.plant_vector import load_curve_arrays, parameter_vector
 from compliance.model.rest_state import initial_state

@@ -15,7 +15,8 @@ import numpy as np
 import pytest
 
 from compliance.model.config import load_plant
-from compliance.model.vector_slots import A_FRIC, A_LOAD, N_AUX, N_STATES, S_V, S_X2
+from compliance.effects.linkage_compliance import S_X2
+from compliance.model.vector_slots import A_FRIC, A_LOAD, N_AUX, N_STATES, S_V
 from compliance.model.assembly import plant_rhs
 from compliance.model.plant_vector import load_curve_arrays, parameter_vector
 from compliance.model.rest_state import initial_state
@@ -180,7 +181,7 @@ def test_valve_dynamics_delay_the_pressure_response(cfg):
 def test_valve_dynamics_stage_spool_moves_in_the_dead_band_opening_does_not(cfg):
     """Spool stage: the filter follows the command even inside the dead band (the spool
     travels through its overlap); opening stage: it follows the opening, which is zero there."""
-    from compliance.model.vector_slots import S_SP, S_SV
+    from compliance.effects.valve_dynamics import S_SP, S_SV
     from compliance.model.assembly import valve_lag_input
 
     vd = {"valve_dynamics": {"natural_frequency": 50.0, "damping": 0.7, "delay": 0.0}}

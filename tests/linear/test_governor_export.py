@@ -41,7 +41,7 @@ def test_tg_is_measured_with_the_same_circuit_and_the_dead_time_subtracted(gov):
     assert gov.Tg == pytest.approx(sum(s["time_constant"] for s in gov.steps) / 2)
     # IEC 61362 window for the servo time constant; the nonlinear steps are slower than the linear model (friction)
     assert 0.15 < gov.Tg < 0.35 and gov.Tg > gov.Tg_linear
-    # dead-zone steady error: the stall band of model.dead_zone_stall, 0.86/0.90 mm for plant A
+    # dead-zone steady error: the stall band of model.pid_controller.stall_error, 0.86/0.90 mm for plant A
     assert gov.steady_error["opening"] == pytest.approx(0.86e-3, abs=0.01e-3)
 
 

@@ -253,7 +253,8 @@ def test_trim_with_a_compliant_linkage_shares_the_load_like_the_rest_state(cfg):
     the trim), the same deflection the simulator's rest state gives."""
     from compliance.model.plant_vector import parameter_vector
     from compliance.model.rest_state import initial_state
-    from compliance.model.vector_slots import S_X, S_X2
+    from compliance.effects.linkage_compliance import S_X2
+    from compliance.model.vector_slots import S_X
 
     k, load = 7e4, 3000.0
     lc = cfg.replace(effects={"linkage_compliance": {"stiffness": k, "damping": 500.0}})

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from compliance.model.config import load_plant
-from compliance.model.dead_zone_stall import stall_error
+from compliance.model.pid_controller import stall_error
 from compliance.papers.plant_a_fig8 import fig8
 
 CREEP = 0.42e-3  # F_S / sigma0 per cylinder: pre-sliding after the valve shuts (bound)

@@ -6,7 +6,7 @@ import pytest
 
 from compliance.cli import main
 from compliance.model.config import load_plant
-from compliance.model.dead_zone_stall import stall_error
+from compliance.model.pid_controller import stall_error
 from compliance.papers.plant_a import CASES, _step_metrics
 
 

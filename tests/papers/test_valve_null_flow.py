@@ -7,9 +7,10 @@ from scipy.optimize import brentq
 
 from compliance.metrics import find_steps, step_response
 from compliance.model.config import load_plant
-from compliance.model.dead_zone_stall import stall_error
+from compliance.model.pid_controller import stall_error
 from compliance.physics.valve_flow import iso6358_mass_flow
-from compliance.physics.valve_opening import land_leak_openings, valve_openings
+from compliance.effects.valve_null_flow import land_leak_openings
+from compliance.physics.valve_opening import valve_openings
 from compliance.simulation import Scenario, simulate
 from compliance.simulation.profiles import steps
 

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from compliance.model.config import load_plant
-from compliance.model.vector_slots import N_AUX, N_STATES, S_PA, S_PB, S_V, S_V2, S_X, S_X2, S_Z1
+from compliance.effects.linkage_compliance import S_V2, S_X2
+from compliance.model.vector_slots import N_AUX, N_STATES, S_PA, S_PB, S_V, S_X, S_Z1
 from compliance.model.assembly import plant_rhs
 from compliance.model.plant_vector import load_curve_arrays, parameter_vector
 from compliance.model.rest_state import initial_state

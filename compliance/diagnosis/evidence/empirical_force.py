@@ -28,8 +28,9 @@ from compliance.model.plant_vector import load_curve_arrays, parameter_vector
 
 from compliance.model.rest_state import load_force, pneumatic_forces
 from compliance.diagnosis.evidence.operating_point import load_at_start
-from compliance.model.vector_slots import P_BV, P_FC, P_FS, P_MASS, P_NFR, P_PATM, P_PF_COEF, P_PF_ON, P_VS
-from compliance.physics.friction import pressure_friction_factor, stribeck_map
+from compliance.effects.pressure_dependent_friction import P_PF_COEF, P_PF_ON, pressure_friction_factor
+from compliance.model.vector_slots import P_BV, P_FC, P_FS, P_MASS, P_NFR, P_PATM, P_VS
+from compliance.physics.friction import stribeck_map
 
 MOVING_SPEED = 2e-3  # m/s; below it static friction absorbs any force
 REVERSAL_TIME = 0.1  # s; decay time of the after-reversal feature (pre-sliding, breakaway transients)

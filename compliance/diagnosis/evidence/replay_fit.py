@@ -35,7 +35,11 @@ from scipy.signal import savgol_filter
 
 from compliance.model.config import PlantConfig
 from compliance.errors import InputError, SimulationError
-from compliance.model.vector_slots import P_KI, P_KP, P_SD_ON, P_SL_ON, P_SL_TAU, P_SL_TD, P_STROKE, S_PSUP, S_TA, S_TB, S_V, S_V2
+from compliance.effects.heat_transfer import S_TA, S_TB
+from compliance.effects.linkage_compliance import S_V2
+from compliance.effects.sensor_lag import P_SL_ON, P_SL_TAU, P_SL_TD
+from compliance.effects.supply_droop import P_SD_ON, S_PSUP
+from compliance.model.vector_slots import P_KI, P_KP, P_STROKE, S_V
 from compliance.model.plant_vector import load_curve_arrays, parameter_vector
 from compliance.model.rest_state import initial_state, set_rest_internal_states
 from compliance.diagnosis.evidence.operating_point import load_at_start

@@ -21,8 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from compliance.effects.param import Param
-
-MIN_FACTOR = 0.05  # s(x) is floored here: a friction level never changes sign along the bore
+from compliance.effects.position_dependent_friction import MIN_FACTOR  # s(x) floor, the servo effect's alike
 
 
 @dataclass(frozen=True)
