@@ -109,6 +109,7 @@ def run(args) -> int:
 
     from compliance.campaign.executor import parse_scheduler
     from compliance.sweep.run import run_sweep, run_yield_file
+    from compliance.requirements.verdict import Overall
     from compliance.sweep.spec import load_sweep
 
     for flag in ("jobs", "samples", "units"):
@@ -135,4 +136,4 @@ def run(args) -> int:
     s = run_sweep(spec, out, command_line=_command_line(args), **kw)
     text = summary_markdown(s)
     print(text.splitlines()[3] if args.quiet else text)
-    return 0 if s["best"] and s["best"]["verified_status"] == "pass" else 1
+    return 0 if s["best"] and s["best"]["verified_status"] == Overall.PASS else 1

@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections import Counter
 
 from compliance.report.requirement_pages import limit_text, metric_text
+from compliance.requirements.verdict import Status
 from compliance.units.formatting import fmt_margin_pct, fmt_si
 
 SOURCE_WORDS = {"paper": "from the paper", "assumed": "assumed", "derived": "derived", "user": "set by the user",
@@ -159,7 +160,7 @@ def failures(results: dict) -> list[dict]:
     remedies = _remedy_lines(results.get("remedies"))
     out = []
     for e in results["requirements"]:
-        if e["status"] != "fail":
+        if e["status"] != Status.FAIL:
             continue
         w = e.get("worst") or {}
         out.append({"id": e["id"], "title": e["title"], "severity": e["severity"], "value": metric_text(w.get("value"), e["metric"]),
@@ -175,11 +176,11 @@ def not_evaluated(results: dict) -> dict:
     for e in results["requirements"]:
         for r in e["rows"]:
             total += 1
-            if r.get("status") == "not_evaluated":
+            if r.get("status") == Status.NOT_EVALUATED:
                 reasons[(e["id"], str(r.get("reason") or "no value").split(":")[0].split(";")[0].strip())] += 1
     items = [{"requirement": rid, "reason": why, "count": n} for (rid, why), n in reasons.most_common()]
     return {"cases": total, "count": sum(reasons.values()), "reasons": items,
-            "requirements": (results["summary"].get("counts") or {}).get("not_evaluated", 0)}
+            "requirements": (results["summary"].get("counts") or {}).get(Status.NOT_EVALUATED, 0)}
 
 
 def assumptions(results: dict) -> list[str]:

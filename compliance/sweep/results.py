@@ -18,6 +18,7 @@ import numpy as np
 import pandas as pd
 
 from compliance.files.atomic import write_bytes_atomic, write_text_atomic
+from compliance.sweep.evaluate import judged
 from compliance.sweep.ranking import rank_key
 from compliance.sweep.runner import shortfall, total_shortfall
 
@@ -44,7 +45,7 @@ def table(candidates: list[dict], rows: list[dict], req_ids: list[str], adjust=(
             rec[f"{rid}.value"] = r.get("value")
             rec[f"{rid}.margin"] = r.get("margin")
             rec[f"{rid}.margin_pct"] = r.get("margin_pct")
-            rec[f"{rid}.status"] = r.get("status", row["status"] if row["status"] in ("invalid", "failed") else None)
+            rec[f"{rid}.status"] = r.get("status", None if judged(row) else row["status"])
         rec["status"] = row["status"]
         rec["shortfall"] = shortfall(row)
         rec["total_shortfall"] = total_shortfall(row)
