@@ -1,8 +1,10 @@
-"""Verdict names are a type: spelt once, in ``compliance.requirements.verdict``.
+"""Verdict names are a type: spelt once, in ``compliance.requirements.verdict`` (requirements) and
+``compliance.diagnosis.verdicts.verdict`` (diagnoses).
 
 A status (``pass``, ``fail``, ``not_evaluated``, ``uncertain``), a run's overall verdict
-(``incomplete``) or a basis (``modelled``, ``by_construction``) written as a bare string in code
-is a second spelling that a typo or a rename silently breaks. These read the source with ``ast``:
+(``incomplete``), a basis (``modelled``, ``by_construction``) or a diagnosis verdict
+(``missing_physics``, ``unexplained``, ...) written as a bare string in code is a second spelling
+that a typo or a rename silently breaks. These read the source with ``ast``:
 such a value may appear only as a *name* of something (a dict key, a subscript, the key of a
 ``.get``) or as a word in a table keyed by the enum members (a status's CSS class may be
 ``"pass"``), never as a value that is compared, returned, assigned or passed.
@@ -14,16 +16,17 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
+from compliance.diagnosis.verdicts.verdict import DiagnosisVerdict
 from compliance.requirements.verdict import Basis, Overall, Status
 
 PACKAGE = Path(__file__).resolve().parents[1] / "compliance"
-OWNER = PACKAGE / "requirements" / "verdict.py"
+OWNERS = {PACKAGE / "requirements" / "verdict.py", PACKAGE / "diagnosis" / "verdicts" / "verdict.py"}
 # words that are also plain words or other vocabularies: "open" (a limit nobody set, as text),
 # "disabled", "assumed" (also a parameter source: paper / assumed / derived / user)
 SHARED_WORDS = {"open", "disabled", "assumed"}
-VERDICT_WORDS = {m.value for enum in (Status, Overall, Basis) for m in enum} - SHARED_WORDS
+VERDICT_WORDS = {m.value for enum in (Status, Overall, Basis, DiagnosisVerdict) for m in enum} - SHARED_WORDS
 KEY_METHODS = {"get", "pop", "setdefault"}
-ENUMS = {"Status", "Overall", "Basis"}
+ENUMS = {"Status", "Overall", "Basis", "DiagnosisVerdict"}
 
 
 def _name_positions(tree: ast.AST) -> set[int]:
@@ -64,11 +67,11 @@ def test_the_checker_finds_a_bare_status_and_spares_names():
 def test_no_bare_verdict_words_in_the_package():
     found = []
     for path in sorted(PACKAGE.rglob("*.py")):
-        if path == OWNER:
+        if path in OWNERS:
             continue
         found += [f"{path.relative_to(PACKAGE.parent)}:{line}: {word!r}"
                   for line, word in bare_verdict_words(path.read_text())]
-    assert not found, "use Status / Overall / Basis from compliance.requirements.verdict:\n" + "\n".join(found)
+    assert not found, "use Status / Overall / Basis (compliance.requirements.verdict) or DiagnosisVerdict:\n" + "\n".join(found)
 
 
 def test_verdict_names_serialise_as_their_json_strings():
