@@ -206,8 +206,9 @@ def _decide(st: Stage) -> dict:
         kept = [r for r in search if r["kept"]]
         if kept:
             winner = kept[-1]["best"]
-            reason = f"{' and '.join(CandidateSet.parse(winner).effects)} together explain {100*scores[winner].explained:.0f} % of the excess residual"
-            verdict_name = DiagnosisVerdict.MISSING_PHYSICS if scores[winner].explained >= EXPLAINED_ENOUGH else DiagnosisVerdict.UNEXPLAINED
+            explained = scores[winner].explained
+            reason = f"{' and '.join(CandidateSet.parse(winner).effects)} together explain {100*explained:.0f} % of the excess residual"
+            verdict_name = DiagnosisVerdict.MISSING_PHYSICS if explained >= EXPLAINED_ENOUGH else DiagnosisVerdict.UNEXPLAINED
     verdict_name, winner, reason = instrument_verdict(scores, n, (verdict_name, winner, reason),
                                                       [k for k in st.fits if k.startswith(PREFIX)])
     after = _own_floors(st, winner, verdict_name)
