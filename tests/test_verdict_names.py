@@ -22,8 +22,9 @@ from compliance.requirements.verdict import Basis, Overall, Status
 PACKAGE = Path(__file__).resolve().parents[1] / "compliance"
 OWNERS = {PACKAGE / "requirements" / "verdict.py", PACKAGE / "diagnosis" / "verdicts" / "verdict.py"}
 # words that are also plain words or other vocabularies: "open" (a limit nobody set, as text),
-# "disabled", "assumed" (also a parameter source: paper / assumed / derived / user)
-SHARED_WORDS = {"open", "disabled", "assumed"}
+# "disabled", "assumed" (also a parameter source: paper / assumed / derived / user), "uncertain"
+# (also a sweep file's table of uncertain parameters)
+SHARED_WORDS = {"open", "disabled", "assumed", "uncertain"}
 VERDICT_WORDS = {m.value for enum in (Status, Overall, Basis, DiagnosisVerdict) for m in enum} - SHARED_WORDS
 KEY_METHODS = {"get", "pop", "setdefault"}
 ENUMS = {"Status", "Overall", "Basis", "DiagnosisVerdict"}

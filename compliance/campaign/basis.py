@@ -15,9 +15,10 @@ A mandatory requirement whose passing rows are all by construction does not coun
 
 from __future__ import annotations
 
-from compliance.requirements.verdict import Basis, Status
+from compliance.model.parameters import used_by_model
+from compliance.requirements.verdict import Basis, Overall, Status
 
-__all__ = ["requirement_basis", "row_basis"]
+__all__ = ["limit_assumed", "requirement_basis", "row_basis", "verdict_qualifier"]
 
 # metric -> the throttle whose conductance sets it (meter-out flow-control valves 2V2/2V3, seed 000)
 _THROTTLE = {"opening_time": "flow_control.opening_conductance", "closing_time": "flow_control.closing_conductance"}
@@ -87,6 +88,9 @@ def row_basis(cfg, reqset, req, row) -> tuple[Basis, str]:
             return Basis.BY_CONSTRUCTION, (
                 "no leakage or valve offset is modelled (internal_leakage, external_leakage, valve_offset off): nothing "
                 "moves a held position once stiction holds it, so drift and hunting are zero by construction")
+    if limit_assumed(req):
+        return "assumed", (f"the limit is an assumed design target ({req.clause}), not a figure of a standard or of the "
+                           "plant owner: the verdict holds against that target only")
     if op.load == "curve" and cfg.sources.get("load.curve") == "assumed":
         return Basis.ASSUMED, "the load at this point comes from the plant's assumed load curve (load.curve, source assumed)"
     return Basis.MODELLED, "simulated with the plant model at this operating point"
@@ -107,3 +111,31 @@ def requirement_basis(rows: list[dict]) -> Basis:
     if Basis.MODELLED in bases:
         return Basis.MODELLED
     return Basis.ASSUMED if Basis.ASSUMED in bases else Basis.BY_CONSTRUCTION
+
+
+def limit_assumed(req) -> bool:
+    """Whether the requirement file says the limit is an assumed target (its clause or standard begins with
+    "assumed"), not a figure of a standard or of the plant owner."""
+    return any(str(t or "").strip().lower().startswith("assumed") for t in (req.clause, req.standard))
+
+
+def verdict_qualifier(results: dict) -> str | None:
+    """What an overall PASS rests on when it is not the plant's evidence against a real limit, else None.
+
+    ``"against assumed targets"`` when a passing mandatory requirement's limit is assumed (verdict
+    basis ``assumed`` for that reason), ``"on a mostly assumed model"`` when more than half of the
+    parameters the selected model uses are assumed; both joined when both hold. One wording for the
+    terminal summary, the results JSON (``summary.qualifier``) and page 1 of the report.
+    """
+    if (results.get("summary") or {}).get("status") != Overall.PASS:
+        return None
+    words = []
+    if any(e.get("limit_assumed") and e.get("status") == Status.PASS and e.get("severity") == "mandatory"
+           for e in results.get("requirements") or []):
+        words.append("against assumed targets")
+    plant = results.get("plant") or {}
+    options = plant.get("options") or {}
+    used = [p for p in plant.get("parameters") or [] if isinstance(p, dict) and used_by_model(str(p.get("key")), options)]
+    if used and sum(1 for p in used if (p.get("source") or "assumed") == "assumed") > len(used) / 2:
+        words.append("on a mostly assumed model")
+    return ", ".join(words) or None

@@ -10,8 +10,39 @@ is eligible (each sample's own reason). docs/results-schema.md, ``coverage``.
 from __future__ import annotations
 
 from compliance.procedures.outcomes import request_key
+from compliance.requirements.verdict import Status
 
-__all__ = ["unjudged"]
+__all__ = ["CASES_BASIS", "case_coverage", "case_coverage_text", "unjudged"]
+
+# the one basis of every count of test cases (terminal summary, results JSON, report page 1)
+CASES_BASIS = ("a judged test case is one requirement \u00d7 procedure \u00d7 operating point of a requirement with a limit; "
+               "open requirements (no limit) are not counted")
+
+
+def case_coverage(entries: list[dict]) -> dict:
+    """Judged test cases evaluated and not evaluated, on the one basis :data:`CASES_BASIS`.
+
+    Parameters
+    ----------
+    entries : list of dict
+        Requirement entries of the results (each with ``limit`` and ``rows``).
+
+    Returns
+    -------
+    dict
+        ``{"rows", "evaluated", "not_evaluated", "basis"}``: a case is evaluated when its verdict
+        row is PASS, FAIL or UNCERTAIN (a value was judged against the limit).
+    """
+    rows = [r for e in entries if e.get("limit") is not None for r in e["rows"]]
+    evaluated = sum(1 for r in rows if r.get("status") in (Status.PASS, Status.FAIL, Status.UNCERTAIN))
+    return {"rows": len(rows), "evaluated": evaluated, "not_evaluated": len(rows) - evaluated, "basis": CASES_BASIS}
+
+
+def case_coverage_text(cov: dict) -> str:
+    """``"87 of 111 judged test cases evaluated, 24 not evaluated"`` from :func:`case_coverage`."""
+    n = cov["rows"]
+    ne = cov.get("not_evaluated", n - cov["evaluated"])
+    return f"{cov['evaluated']} of {n} judged test cases evaluated, {ne} not evaluated"
 
 
 def _judged_pairs(entries) -> set[tuple[str, str]]:

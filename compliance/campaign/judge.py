@@ -8,7 +8,7 @@ combines its rows. Values are also formatted in each metric's display unit for t
 
 from __future__ import annotations
 
-from compliance.campaign.basis import requirement_basis, row_basis
+from compliance.campaign.basis import limit_assumed, requirement_basis, row_basis
 from compliance.campaign.plan import Job
 from compliance.units.formatting import fmt_margin_pct, fmt_value
 from compliance.requirements.tightening import check_tightening
@@ -208,6 +208,7 @@ def judge(cfg, reqset: RequirementSet, jobs: list[Job], outcomes) -> tuple[list[
             "reading": req.reading,
             "alternative": req.alternative,
             "own_choice": req.own_choice,
+            "limit_assumed": limit_assumed(req),
             "note": req.note,
             "loosened": loosen,
         })

@@ -9,6 +9,8 @@ from __future__ import annotations
 from pathlib import Path
 from xml.sax.saxutils import escape, quoteattr
 
+from compliance.campaign.basis import verdict_qualifier
+from compliance.campaign.coverage import CASES_BASIS, case_coverage_text
 from compliance.errors import InputError
 from compliance.files.atomic import write_text_atomic
 from compliance.files.jsonable import json_text, read_json
@@ -142,7 +144,9 @@ def summary_lines(results: dict) -> list[str]:
         f"{c['pass']} pass, {c.get('pass_by_construction', 0)} pass by construction (not evidence), "
         f"{c.get('fail_mandatory', c['fail'])} fail (mandatory), {c.get('fail_advisory', 0)} fail (advisory), "
         f"{c.get('uncertain', 0)} uncertain, {c['not_evaluated']} not evaluated, {c['open']} open (no limit set), "
-        f"{c['disabled']} disabled" + (f"; {cov['evaluated']}/{cov['rows']} cases evaluated" if cov else ""))
+        f"{c['disabled']} disabled" + (f"; {case_coverage_text(cov)}" if cov else ""))
+    if cov:
+        out.append(f"  ({cov.get('basis') or CASES_BASIS})")
     for e in results["requirements"]:
         if e["status"] == Status.NOT_EVALUATED:
             reasons = sorted({r["reason"] for r in e["rows"] if r.get("reason")})
@@ -164,7 +168,8 @@ def summary_lines(results: dict) -> list[str]:
         out.append("  assumptions that matter most: " + "; ".join(f"{a['parameter']} ({a['why']})" for a in top))
     for n in s.get("notes", []):
         out.append(f"  {n}")
-    out.append(f"VERDICT: {s['status'].upper()}"
+    qualifier = s["qualifier"] if "qualifier" in s else verdict_qualifier(results)
+    out.append(f"VERDICT: {s['status'].upper()}" + (f" ({qualifier})" if qualifier else "")
                + (f" (mandatory failures: {', '.join(s['failed_mandatory'])})" if s.get("failed_mandatory") else ""))
     return out
 

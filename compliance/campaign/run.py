@@ -29,7 +29,8 @@ from compliance.errors import InputError
 from compliance.requirements.consistency import consistency_findings
 from compliance.requirements.tightening import check_tightening
 from compliance.requirements.requirement_set import RequirementSet
-from compliance.campaign.coverage import unjudged
+from compliance.campaign.basis import verdict_qualifier
+from compliance.campaign.coverage import case_coverage, unjudged
 from compliance.campaign.uncertainty import local_bands, ranged_parameters
 from compliance.requirements.verdict import Basis, Status, overall_status
 
@@ -84,16 +85,10 @@ def summary_section(entries: list[dict], notes: list[str], uncertainty: dict | N
         "open": [e["id"] for e in entries if e["status"] == Status.OPEN],
         "passed_by_construction": [e["id"] for e in entries if _by_construction(e)],
         "uncertain": [e["id"] for e in entries if e["status"] == Status.UNCERTAIN],
-        "coverage": coverage_summary(entries),
+        "coverage": case_coverage(entries),
         "top_assumptions": (uncertainty or {}).get("top_assumptions") or [],
         "notes": notes,
     }
-
-
-def coverage_summary(entries: list[dict]) -> dict:
-    """Verdict rows evaluated out of all rows, over the requirements that have a limit."""
-    rows = [r for e in entries if e.get("limit") is not None for r in e["rows"]]
-    return {"rows": len(rows), "evaluated": sum(1 for r in rows if r.get("status") in (Status.PASS, Status.FAIL, Status.UNCERTAIN))}
 
 
 def plant_section(cfg) -> dict:
@@ -194,7 +189,7 @@ def run_campaign(cfg, reqset: RequirementSet, *, workers: int | None = None, pro
             "marks": o.marks,
             "wall_time": o.wall_time,
         })
-    return {
+    results = {
         "schema": RESULTS_SCHEMA,
         "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         "command_line": command_line,
@@ -210,3 +205,5 @@ def run_campaign(cfg, reqset: RequirementSet, *, workers: int | None = None, pro
         "timing": {"wall": time.perf_counter() - t0, "runs": len(jobs), "workers": used,
                    "run_wall_sum": sum(o.wall_time for o in outcomes)},
     }
+    results["summary"]["qualifier"] = verdict_qualifier(results)
+    return results

@@ -100,12 +100,14 @@ def finish_results(results: dict, args, name: str = "check") -> dict:
 
 def monte_carlo(cfg, reqset, results: dict, args) -> None:
     """Replace the verdicts' bands by a Monte Carlo of ``args.uncertainty`` plants and re-summarise."""
+    from compliance.campaign.basis import verdict_qualifier
     from compliance.campaign.run import summary_section
     from compliance.sweep.tolerance.uncertainty_mc import monte_carlo_bands
 
     results["uncertainty"] = monte_carlo_bands(cfg, reqset, results, args.uncertainty, workers=args.jobs,
                                                progress=not args.quiet)
     results["summary"] = summary_section(results["requirements"], results["summary"]["notes"], results["uncertainty"])
+    results["summary"]["qualifier"] = verdict_qualifier(results)
 
 
 def check_uncertainty_option(args, cfg=None) -> None:

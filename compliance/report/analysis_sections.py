@@ -104,6 +104,17 @@ def _map_minimum(omap: dict | None, name: str):
     return best
 
 
+def _crosscheck_summary(rows: list[dict]) -> str:
+    """One sentence on the linear vs nonlinear cross-check (the table itself goes to the appendix)."""
+    done = [r for r in rows if "skipped" not in r]
+    ratios = [r["ratio"] for r in done if r.get("ratio") is not None]
+    stalled = sum(1 for r in done if r.get("tau_linear") is not None and r.get("tau_nonlinear") is None)
+    return (f"{len(done)} small steps were simulated with the nonlinear model at the critical points" + (
+        f": where the servo completes the step its time constant is {fmt_num(min(ratios), 3)} to {fmt_num(max(ratios), 3)}"
+        " times the linear one (friction and the valve dead zone, which the linear model leaves out)" if ratios else "")
+        + (f"; {stalled} steps stall inside the valve dead zone and reach no 63.2 % point" if stalled else "") + ".")
+
+
 def linear_section(linear: dict | None, start: int, results: dict | None = None) -> tuple[dict | None, list[dict]]:
     """Context of the linear-analysis section and its figure specs (ids from ``start``)."""
     if not linear:
@@ -157,6 +168,7 @@ def linear_section(linear: dict | None, start: int, results: dict | None = None)
                       "ratio": fmt_num(r.get("ratio"), 3), "steady_error": _mm(r.get("steady_error"), 2),
                       "why": r.get("why") or "agrees within 20 %"})
     gov = None
+    summary = _crosscheck_summary(linear.get("crosscheck") or [])
     g = linear.get("governor")
     if g:
         units = g.get("units") or {}
@@ -175,7 +187,7 @@ def linear_section(linear: dict | None, start: int, results: dict | None = None)
         gov = {"model": g.get("model", "HYGOV"), "rows": rows,
                "basis": [intro] + governor_basis(g.get("basis") or {}, (results or {}).get("plant", {}).get("load_curve"))}
     notes = list((omap or {}).get("notes") or [])
-    ctx = {"maps": maps, "points": points, "bode": bode, "poles": poles, "crosscheck": cross, "governor": gov,
+    ctx = {"maps": maps, "points": points, "bode": bode, "poles": poles, "crosscheck": cross, "crosscheck_summary": summary, "governor": gov,
            "notes": notes, "window": (omap or {}).get("window"), "criterion": criterion}
     return ctx, specs
 

@@ -155,6 +155,23 @@ def pdf_problems(path) -> list[str]:
     return out
 
 
+BODY_PAGES_MAX = 25  # the plant-A body (sign-off page to the signatures of section 7), issue 25
+
+
+def body_pages(path) -> dict:
+    """Pages of a compliance report PDF: ``{"body", "appendix", "total"}``.
+
+    The body ends before the page whose text has the heading "Appendix" on a line of its own
+    (a report without an appendix is all body).
+    """
+    import pdfplumber
+
+    with pdfplumber.open(str(path)) as pdf:
+        texts = [p.extract_text() or "" for p in pdf.pages]
+    body = next((i for i, t in enumerate(texts) if re.search(r"^\s*Appendix\s*$", t, re.M)), len(texts))
+    return {"body": body, "appendix": len(texts) - body, "total": len(texts)}
+
+
 def _overprints(chars: list) -> list[str]:
     """Pairs of characters on different text lines or far apart in one line that overlap."""
     grid: dict = {}
@@ -174,3 +191,27 @@ def _overprints(chars: list) -> list[str]:
                 if _overlap(box(ci), box(cj)) > 0.35:
                     out.append(f"'{ci['text']}' at ({ci['x0']:.0f}, {ci['top']:.0f}) overprints '{cj['text']}'")
     return out[:20]
+
+
+def main(argv=None) -> int:
+    """``python -m compliance.report.layout_check REPORT.html|REPORT.pdf ...``: print the problems; exit 1 if any."""
+    import argparse
+    from pathlib import Path
+
+    ap = argparse.ArgumentParser(description="Clipped or overprinted text in rendered reports (HTML figures, PDF pages); "
+                                             "for a PDF also its body and appendix pages.")
+    ap.add_argument("reports", nargs="+", type=Path, metavar="REPORT", help="an .html or .pdf report")
+    n = 0
+    for path in ap.parse_args(argv).reports:
+        if path.suffix == ".pdf":
+            problems = pdf_problems(path)
+            print(f"{path}: " + ", ".join(f"{k} {v}" for k, v in body_pages(path).items()) + " pages")
+        else:
+            problems = html_problems(path.read_text(encoding="utf-8"))
+        n += len(problems)
+        print("\n".join(f"{path}: {p}" for p in problems) or f"{path}: clean")
+    return 1 if n else 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

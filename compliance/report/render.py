@@ -33,7 +33,7 @@ from compliance.report import content as C
 from compliance.report import signoff as S
 from compliance.report.analysis_sections import linear_section, validation_section
 from compliance.report.requirement_pages import requirement_pages
-from compliance.units.formatting import fmt_date, fmt_num, fmt_si, status_word, unit_text
+from compliance.units.formatting import fmt_date, fmt_margin_pct, fmt_num, fmt_si, status_word, unit_text
 
 TEMPLATES = resources.files("compliance.report") / "templates"
 VALIDATION_SCHEMA = "govcheck.validation/1"
@@ -126,7 +126,8 @@ def _environment() -> jinja2.Environment:
         lstrip_blocks=True,
     )
     env.filters.update(status_class=C.status_class, status_word=status_word, num=fmt_num, unit=unit_text,
-                       setting=C.setting_text, words=C.reader_text, si=lambda v, u: fmt_si(v, u or ""))
+                       setting=C.setting_text, words=C.reader_text, si=lambda v, u: fmt_si(v, u or ""),
+                       margin=lambda v: fmt_margin_pct(v) or "\u2013")
     return env
 
 
@@ -239,6 +240,7 @@ def build_report(results: dict, workers: int | None = None, appendix: str = "sum
         "rs": rs,
         "summary": summary,
         "verdict": summary["status"],
+        "qualified": S.qualified_verdict(results),
         "created": fmt_date(results.get("created")),
         "rows": C.summary_rows(results),
         "basis": S.basis(results),

@@ -11,41 +11,15 @@ from __future__ import annotations
 
 from collections import Counter
 
+from compliance.campaign.coverage import case_coverage, case_coverage_text
+from compliance.campaign.basis import verdict_qualifier
+from compliance.model.parameters import used_by_model
 from compliance.report.requirement_pages import limit_text, metric_text
-from compliance.requirements.verdict import Status
+from compliance.requirements.verdict import Overall, Status
 from compliance.units.formatting import fmt_margin_pct, fmt_si
 
 SOURCE_WORDS = {"paper": "from the paper", "assumed": "assumed", "derived": "derived", "user": "set by the user",
                 "fitted": "fitted to a recording"}
-
-
-# parameters read only under one option value (model/assembly.py: the flow law, the friction law and the
-# controller type pick their own parameters; the others are not read at all)
-_ONLY_WHEN = (
-    (("valve.sonic_conductance", "valve.critical_pressure_ratio", "air.reference_density", "air.reference_temperature",
-      "flow_control."), "valve.flow_law", ("iso6358",)),
-    (("valve.effective_area",), "valve.flow_law", ("sanville",)),
-    (("valve.bobrow_coefficient",), "valve.flow_law", ("bobrow",)),
-    (("valve.power_law_",), "valve.flow_law", ("power_law",)),
-    (("friction.bristle_",), "friction.model", ("lugre",)),
-    (("friction.limit_velocity",), "friction.model", ("variable_viscous", "piecewise_stribeck")),
-    (("friction.static_force", "friction.coulomb_force", "friction.stribeck_velocity", "friction.viscous_coefficient"),
-     "friction.model", ("lugre", "variable_viscous")),
-    (("friction.breakaway_force", "friction.low_speed_coefficient", "friction.critical_velocity",
-      "friction.high_speed_coefficient"), "friction.model", ("piecewise_stribeck",)),
-    (("controller.closed_loop_", "controller.acceleration_observer", "controller.friction_observer",
-      "controller.velocity_filter"), "controller.type", ("state_feedback",)),
-    (("controller.kp", "controller.ki", "controller.kd", "controller.filter_cutoff", "controller.compensation_"),
-     "controller.type", ("pid",)),
-)
-
-
-def used_by_model(key: str, options: dict) -> bool:
-    """Whether the selected model (its flow law, friction law, controller) reads parameter ``key``."""
-    for prefixes, option, values in _ONLY_WHEN:
-        if any(key == p or (p.endswith(("_", ".")) and key.startswith(p)) for p in prefixes):
-            return str(options.get(option, "")) in values
-    return True
 
 
 def _deciding(results: dict, used: list[dict]) -> list[str]:
@@ -109,8 +83,10 @@ def document_block(identity: dict, files: list[dict], document: dict | None = No
     number = document.get("number") or identity.get("document_number")
     revision = document.get("revision") or identity.get("revision")
     draft = (needs_identity and not identity) or not number
-    why = ("no [identity] table in the configuration" if needs_identity and not identity else "no document number "
-           "(--document-number)") if draft else None
+    why = None
+    if draft:  # in the signer's words: what is missing, not how to add it
+        missing = ["the site, the unit and the equipment are not identified"] if needs_identity and not identity else []
+        why = "; ".join(missing + ([] if number else ["no document number has been assigned"]))
     return {"number": number, "revision": revision, "draft": draft, "draft_reason": why, "files": files,
             "author": identity.get("author"), "test_date": identity.get("test_date")}
 
@@ -151,7 +127,7 @@ def _remedy_lines(rem) -> dict:
         best = next((b for b in s.get("by_parameter", []) if b.get("delta_margin_pct", 0) > 0), None)
         if s["requirement"] not in out and best:
             out[s["requirement"]] = (f"no passing setting found; {best['path']} helps most "
-                                     f"({best['delta_margin_pct']:+.1f} points per {fmt_si(best['step'], best['unit'])})")
+                                     f"({best['delta_margin_pct']:+.1f} points per {fmt_si(best['step'], best['unit'])})".replace("-", "\u2212"))
     return out
 
 
@@ -171,15 +147,19 @@ def failures(results: dict) -> list[dict]:
 
 
 def not_evaluated(results: dict) -> dict:
-    """Test cases (requirement x procedure x operating point) not evaluated, counted by reason."""
-    total, reasons = 0, Counter()
+    """Judged test cases not evaluated, counted by reason, on the basis of the terminal and JSON summaries
+    (:func:`compliance.campaign.coverage.case_coverage`)."""
+    cov = case_coverage(results["requirements"])
+    reasons = Counter()
     for e in results["requirements"]:
+        if e.get("limit") is None:
+            continue
         for r in e["rows"]:
-            total += 1
             if r.get("status") == Status.NOT_EVALUATED:
                 reasons[(e["id"], str(r.get("reason") or "no value").split(":")[0].split(";")[0].strip())] += 1
     items = [{"requirement": rid, "reason": why, "count": n} for (rid, why), n in reasons.most_common()]
-    return {"cases": total, "count": sum(reasons.values()), "reasons": items,
+    return {"cases": cov["rows"], "count": cov["not_evaluated"], "evaluated": cov["evaluated"], "basis": cov["basis"],
+            "text": case_coverage_text(cov), "reasons": items,
             "requirements": (results["summary"].get("counts") or {}).get(Status.NOT_EVALUATED, 0)}
 
 
@@ -196,3 +176,27 @@ def assumptions(results: dict) -> list[str]:
         out.append("The model has not been validated against a recording of this servo; friction, valve and leakage "
                    "parameters may differ on the real unit.")
     return out
+
+
+def qualified_verdict(results: dict) -> dict:
+    """Page 1's verdict: the word, its qualifier (``campaign.basis.verdict_qualifier``) and why, in the owner's words.
+
+    A PASS against assumed limits or on a mostly assumed model is not a plain (green) PASS: its
+    class is ``warn`` and the qualifier is printed under the word.
+    """
+    status = results["summary"]["status"]
+    summary = results["summary"]
+    qualifier = (summary["qualifier"] if "qualifier" in summary else verdict_qualifier(results)) if status == Overall.PASS else None
+    if not qualifier:
+        return {"status": status, "qualifier": None, "css": None, "why": None}
+    b = basis(results)
+    why = []
+    if "assumed targets" in qualifier:
+        ids = [e["id"] for e in results["requirements"] if e.get("limit_assumed") and e["status"] == Status.PASS]
+        why.append(f"the limits of {', '.join(ids)} are assumed design targets of the requirement file, not figures of a "
+                   "standard or of the plant owner")
+    if "assumed model" in qualifier:
+        why.append(f"{b['assumed']} of the {b['n_params']} parameters the model uses are assumed")
+    return {"status": status, "qualifier": qualifier, "css": "warn",
+            "why": "; ".join(why) + ": the PASS says the model meets these targets, not that the built system meets "
+                                    "a specification"}

@@ -37,10 +37,14 @@ def remedies_markdown(rem: dict) -> str:
     pick = rem.get("remedy") or rem.get("closest")
     if pick:
         title = "Smallest verified change" if rem.get("remedy") else "Closest candidate (does not pass)"
-        lines += ["", f"**{title}** (normalised change {pick['change']:.3f}; binding {pick['binding']} "
-                      f"{_margin(pick['binding_margin_pct'])}):", ""]
-        lines += ["| parameter | from | to |", "|---|---|---|"]
-        lines += [f"| {c['path']} | {_g(c['from'], c['unit'])} | {_g(c['to'], c['unit'])} |" for c in pick["changes"]]
+        if not pick["changes"]:  # the configuration as given ranks first: no table of nothing
+            lines += ["", f"**{title}**: the configuration as given (no candidate judged ranks before it); binding "
+                          f"{pick['binding']} {_margin(pick['binding_margin_pct'])}."]
+        else:
+            lines += ["", f"**{title}** (normalised change {pick['change']:.3f}; binding {pick['binding']} "
+                          f"{_margin(pick['binding_margin_pct'])}):", ""]
+            lines += ["| parameter | from | to |", "|---|---|---|"]
+            lines += [f"| {c['path']} | {_g(c['from'], c['unit'])} | {_g(c['to'], c['unit'])} |" for c in pick["changes"]]
         if pick.get("hardware"):
             lines.append("\nHardware: " + "; ".join(f"{h['title']} (cost {h['cost']:g})" for h in pick["hardware"]))
         if pick.get("failed_mandatory"):

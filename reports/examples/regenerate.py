@@ -6,7 +6,7 @@
 
 Each example is made by the documented govcheck command (printed before it runs). Afterwards
 every HTML and PDF example is checked for text outside its figure or page and for overprinting
-(compliance.report.layout_check), for names of the code base, "seed" and references to missing
+(compliance.report.layout_check; the plant-A body at most 25 pages), for names of the code base, "seed" and references to missing
 sections (compliance.report.text_check), and every file an example points at must exist.
 Exit 0 when all is made and clean, 1 when a check fails, 2 when a command fails.
 """
@@ -66,7 +66,7 @@ def _pointers_missing() -> list[str]:
 def check() -> list[str]:
     """Layout and text problems of every example, and missing pointers."""
     sys.path.insert(0, str(ROOT))
-    from compliance.report.layout_check import html_problems, pdf_problems
+    from compliance.report.layout_check import BODY_PAGES_MAX, body_pages, html_problems, pdf_problems
     from compliance.report.text_check import html_text, repository_names, text_problems
 
     names = repository_names(ROOT)
@@ -83,6 +83,9 @@ def check() -> list[str]:
         problems += [f"{html.name}: {p}" for p in text_problems(text, headings, repo_names=names, allowed=inputs)]
     for pdf in sorted((ROOT / OUT).rglob("*.pdf")):
         problems += [f"{pdf.name}: {p}" for p in pdf_problems(pdf)]
+    plant_a = ROOT / OUT / "plant-a-shpp-400kw.pdf"
+    if plant_a.exists() and body_pages(plant_a)["body"] > BODY_PAGES_MAX:
+        problems.append(f"{plant_a.name}: the body has {body_pages(plant_a)['body']} pages, more than {BODY_PAGES_MAX}")
     return problems + _pointers_missing()
 
 

@@ -198,6 +198,11 @@ def test_plant_a_against_shpp_end_to_end(tmp_path, capsys):
     # page-1 counts: passes by construction and advisory failures apart, cases evaluated
     assert "pass by construction (not evidence)" in printed and "fail (advisory)" in printed
     assert "cases evaluated" in printed and "assumptions that matter most" in printed
+    # the judged test cases on one basis: the same counts as the JSON (and page 1 of the report)
+    cov = r["summary"]["coverage"]
+    assert cov["rows"] == cov["evaluated"] + cov["not_evaluated"] > cov["evaluated"] > 0
+    assert f"{cov['evaluated']} of {cov['rows']} judged test cases evaluated, {cov['not_evaluated']} not evaluated" in printed
+    assert cov["basis"] in printed
     # every computed value is judged or carries the reason it is not (issue 22)
     judged = {(row["run"], e["request_key"]) for e in r["requirements"] for row in e["rows"]}
     why = {(u["run"], u["metric"]): u["reason"] for u in r["coverage"]["unjudged"]}

@@ -97,3 +97,62 @@ def test_si_prefixes_and_fit_bounds():
     assert at_bound(1.0000041e-4, 1e-4, 0.05, True)
     assert not at_bound(4.7e-3, 1e-4, 0.05, True)
     assert at_bound(0.0, 0.0, 1000.0) and not at_bound(3.2, 0.0, 1000.0)
+
+
+# --------------------------------------------------------------------------- issue 25: verdicts on assumptions
+def _plant_b_like(res: dict, share_assumed: float) -> dict:
+    """The fixture turned into a PASS against assumed targets with a given share of assumed parameters."""
+    res["summary"].update(status="pass", failed_mandatory=[], qualifier=None)
+    res["summary"].pop("qualifier")
+    for e in res["requirements"]:
+        e["status"], e["severity"], e["limit_assumed"] = "pass", "mandatory", True
+    used = [p for p in res["plant"]["parameters"] if S.used_by_model(p["key"], res["plant"]["options"])]
+    n = round(share_assumed * len(used))
+    for i, p in enumerate(used):
+        p["source"] = "assumed" if i < n else "paper"
+    return res
+
+
+def test_a_pass_against_assumed_targets_on_a_mostly_assumed_model_is_not_a_plain_pass():
+    from compliance.campaign.basis import verdict_qualifier
+    from compliance.campaign.results_files import summary_lines
+
+    res = _plant_b_like(_results(), 0.8)
+    assert verdict_qualifier(res) == "against assumed targets, on a mostly assumed model"
+    v = S.qualified_verdict(res)
+    assert v["css"] == "warn" and v["qualifier"] == verdict_qualifier(res)
+    b = S.basis(res)
+    assert f"{b['assumed']} of the {b['n_params']} parameters the model uses are assumed" in v["why"]
+    assert "not figures of a standard or of the plant owner" in v["why"]
+    assert summary_lines(res)[-1] == "VERDICT: PASS (against assumed targets, on a mostly assumed model)"
+    # limits from a standard and a model mostly from the paper: a plain PASS
+    res = _plant_b_like(_results(), 0.3)
+    for e in res["requirements"]:
+        e["limit_assumed"] = False
+    assert verdict_qualifier(res) is None and S.qualified_verdict(res)["css"] is None
+    assert summary_lines(res)[-1] == "VERDICT: PASS"
+
+
+def test_an_assumed_limit_makes_the_verdict_basis_assumed():
+    from types import SimpleNamespace
+
+    from compliance.campaign.basis import limit_assumed, row_basis
+
+    req = SimpleNamespace(clause="assumed (plant-B design target)", standard="assumed design targets", metric="path_rms_error",
+                          source="simulation")
+    assert limit_assumed(req) and not limit_assumed(SimpleNamespace(clause="4.2.1", standard="IEC 61362"))
+    op = SimpleNamespace(load=None, flow_control=None)
+    reqset = SimpleNamespace(operating_points={"centre": op}, procedures={})
+    cfg = SimpleNamespace(flow_control_installed=False, effects={}, sources={}, assumptions={})
+    basis, why = row_basis(cfg, reqset, req, {"status": "pass", "value": 1e-4, "operating_point": "centre",
+                                               "procedure": "circle"})
+    assert basis == "assumed" and "assumed design target" in why
+
+
+def test_draft_reason_is_in_the_signers_words():
+    doc = S.document_block({}, [], None)
+    assert doc["draft"]
+    assert doc["draft_reason"] == ("the site, the unit and the equipment are not identified; no document number has been "
+                                   "assigned")
+    assert "[identity]" not in doc["draft_reason"] and "--" not in doc["draft_reason"]
+    assert S.document_block({"site": "x"}, [], None)["draft_reason"] == "no document number has been assigned"

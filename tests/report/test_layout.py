@@ -51,7 +51,7 @@ def test_identity_and_a_document_number_remove_the_draft_mark(report, tmp_path):
     res = json.loads(FIXTURE.read_text(encoding="utf-8"))  # no [identity]: a draft, whatever the number
     render_report(res, tmp_path / "d.html", appendix="none", document={"number": "QA-GOV-0001"})
     draft = (tmp_path / "d.html").read_text(encoding="utf-8")
-    assert 'class="draft-svg"' in draft and "no [identity] table in the configuration" in draft
+    assert 'class="draft-svg"' in draft and "the site, the unit and the equipment are not identified" in draft
 
 
 def _svg(draw) -> str:
@@ -78,6 +78,21 @@ def test_a_label_below_the_figure_is_found():
 
     problems = svg_problems(_svg(draw))
     assert any("'time [s]' outside the viewBox" in p for p in problems), problems
+
+
+def test_the_command_line_names_a_clipped_label_and_exits_1(tmp_path, capsys):
+    from compliance.report.layout_check import main as layout_main
+
+    def draw(fig, ax):
+        ax.set_xlabel("time [s]")
+        fig.subplots_adjust(bottom=0.02)
+
+    bad, good = tmp_path / "bad.html", tmp_path / "good.html"
+    bad.write_text(f"<html><body><figure>{_svg(draw)}</figure></body></html>", encoding="utf-8")
+    good.write_text("<html><body><p>no figure</p></body></html>", encoding="utf-8")
+    assert layout_main([str(good)]) == 0
+    assert layout_main([str(good), str(bad)]) == 1
+    assert "'time [s]' outside the viewBox" in capsys.readouterr().out
 
 
 def test_two_labels_drawn_over_each_other_are_found():

@@ -105,9 +105,10 @@ def _render_partial(tolerance_yield):
            "remedy": None, "closest": {"changes": [{"path": "controller.kp", "unit": "V/m", "from": 280.0, "to": 300.0}],
                                        "change": 0.1, "binding": "TC", "binding_margin_pct": -2.0, "failed_mandatory": ["TC"]}}
     env = jinja2.Environment(loader=jinja2.FileSystemLoader(TEMPLATES), autoescape=True, undefined=jinja2.StrictUndefined)
-    from compliance.units.formatting import fmt_si
+    from compliance.units.formatting import fmt_margin_pct, fmt_si
 
-    env.filters["si"] = lambda v, u: fmt_si(v, u or "")  # the report's filter for values with units
+    env.filters["si"] = lambda v, u: fmt_si(v, u or "")  # the report's filters: values with units, capped margins
+    env.filters["margin"] = lambda v: fmt_margin_pct(v) or "\u2013"
     html = env.get_template("_remedies.html.j2").render(remedies=rem, tolerance_yield=tolerance_yield)
     assert "What would make it pass" in html and "Closest candidate" in html and "controller.kp" in html
     assert "Tolerance yield" in html and html.count("<svg") == 2

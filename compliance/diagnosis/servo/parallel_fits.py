@@ -13,7 +13,8 @@ import tomllib
 from dataclasses import dataclass
 
 from compliance.model.config import plant_from_dict
-from compliance.diagnosis.servo.candidates import Candidate, FitParam
+from compliance.diagnosis.servo.candidates import Candidate
+from compliance.model.parameters import ParamHandle
 from compliance.diagnosis.servo.fit import FitContext, FitResult, fit_candidate, least_squares_fit
 from compliance.diagnosis.servo.recalibration import forward_select_base
 from compliance.diagnosis.servo.effect_sets import extend_fit, screen_addition
@@ -26,7 +27,7 @@ _WORKER: dict = {}
 class RecalibrateBase:
     """Greedy forward selection of the base parameters ``params`` (``penalty`` per added parameter)."""
 
-    params: tuple[FitParam, ...]
+    params: tuple[ParamHandle, ...]
     penalty: float
 
     def fit(self, ctx: FitContext) -> FitResult:

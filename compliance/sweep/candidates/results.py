@@ -18,6 +18,7 @@ import numpy as np
 import pandas as pd
 
 from compliance.files.atomic import write_bytes_atomic, write_text_atomic
+from compliance.requirements.verdict import Status
 from compliance.sweep.candidates.evaluate import judged
 from compliance.sweep.candidates.ranking import rank_key
 from compliance.sweep.candidates.runner import shortfall, total_shortfall
@@ -75,8 +76,17 @@ def tightest(df: pd.DataFrame, rows: list[dict], k: int = 2) -> list[str]:
 
 
 def pareto_front(df: pd.DataFrame, a: str, b: str) -> list[int]:
-    """Candidates not dominated in (margin % of ``a``, margin % of ``b``), both maximised."""
-    ok = df[[f"{a}.margin_pct", f"{b}.margin_pct"]].dropna()
+    """Candidates not dominated in (margin % of ``a``, margin % of ``b``), both maximised.
+
+    Only candidates with both requirements evaluated (pass or fail) take part: a margin of a case
+    that was not evaluated is no point of the front.
+    """
+    cols = [f"{a}.margin_pct", f"{b}.margin_pct"]
+    judged = np.ones(len(df), dtype=bool)
+    for r in (a, b):
+        if f"{r}.status" in df:
+            judged &= df[f"{r}.status"].isin((Status.PASS, Status.FAIL)).to_numpy()
+    ok = df.loc[judged, cols].dropna()
     pts = ok.to_numpy()
     idx = ok.index.to_numpy()
     front = []

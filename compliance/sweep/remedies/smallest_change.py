@@ -34,6 +34,7 @@ from compliance.sweep.candidates.results import change
 from compliance.sweep.candidates.ranking import SETTINGS_COST, candidate_passes, failing_mandatory, rank_key
 from compliance.sweep.candidates.runner import run_candidates, shortfall
 from compliance.sweep.candidates.sampling import from_normalised, to_normalised
+from compliance.units.formatting import fmt_margin_pct
 
 __all__ = ["STEP", "TARGET", "binding", "closeness", "describe_candidate", "find_remedy", "mandatory_margins", "unreachable"]
 
@@ -246,6 +247,6 @@ def _none_found(out, adjust, start, closest):
     reach = (f" Out of reach of every declared parameter by the local sensitivities: {', '.join(out['out_of_reach'])}."
              if out["out_of_reach"] else "")
     out["note"] = (f"no candidate of the {out['evaluated']} judged in the declared space passes every mandatory requirement; "
-                   f"the closest is stopped by {rid} ({out['closest']['binding_margin_pct']:+.1f} % of its limit).{reach} "
+                   f"the closest is stopped by {rid} (margin {fmt_margin_pct(out['closest']['binding_margin_pct'])}).{reach} "
                    "This is the evidence of a search, not a proof that no pass exists.")
     return out
