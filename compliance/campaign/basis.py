@@ -16,11 +16,9 @@ A mandatory requirement whose passing rows are all by construction does not coun
 from __future__ import annotations
 
 from compliance.model.parameters import used_by_model
-from compliance.requirements.verdict import FAIL, NOT_EVALUATED, PASS
+from compliance.requirements.verdict import Basis, Overall, Status
 
-__all__ = ["BASES", "limit_assumed", "requirement_basis", "row_basis", "verdict_qualifier"]
-
-BASES = ("modelled", "by_construction", "assumed", "not_evaluated")
+__all__ = ["limit_assumed", "requirement_basis", "row_basis", "verdict_qualifier"]
 
 # metric -> the throttle whose conductance sets it (meter-out flow-control valves 2V2/2V3, seed 000)
 _THROTTLE = {"opening_time": "flow_control.opening_conductance", "closing_time": "flow_control.closing_conductance"}
@@ -60,14 +58,14 @@ def _derived(cfg, op, flow_control: bool, stroke_metric: str | None):
     return key, der
 
 
-def row_basis(cfg, reqset, req, row) -> tuple[str, str]:
+def row_basis(cfg, reqset, req, row) -> tuple[Basis, str]:
     """(basis, basis_reason) of one verdict row (see the module docstring)."""
-    if row.get("non_responding") and row.get("status") == FAIL:
-        return "modelled", "the simulated step never responded: " + (row.get("reason") or "")
-    if row.get("status") == NOT_EVALUATED or row.get("value") is None:
-        return "not_evaluated", row.get("reason") or "no value"
+    if row.get("non_responding") and row.get("status") == Status.FAIL:
+        return Basis.MODELLED, "the simulated step never responded: " + (row.get("reason") or "")
+    if row.get("status") == Status.NOT_EVALUATED or row.get("value") is None:
+        return Basis.NOT_EVALUATED, row.get("reason") or "no value"
     if req.source == "linear":
-        return "modelled", "linearised model at the operating point (compliance.linear)"
+        return Basis.MODELLED, "linearised model at the operating point (compliance.linear)"
     op = reqset.operating_points[row["operating_point"]]
     proc = reqset.procedures.get(row["procedure"])
     fc = proc.settings.get("flow_control", True) if proc is not None and proc.kind == "full_stroke" else op.flow_control
@@ -75,44 +73,44 @@ def row_basis(cfg, reqset, req, row) -> tuple[str, str]:
     found = _derived(cfg, op, installed, _stroke_metric(req, row))
     if found:
         key, der = found
-        return "by_construction", (
+        return Basis.BY_CONSTRUCTION, (
             f"{key} ({cfg.sources[key]}) was derived so that the model gives {der['metric']} = {der['value']} at "
             f"{der['load_text']}: at this load the figure is the derivation's target, not evidence; measure the stroke")
     if req.metric == "cross_adjustment_change":
         on = [e for e in _COUPLING_EFFECTS if e in cfg.effects]
         if not on:
-            return "by_construction", (
+            return Basis.BY_CONSTRUCTION, (
                 "the model's supply is ideal (no supply_droop or line_dynamics effect) and each meter-out throttle sits on "
                 "its own exhaust path: nothing couples the two directions, so the cross change is zero by construction")
     if req.metric in ("drift", "limit_cycle_amplitude"):
         on = [e for e in _LEAK_EFFECTS if e in cfg.effects]
         if not on:
-            return "by_construction", (
+            return Basis.BY_CONSTRUCTION, (
                 "no leakage or valve offset is modelled (internal_leakage, external_leakage, valve_offset off): nothing "
                 "moves a held position once stiction holds it, so drift and hunting are zero by construction")
     if limit_assumed(req):
         return "assumed", (f"the limit is an assumed design target ({req.clause}), not a figure of a standard or of the "
                            "plant owner: the verdict holds against that target only")
     if op.load == "curve" and cfg.sources.get("load.curve") == "assumed":
-        return "assumed", "the load at this point comes from the plant's assumed load curve (load.curve, source assumed)"
-    return "modelled", "simulated with the plant model at this operating point"
+        return Basis.ASSUMED, "the load at this point comes from the plant's assumed load curve (load.curve, source assumed)"
+    return Basis.MODELLED, "simulated with the plant model at this operating point"
 
 
-def requirement_basis(rows: list[dict]) -> str:
+def requirement_basis(rows: list[dict]) -> Basis:
     """Basis of a requirement from its rows: that of its worst failure if it fails; for a pass, by
     construction when every passing row is, else modelled (assumed when no row is modelled)."""
-    judged = [r for r in rows if r.get("status") in (PASS, FAIL)]
+    judged = [r for r in rows if r.get("status") in (Status.PASS, Status.FAIL)]
     if not judged:
-        return "not_evaluated"
-    fails = [r for r in judged if r["status"] == FAIL]
+        return Basis.NOT_EVALUATED
+    fails = [r for r in judged if r["status"] == Status.FAIL]
     if fails:
-        return "modelled" if any(r["basis"] == "modelled" for r in fails) else fails[0]["basis"]
+        return Basis.MODELLED if any(r["basis"] == Basis.MODELLED for r in fails) else fails[0]["basis"]
     bases = {r["basis"] for r in judged}
-    if bases == {"by_construction"}:
-        return "by_construction"
-    if "modelled" in bases:
-        return "modelled"
-    return "assumed" if "assumed" in bases else "by_construction"
+    if bases == {Basis.BY_CONSTRUCTION}:
+        return Basis.BY_CONSTRUCTION
+    if Basis.MODELLED in bases:
+        return Basis.MODELLED
+    return Basis.ASSUMED if Basis.ASSUMED in bases else Basis.BY_CONSTRUCTION
 
 
 def limit_assumed(req) -> bool:
@@ -129,10 +127,10 @@ def verdict_qualifier(results: dict) -> str | None:
     parameters the selected model uses are assumed; both joined when both hold. One wording for the
     terminal summary, the results JSON (``summary.qualifier``) and page 1 of the report.
     """
-    if (results.get("summary") or {}).get("status") != "pass":
+    if (results.get("summary") or {}).get("status") != Overall.PASS:
         return None
     words = []
-    if any(e.get("limit_assumed") and e.get("status") == PASS and e.get("severity") == "mandatory"
+    if any(e.get("limit_assumed") and e.get("status") == Status.PASS and e.get("severity") == "mandatory"
            for e in results.get("requirements") or []):
         words.append("against assumed targets")
     plant = results.get("plant") or {}

@@ -10,7 +10,7 @@ is eligible (each sample's own reason). docs/results-schema.md, ``coverage``.
 from __future__ import annotations
 
 from compliance.procedures.outcomes import request_key
-from compliance.requirements.verdict import FAIL, PASS, UNCERTAIN
+from compliance.requirements.verdict import Status
 
 __all__ = ["CASES_BASIS", "case_coverage", "case_coverage_text", "unjudged"]
 
@@ -34,7 +34,7 @@ def case_coverage(entries: list[dict]) -> dict:
         row is PASS, FAIL or UNCERTAIN (a value was judged against the limit).
     """
     rows = [r for e in entries if e.get("limit") is not None for r in e["rows"]]
-    evaluated = sum(1 for r in rows if r.get("status") in (PASS, FAIL, UNCERTAIN))
+    evaluated = sum(1 for r in rows if r.get("status") in (Status.PASS, Status.FAIL, Status.UNCERTAIN))
     return {"rows": len(rows), "evaluated": evaluated, "not_evaluated": len(rows) - evaluated, "basis": CASES_BASIS}
 
 

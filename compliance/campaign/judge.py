@@ -16,7 +16,7 @@ from compliance.linear.requirement_values import linear_value
 from compliance.metrics.catalogue import METRICS
 from compliance.requirements.requirement_set import RequirementSet
 from compliance.procedures.outcomes import Sample, request_key
-from compliance.requirements.verdict import DISABLED, FAIL, NOT_EVALUATED, OPEN, Verdict, evaluate, requirement_status, worst_index
+from compliance.requirements.verdict import Basis, Status, Verdict, evaluate, requirement_status, worst_index
 
 __all__ = ["fmt", "judge", "judge_row", "sample_dict"]
 
@@ -58,7 +58,7 @@ def judge_row(req, proc: str, op: str, limit, samples, error: str | None) -> dic
     """One verdict row of ``req`` at ``proc@op`` from a run's candidate values (the worst eligible one decides)."""
     base = {"procedure": proc, "operating_point": op, "run": f"{proc}@{op}"}
     if error:
-        v = Verdict(None, req.comparator, limit or (), None, None, NOT_EVALUATED, error)
+        v = Verdict(None, req.comparator, limit or (), None, None, Status.NOT_EVALUATED, error)
         return {**base, **v.as_dict(), "which": None, "samples": []}
     samples = samples or []
     shown = [sample_dict(s, req.metric) for s in samples]
@@ -69,11 +69,11 @@ def judge_row(req, proc: str, op: str, limit, samples, error: str | None) -> dic
     if req.limit is None:
         pick = _open_pick(req.comparator, samples)
         return {**base, "value": pick.value if pick else None, "comparator": req.comparator, "limit": None,
-                "margin": None, "margin_pct": None, "status": OPEN,
+                "margin": None, "margin_pct": None, "status": Status.OPEN,
                 "reason": None if pick else _why(samples), "which": pick.label if pick else None,
                 "samples": shown}
     if not usable:
-        v = Verdict(None, req.comparator, limit, None, None, NOT_EVALUATED, _why(samples))
+        v = Verdict(None, req.comparator, limit, None, None, Status.NOT_EVALUATED, _why(samples))
         return {**base, **v.as_dict(), "which": None, "samples": shown}
     verdicts = [evaluate(s.value, req.comparator, limit) for s in usable]
     w = worst_index(verdicts)
@@ -87,9 +87,9 @@ def _non_responding_row(req, base: dict, limit, silent, shown) -> dict:
     labels = [x.label for x in silent]
     if req.limit is None or req.comparator not in ("<=", "<", "within"):
         return {**base, "value": None, "comparator": req.comparator, "limit": None if req.limit is None else list(limit),
-                "margin": None, "margin_pct": None, "status": OPEN if req.limit is None else NOT_EVALUATED,
+                "margin": None, "margin_pct": None, "status": Status.OPEN if req.limit is None else Status.NOT_EVALUATED,
                 "reason": why, "which": s.label, "samples": shown, "non_responding": labels}
-    v = Verdict(None, req.comparator, tuple(limit), None, None, FAIL, why + ", beyond any upper limit")
+    v = Verdict(None, req.comparator, tuple(limit), None, None, Status.FAIL, why + ", beyond any upper limit")
     return {**base, **v.as_dict(), "which": s.label, "samples": shown, "non_responding": labels}
 
 
@@ -167,9 +167,9 @@ def judge(cfg, reqset: RequirementSet, jobs: list[Job], outcomes) -> tuple[list[
             r["display"] = _display_row(r, req.metric)
         verdicts = [_row_verdict(req, r) for r in rows] if req.limit is not None else []
         if not req.enabled:
-            status = DISABLED
+            status = Status.DISABLED
         elif req.limit is None:
-            status = OPEN
+            status = Status.OPEN
         else:
             status = requirement_status(verdicts)
         worst = None
@@ -202,8 +202,8 @@ def judge(cfg, reqset: RequirementSet, jobs: list[Job], outcomes) -> tuple[list[
             "status": status,
             "worst": None if worst is None else {k: worst.get(k) for k in _WORST_KEYS},
             "rows": rows,
-            "basis": requirement_basis(rows) if req.enabled and req.limit is not None else "not_evaluated",
-            "coverage": {"rows": len(rows), "evaluated": sum(1 for r in rows if r.get("status") in ("pass", "fail")),
+            "basis": requirement_basis(rows) if req.enabled and req.limit is not None else Basis.NOT_EVALUATED,
+            "coverage": {"rows": len(rows), "evaluated": sum(1 for r in rows if r.get("status") in (Status.PASS, Status.FAIL)),
                          "extended": sum(1 for r in rows if r.get("extended"))},
             "reading": req.reading,
             "alternative": req.alternative,

@@ -17,6 +17,7 @@ A requirement already failing in the baseline is reported, not counted as a regr
 from __future__ import annotations
 
 from compliance.campaign.results_files import _STATUS_WORD
+from compliance.requirements.verdict import Overall, Status
 
 
 def _worst(entry: dict | None):
@@ -28,7 +29,7 @@ def _worst(entry: dict | None):
 
 def not_evaluated_reason(entry: dict | None) -> str | None:
     """Why a requirement could not be evaluated (the distinct reasons of its rows), or None."""
-    if not entry or entry.get("status") != "not_evaluated":
+    if not entry or entry.get("status") != Status.NOT_EVALUATED:
         return None
     reasons = sorted({r["reason"] for r in entry.get("rows") or [] if r.get("reason")})
     return "; ".join(reasons) if reasons else "no reason recorded"
@@ -40,13 +41,13 @@ def _status_reasons(rid: str, b: dict | None, c: dict | None, why: str | None, a
     cs = c["status"] if c else "absent"
     if b is not None and c is None:
         return ["requirement removed in the candidate"], None
-    if b is None and cs == "fail":
+    if b is None and cs == Status.FAIL:
         return ["new requirement fails"], None
-    if cs == "not_evaluated" and (bs == "pass" or (bs == "fail" and c["severity"] == "mandatory")):
+    if cs == Status.NOT_EVALUATED and (bs == Status.PASS or (bs == Status.FAIL and c["severity"] == "mandatory")):
         if allowed:
             return [], f"{bs} -> not_evaluated allowed explicitly (--allow-not-evaluated {rid}): {why}"
         return [f"{bs} -> not_evaluated: could not be evaluated: {why}"], None
-    if bs == "pass" and cs != "pass":
+    if bs == Status.PASS and cs != Status.PASS:
         return [f"{bs} -> {cs}"], None
     return [], None
 
@@ -107,11 +108,11 @@ def compare(baseline: dict, candidate: dict, max_margin_loss: float | None = Non
             "reasons": reasons,
             "not_evaluated_reason": why,
             "allowed": allowed_note,
-            "preexisting_failure": bs == "fail" and cs == "fail",
+            "preexisting_failure": bs == Status.FAIL and cs == Status.FAIL,
         })
     return {
         "schema": "govcheck-gate/1",
-        "status": "fail" if tripped else "pass",
+        "status": Overall.FAIL if tripped else Overall.PASS,
         "tripped": tripped,
         "max_margin_loss": max_margin_loss,
         "allow_not_evaluated": sorted(allowed),
@@ -160,7 +161,7 @@ def gate_table(result: dict) -> str:
 
 def gate_markdown(result: dict) -> str:
     """Markdown summary fit for a pull-request comment."""
-    ok = result["status"] == "pass"
+    ok = result["status"] == Overall.PASS
     b, c = result["baseline"], result["candidate"]
     lines = [
         f"### govcheck gate: {'passed' if ok else 'FAILED'}"

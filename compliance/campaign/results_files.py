@@ -14,6 +14,7 @@ from compliance.campaign.coverage import CASES_BASIS, case_coverage_text
 from compliance.errors import InputError
 from compliance.files.atomic import write_text_atomic
 from compliance.files.jsonable import json_text, read_json
+from compliance.requirements.verdict import Basis, Status
 from compliance.units.formatting import STATUS_WORD as _STATUS_WORD  # the one status-word table
 
 RESULTS_SCHEMA = "govcheck-results/1"
@@ -97,12 +98,12 @@ def _numbers(v) -> bool:
 
 
 # --------------------------------------------------------------------------- terminal
-_BASIS_WORD = {"modelled": "modelled", "by_construction": "by constr.", "assumed": "assumed", "not_evaluated": "-"}
+_BASIS_WORD = {Basis.MODELLED: "modelled", Basis.BY_CONSTRUCTION: "by constr.", Basis.ASSUMED: "assumed", Basis.NOT_EVALUATED: "-"}
 
 
 def _status_cell(e: dict) -> str:
     word = _STATUS_WORD.get(e["status"], e["status"])
-    if e["status"] == "pass" and e.get("basis") == "by_construction":
+    if e["status"] == Status.PASS and e.get("basis") == Basis.BY_CONSTRUCTION:
         return word + " (by construction)"
     return word
 
@@ -147,12 +148,12 @@ def summary_lines(results: dict) -> list[str]:
     if cov:
         out.append(f"  ({cov.get('basis') or CASES_BASIS})")
     for e in results["requirements"]:
-        if e["status"] == "not_evaluated":
+        if e["status"] == Status.NOT_EVALUATED:
             reasons = sorted({r["reason"] for r in e["rows"] if r.get("reason")})
             out.append(f"  not evaluated {e['id']}: {'; '.join(reasons)[:200]}")
-        elif e["status"] == "pass" and e.get("basis") == "by_construction":
+        elif e["status"] == Status.PASS and e.get("basis") == Basis.BY_CONSTRUCTION:
             out.append(f"  by construction {e['id']}: {((e.get('worst') or {}).get('basis_reason') or '')[:200]}")
-        elif e["status"] == "uncertain":
+        elif e["status"] == Status.UNCERTAIN:
             deciding = ", ".join(((e.get("worst") or {}).get("band") or {}).get("deciding") or [])
             out.append(f"  uncertain {e['id']}: its band straddles the limit; decided by {deciding or '-'}")
     findings = results.get("findings") or []
@@ -209,12 +210,12 @@ def junit_xml(results: dict) -> str:
                    + (f" ({r['which']})" if r.get("which") else ""))
             body = ""
             st = r.get("status")
-            if st == "fail":
+            if st == Status.FAIL:
                 cnt["failures"] += 1
                 body = f"<failure message={quoteattr(msg)} type=\"requirement\">{escape(e['title'])}</failure>"
-            elif st in ("not_evaluated", "uncertain"):
+            elif st in (Status.NOT_EVALUATED, Status.UNCERTAIN):
                 band = r.get("band") or {}
-                reason = (r.get("reason") or "not evaluated") if st == "not_evaluated" else (
+                reason = (r.get("reason") or "not evaluated") if st == Status.NOT_EVALUATED else (
                     f"uncertain: band {band.get('low')} .. {band.get('high')} straddles the limit; decided by "
                     + ", ".join(band.get("deciding") or []))
                 if e["severity"] == "mandatory":
@@ -223,9 +224,9 @@ def junit_xml(results: dict) -> str:
                 else:
                     cnt["skipped"] += 1
                     body = f"<skipped message={quoteattr(reason)}/>"
-            elif st in ("open", "disabled"):
+            elif st in (Status.OPEN, Status.DISABLED):
                 cnt["skipped"] += 1
-                body = f"<skipped message={quoteattr(('open: no limit set; measured ' + d.get('value', '-')) if st == 'open' else 'disabled')}/>"
+                body = f"<skipped message={quoteattr(('open: no limit set; measured ' + d.get('value', '-')) if st == Status.OPEN else Status.DISABLED)}/>"
             out = f"<system-out>{escape(msg)}</system-out>"
             cases.append(f'    <testcase classname={quoteattr(e["id"])} name={quoteattr(r.get("run") or e["id"])} time="0">{body}{out}</testcase>')
         for k in tot:

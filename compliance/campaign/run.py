@@ -32,7 +32,7 @@ from compliance.requirements.requirement_set import RequirementSet
 from compliance.campaign.basis import verdict_qualifier
 from compliance.campaign.coverage import case_coverage, unjudged
 from compliance.campaign.uncertainty import local_bands, ranged_parameters
-from compliance.requirements.verdict import DISABLED, FAIL, NOT_EVALUATED, OPEN, PASS, UNCERTAIN, overall_status
+from compliance.requirements.verdict import Basis, Status, overall_status
 
 __all__ = [
     "RESULTS_SCHEMA",
@@ -60,31 +60,31 @@ def _versions() -> dict:
 
 
 def _by_construction(e: dict) -> bool:
-    return e["status"] == PASS and e.get("basis") == "by_construction"
+    return e["status"] == Status.PASS and e.get("basis") == Basis.BY_CONSTRUCTION
 
 
 def summary_counts(entries: list[dict]) -> dict:
     """Requirement counts by status, with passes by construction and advisory failures counted apart."""
-    counts = {s: sum(1 for e in entries if e["status"] == s) for s in (PASS, FAIL, NOT_EVALUATED, OPEN, DISABLED, UNCERTAIN)}
+    counts = {s: sum(1 for e in entries if e["status"] == s) for s in Status}  # in declared order
     counts["pass_by_construction"] = sum(1 for e in entries if _by_construction(e))
-    counts[PASS] -= counts["pass_by_construction"]  # a pass by construction is not evidence: never counted as a pass
-    counts["fail_mandatory"] = sum(1 for e in entries if e["status"] == FAIL and e["severity"] == "mandatory")
-    counts["fail_advisory"] = counts[FAIL] - counts["fail_mandatory"]
+    counts[Status.PASS] -= counts["pass_by_construction"]  # a pass by construction is not evidence: never counted as a pass
+    counts["fail_mandatory"] = sum(1 for e in entries if e["status"] == Status.FAIL and e["severity"] == "mandatory")
+    counts["fail_advisory"] = counts[Status.FAIL] - counts["fail_mandatory"]
     return counts
 
 
 def summary_section(entries: list[dict], notes: list[str], uncertainty: dict | None = None) -> dict:
     """The results' ``summary``: overall verdict, counts, lists of ids by outcome, coverage, the assumptions that matter most."""
-    judged = [(e["severity"], e["status"], e.get("basis")) for e in entries if e["status"] not in (OPEN, DISABLED)]
+    judged = [(e["severity"], e["status"], e.get("basis")) for e in entries if e["status"] not in (Status.OPEN, Status.DISABLED)]
     return {
         "status": overall_status(judged),
         "counts": summary_counts(entries),
-        "failed": [e["id"] for e in entries if e["status"] == FAIL],
-        "failed_mandatory": [e["id"] for e in entries if e["status"] == FAIL and e["severity"] == "mandatory"],
-        "not_evaluated": [e["id"] for e in entries if e["status"] == NOT_EVALUATED],
-        "open": [e["id"] for e in entries if e["status"] == OPEN],
+        "failed": [e["id"] for e in entries if e["status"] == Status.FAIL],
+        "failed_mandatory": [e["id"] for e in entries if e["status"] == Status.FAIL and e["severity"] == "mandatory"],
+        "not_evaluated": [e["id"] for e in entries if e["status"] == Status.NOT_EVALUATED],
+        "open": [e["id"] for e in entries if e["status"] == Status.OPEN],
         "passed_by_construction": [e["id"] for e in entries if _by_construction(e)],
-        "uncertain": [e["id"] for e in entries if e["status"] == UNCERTAIN],
+        "uncertain": [e["id"] for e in entries if e["status"] == Status.UNCERTAIN],
         "coverage": case_coverage(entries),
         "top_assumptions": (uncertainty or {}).get("top_assumptions") or [],
         "notes": notes,

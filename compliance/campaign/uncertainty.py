@@ -21,7 +21,7 @@ from compliance.campaign.executor import map_tasks
 from compliance.campaign.judge import judge_row
 from compliance.procedures.outcomes import traces_off
 from compliance.procedures.registry import run as run_procedure
-from compliance.requirements.verdict import FAIL, PASS, UNCERTAIN, evaluate
+from compliance.requirements.verdict import Basis, Status, evaluate
 
 __all__ = ["apply_band", "local_bands", "ranged_parameters", "top_assumptions"]
 
@@ -51,8 +51,8 @@ FAR_MARGIN_PCT = 100.0
 def _targets(entries, far: float | None = None) -> list[dict]:
     """Requirements whose deciding row is a modelled (or assumed) simulated value with a verdict
     (and, with ``far``, a margin within ``far`` per cent of the limit)."""
-    out = [e for e in entries if e["source"] == "simulation" and e["status"] in (PASS, FAIL) and e.get("worst")
-           and e["worst"].get("basis") in ("modelled", "assumed") and e["worst"].get("value") is not None]
+    out = [e for e in entries if e["source"] == "simulation" and e["status"] in (Status.PASS, Status.FAIL) and e.get("worst")
+           and e["worst"].get("basis") in (Basis.MODELLED, Basis.ASSUMED) and e["worst"].get("value") is not None]
     if far is None:
         return out
     return [e for e in out if e["worst"].get("margin_pct") is None or abs(e["worst"]["margin_pct"]) <= far]
@@ -82,12 +82,12 @@ def apply_band(e: dict, low: float, high: float, swings: dict, method: str) -> N
     v0 = w["value"]
     sign = 1.0
     if e["comparator"] in ("<=", "<"):
-        sign = 1.0 if w["status"] == PASS else -1.0
+        sign = 1.0 if w["status"] == Status.PASS else -1.0
     elif e["comparator"] in (">=", ">"):
-        sign = -1.0 if w["status"] == PASS else 1.0
+        sign = -1.0 if w["status"] == Status.PASS else 1.0
     else:
         mid = 0.5 * (lim[0] + lim[1])
-        sign = (1.0 if v0 >= mid else -1.0) * (1.0 if w["status"] == PASS else -1.0)
+        sign = (1.0 if v0 >= mid else -1.0) * (1.0 if w["status"] == Status.PASS else -1.0)
     band = {"low": low, "high": high, "method": method,
             "margin_low_pct": min(x.margin_pct for x in ends) if all(x.margin_pct is not None for x in ends) else None,
             "margin_high_pct": max(x.margin_pct for x in ends) if all(x.margin_pct is not None for x in ends) else None,
@@ -99,10 +99,10 @@ def apply_band(e: dict, low: float, high: float, swings: dict, method: str) -> N
         if r["run"] == w["run"] and r.get("which") == w.get("which"):
             r["band"] = band
             if straddles:
-                r["status"] = UNCERTAIN
+                r["status"] = Status.UNCERTAIN
     if straddles:
-        w["status"] = UNCERTAIN
-        e["status"] = UNCERTAIN
+        w["status"] = Status.UNCERTAIN
+        e["status"] = Status.UNCERTAIN
 
 
 def local_bands(cfg, reqset, jobs, entries, *, workers=None, progress=False) -> dict:

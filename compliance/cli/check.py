@@ -132,6 +132,7 @@ def run(args) -> int:
     from compliance.cli.progress import progress
     from compliance.files.reproducible import fixed_created, is_reproducible
     from compliance.requirements.loading import load_requirements
+    from compliance.requirements.verdict import Overall
 
     check_uncertainty_option(args)
     from compliance.cli.sweep import check_remedies_options
@@ -197,4 +198,4 @@ def run(args) -> int:
         write_json(results, args.json)
     if args.junit:
         write_junit(results, args.junit)
-    return 0 if results["summary"]["status"] == "pass" else 1
+    return 0 if results["summary"]["status"] == Overall.PASS else 1

@@ -103,13 +103,13 @@ def run(args) -> int:
         diag = diagnose(cfg, frame, meta, effects=effects, jobs=args.jobs, recalibrate=not args.no_recalibration,
                         suggest_test=args.suggest_test)
         bar.update(1)
-    unsaved = None
+    unsaved = saved = None
     if args.save_model:
         if diag.fitted_cfg is None:
             unsaved = f"--save-model {args.save_model}: not written: the verdict is '{diag.verdict}', so there is no fitted model to save"
         else:
-            save_fitted(diag, args.save_model)
-    data = diag.to_dict()
+            saved = str(save_fitted(diag, args.save_model))
+    data = diag.to_dict(saved_model=saved)
     if args.json:
         write_json_atomic(args.json, _finish(data, args))
     if args.report or args.pdf:

@@ -101,6 +101,7 @@ def run(args) -> int:
     from compliance.files.atomic import write_json_atomic, write_text_atomic
     from compliance.files.reproducible import is_reproducible, make_reproducible
     from compliance.model.config import load_plant
+    from compliance.requirements.verdict import Overall
 
     candidate = _candidate(args)
     if args.max_margin_loss is not None and not args.max_margin_loss >= 0:
@@ -133,4 +134,4 @@ def run(args) -> int:
         write_text_atomic(args.markdown, gate_markdown(result))
     if args.json:
         write_json_atomic(args.json, result)
-    return 0 if result["status"] == "pass" else 1
+    return 0 if result["status"] == Overall.PASS else 1

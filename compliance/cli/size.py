@@ -62,6 +62,7 @@ def run(args) -> int:
     from compliance.cli.sweep import check_remedies_options, remedies_kwargs, save_remedy
     from compliance.model.config import load_plant, save_plant
     from compliance.requirements.loading import load_requirements
+    from compliance.requirements.verdict import Overall
     from compliance.sweep.sizing.duty_file import load_duty
     from compliance.sweep.sizing.size_servo import size_servo, time_constant_target
     from compliance.sweep.sizing.throttle_tuning import tune_throttles
@@ -99,4 +100,4 @@ def run(args) -> int:
         sys.stdout.write("\n" + remedies_markdown(results["remedies"]))
     if args.json:
         write_json(results, args.json)
-    return 0 if results["summary"]["status"] == "pass" else 1
+    return 0 if results["summary"]["status"] == Overall.PASS else 1

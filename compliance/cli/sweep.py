@@ -122,6 +122,7 @@ def run(args) -> int:
 
     from compliance.campaign.executor import parse_scheduler
     from compliance.sweep.run import run_sweep, run_yield_file
+    from compliance.requirements.verdict import Overall
     from compliance.sweep.candidates.spec import load_sweep
 
     for flag in ("jobs", "samples", "units"):
@@ -152,7 +153,7 @@ def run(args) -> int:
         _write_section(out / "summary.html", f"{spec.title}: what would make it pass", remedies=s["remedies"])
     text = summary_markdown(s)
     print(text.splitlines()[3] if args.quiet else text)
-    return 0 if s["best"] and s["best"]["verified_status"] == "pass" else 1
+    return 0 if s["best"] and s["best"]["verified_status"] == Overall.PASS else 1
 
 
 # --------------------------------------------------------------------------- the remedies options of check and size

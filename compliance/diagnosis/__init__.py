@@ -13,6 +13,8 @@ Public API:
 
 Rooms, one job each (dependencies point down this list, never back):
 
+- ``verdicts/``: the names a diagnosis concludes with: its verdicts (``DiagnosisVerdict``) and its
+  candidate explanations (``CandidateSet``, named ``a+b+base``), parsed in one place;
 - ``evidence/``: the recording against the nominal model, before any fit: the fast replay with
   matched noise, the stated operating point, noise floors, normalised residuals, where the model
   misses, the missing force outside the library, the test that would tell two explanations apart;

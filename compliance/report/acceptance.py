@@ -14,6 +14,7 @@ from compliance.errors import InputError
 from compliance.metrics import METRICS
 from compliance.metrics.catalogue import STEP_OPTION_DEFAULTS
 from compliance.report.requirement_pages import limit_text, metric_text
+from compliance.requirements.verdict import Status
 from compliance.units.amounts import parse_amount
 from compliance.units.formatting import fmt_value, unit_text
 
@@ -232,13 +233,13 @@ def conclusions(results: dict) -> list[dict]:
     """One row per requirement needing a decision: the finding and an empty disposition (accept / rework / waive)."""
     out = []
     for e in results["requirements"]:
-        if e["status"] not in ("fail", "uncertain", "not_evaluated", "open"):
+        if e["status"] not in (Status.FAIL, Status.UNCERTAIN, Status.NOT_EVALUATED, Status.OPEN):
             continue
         w = e.get("worst") or {}
         value = metric_text(w.get("value"), e["metric"]) if w else "\u2013"
-        if e["status"] == "open":
+        if e["status"] == Status.OPEN:
             finding = f"no limit set; value found {value}"
-        elif e["status"] == "not_evaluated":
+        elif e["status"] == Status.NOT_EVALUATED:
             finding = "not evaluated (see its page)"
         else:
             finding = f"{value} against {limit_text(e)}" + (f" at {w.get('operating_point')}" if w.get("operating_point") else "")

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from compliance.units.formatting import fmt_num, fmt_value, unit_text as pretty_unit
 from compliance.report.figures_linear import MAP_QUANTITIES
+from compliance.diagnosis.verdicts.verdict import EXPLAINED, DiagnosisVerdict
 
 SIGNAL_DISPLAY = {  # signal -> (label, unit shown, scale from SI)
     "position": ("position", "mm", 1e3),
@@ -345,8 +346,8 @@ def diagnosis_finding(diag: dict) -> dict:
             step = (f"Ambiguous between {winner.get('name')} and {runner.get('name')} (BIC differs by {gap:.1f}, under 10): "
                     "run a test that separates them before changing the model. " + step)
     return {"verdict": verdict, "word": VERDICT_TEXT.get(verdict, str(verdict or "\u2013").upper()),
-            "effect": (winner or {}).get("name") if verdict in ("missing_physics", "parameters_only") else None,
-            "params": params if verdict in ("missing_physics", "parameters_only") else [],
+            "effect": (winner or {}).get("name") if verdict in EXPLAINED else None,
+            "params": params if verdict in EXPLAINED else [],
             "explanation": diag.get("explanation"), "next": step}
 
 

@@ -13,6 +13,7 @@ import shlex
 
 from compliance.errors import InputError
 from compliance.report.requirement_pages import TOLERANCE_METRICS, limit_text, metric_text, reader_text
+from compliance.requirements.verdict import Basis, Overall, Status
 from compliance.units.formatting import fmt_margin_pct, fmt_num, unit_text
 
 RESULTS_SCHEMA = "govcheck-results/1"
@@ -105,7 +106,8 @@ def readable_settings(settings: dict) -> list[tuple[str, str]]:
 
 def status_class(status: str | None) -> str:
     """CSS class of a status badge."""
-    return {"pass": "pass", "fail": "fail", "incomplete": "warn", "not_evaluated": "warn", "uncertain": "warn"}.get(status or "", "neutral")
+    return {Status.PASS: "pass", Status.FAIL: "fail", Overall.INCOMPLETE: "warn", Status.NOT_EVALUATED: "warn",
+            Status.UNCERTAIN: "warn"}.get(status or "", "neutral")
 
 
 # --------------------------------------------------------------------------- sections
@@ -127,7 +129,7 @@ def summary_rows(results: dict) -> list[dict]:
         w = e.get("worst") or {}
         d = _display(w, e["metric"]) if w else {}
         reason = None
-        if e["status"] == "not_evaluated":
+        if e["status"] == Status.NOT_EVALUATED:
             reason = "; ".join(sorted({r.get("reason") for r in e["rows"] if r.get("reason")})) or "not evaluated"
         where = None
         if w:
@@ -152,8 +154,8 @@ def summary_rows(results: dict) -> list[dict]:
 
 
 # how a verdict is known (the verdict work's ``basis`` key; absent in older results)
-BASIS_WORDS = {"modelled": "modelled", "by_construction": "by construction", "not_evaluated": "not evaluated",
-               "assumed": "assumed"}
+BASIS_WORDS = {Basis.MODELLED: "modelled", Basis.BY_CONSTRUCTION: "by construction", Basis.NOT_EVALUATED: "not evaluated",
+               Basis.ASSUMED: "assumed"}
 
 
 def band_text(band, metric: str) -> str | None:

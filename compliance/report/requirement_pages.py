@@ -12,6 +12,7 @@ from __future__ import annotations
 import re
 
 from compliance.metrics import METRICS
+from compliance.requirements.verdict import Status
 from compliance.units.formatting import fmt_margin_pct, fmt_value, unit_text
 
 TOLERANCE_METRICS = ("max_positioning_error", "tracking_max_error", "steady_state_error")
@@ -116,7 +117,7 @@ def _grouped(rows: list[dict]) -> list[dict]:
         ms = g.pop("members")
         if len(ms) == 1:
             continue
-        if g["status"] == "not_evaluated":
+        if g["status"] == Status.NOT_EVALUATED:
             g["steps"] = [{"text": "first point shown, the others alike:",
                            "excluded": True}] + g["steps"]
             continue
@@ -233,7 +234,7 @@ def requirement_pages(results: dict, start: int = 1) -> tuple[list[dict], list[d
     for e in results["requirements"]:
         key = (e.get("source", "simulation"), tuple(sorted({r.get("run") for r in e["rows"]})) or (e["id"],))
         groups.setdefault(key, []).append(e)
-    rank = {"fail": 0, "not_evaluated": 1, "open": 2, "pass": 3, "disabled": 4}
+    rank = {Status.FAIL: 0, Status.NOT_EVALUATED: 1, Status.OPEN: 2, Status.PASS: 3, Status.DISABLED: 4}
     pages, specs = [], []
     for (source, _), entries in groups.items():
         lead = min(entries, key=lambda e: rank.get(e["status"], 5))
@@ -247,7 +248,7 @@ def requirement_pages(results: dict, start: int = 1) -> tuple[list[dict], list[d
                          "limit": limit_text(e), "value": metric_text(w.get("value"), e["metric"]) if w else "\u2013",
                          "margin_pct": fmt_margin_pct(w.get("margin_pct")), "cases": cases,
                          "cannot_fail": sum(1 for c in cases if c["cannot_fail"]),
-                         "not_evaluated": sum(len(c["ops"]) for c in cases if c["status"] == "not_evaluated")})
+                         "not_evaluated": sum(len(c["ops"]) for c in cases if c["status"] == Status.NOT_EVALUATED)})
         reasons = _distinct_reasons(str(x) for e in entries for r in e["rows"] for x in
                                     [r.get("reason")] + [s.get("reason") for s in r.get("samples") or []] if x and ":" in str(x))
         page = {"anchor": "page-" + lead["id"], "ids": [e["id"] for e in entries], "title": lead["title"],
@@ -289,7 +290,7 @@ def requirement_pages(results: dict, start: int = 1) -> tuple[list[dict], list[d
             page["figure"] = {"id": spec["id"], "run": run["id"], "procedure": run["procedure"],
                               "operating_point": run["operating_point"], "which": w.get("which"), "trace": tr.get("label"),
                               "limit_drawn": False}
-        if lead["metric"] == "time_constant" and source == "simulation" and lead["status"] == "fail":
+        if lead["metric"] == "time_constant" and source == "simulation" and lead["status"] == Status.FAIL:
             page["facts"].append(_linear_contrast(results))
         page["facts"] = [f for f in page["facts"] if f]
         pages.append(page)

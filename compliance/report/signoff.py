@@ -15,6 +15,7 @@ from compliance.campaign.coverage import case_coverage, case_coverage_text
 from compliance.campaign.basis import verdict_qualifier
 from compliance.model.parameters import used_by_model
 from compliance.report.requirement_pages import limit_text, metric_text
+from compliance.requirements.verdict import Overall, Status
 from compliance.units.formatting import fmt_margin_pct, fmt_si
 
 SOURCE_WORDS = {"paper": "from the paper", "assumed": "assumed", "derived": "derived", "user": "set by the user",
@@ -135,7 +136,7 @@ def failures(results: dict) -> list[dict]:
     remedies = _remedy_lines(results.get("remedies"))
     out = []
     for e in results["requirements"]:
-        if e["status"] != "fail":
+        if e["status"] != Status.FAIL:
             continue
         w = e.get("worst") or {}
         out.append({"id": e["id"], "title": e["title"], "severity": e["severity"], "value": metric_text(w.get("value"), e["metric"]),
@@ -154,12 +155,12 @@ def not_evaluated(results: dict) -> dict:
         if e.get("limit") is None:
             continue
         for r in e["rows"]:
-            if r.get("status") == "not_evaluated":
+            if r.get("status") == Status.NOT_EVALUATED:
                 reasons[(e["id"], str(r.get("reason") or "no value").split(":")[0].split(";")[0].strip())] += 1
     items = [{"requirement": rid, "reason": why, "count": n} for (rid, why), n in reasons.most_common()]
     return {"cases": cov["rows"], "count": cov["not_evaluated"], "evaluated": cov["evaluated"], "basis": cov["basis"],
             "text": case_coverage_text(cov), "reasons": items,
-            "requirements": (results["summary"].get("counts") or {}).get("not_evaluated", 0)}
+            "requirements": (results["summary"].get("counts") or {}).get(Status.NOT_EVALUATED, 0)}
 
 
 def assumptions(results: dict) -> list[str]:
@@ -185,13 +186,13 @@ def qualified_verdict(results: dict) -> dict:
     """
     status = results["summary"]["status"]
     summary = results["summary"]
-    qualifier = (summary["qualifier"] if "qualifier" in summary else verdict_qualifier(results)) if status == "pass" else None
+    qualifier = (summary["qualifier"] if "qualifier" in summary else verdict_qualifier(results)) if status == Overall.PASS else None
     if not qualifier:
         return {"status": status, "qualifier": None, "css": None, "why": None}
     b = basis(results)
     why = []
     if "assumed targets" in qualifier:
-        ids = [e["id"] for e in results["requirements"] if e.get("limit_assumed") and e["status"] == "pass"]
+        ids = [e["id"] for e in results["requirements"] if e.get("limit_assumed") and e["status"] == Status.PASS]
         why.append(f"the limits of {', '.join(ids)} are assumed design targets of the requirement file, not figures of a "
                    "standard or of the plant owner")
     if "assumed model" in qualifier:

@@ -14,12 +14,39 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
+from enum import StrEnum
 
 COMPARATORS = ("<=", "<", ">=", ">", "within")
 EQUAL_REL_TOL = 1e-9  # round-off of unit conversions; far below any measurement resolution
 
-PASS, FAIL, NOT_EVALUATED, OPEN, DISABLED = "pass", "fail", "not_evaluated", "open", "disabled"
-UNCERTAIN = "uncertain"  # the value's uncertainty band straddles the limit (compliance.campaign.uncertainty)
+
+
+class Status(StrEnum):
+    """Status of one requirement row or requirement, spelt as in the results JSON."""
+
+    PASS = "pass"
+    FAIL = "fail"
+    NOT_EVALUATED = "not_evaluated"  # no value (the reason says why)
+    OPEN = "open"  # no limit set (a purchaser's data-sheet value nobody filled in)
+    DISABLED = "disabled"
+    UNCERTAIN = "uncertain"  # the value's uncertainty band straddles the limit (compliance.campaign.uncertainty)
+
+
+class Overall(StrEnum):
+    """Verdict of a whole run (results ``summary.status``, a regression gate's ``status``)."""
+
+    PASS = "pass"
+    FAIL = "fail"
+    INCOMPLETE = "incomplete"  # nothing mandatory fails, but something mandatory is not evidence
+
+
+class Basis(StrEnum):
+    """How a verdict's value is known (compliance.campaign.basis)."""
+
+    MODELLED = "modelled"  # the model predicts it from the plant's parameters
+    BY_CONSTRUCTION = "by_construction"  # a parameter was derived to give this figure: not evidence
+    ASSUMED = "assumed"  # it rests on an assumed input (e.g. the load curve) more than on the servo
+    NOT_EVALUATED = "not_evaluated"  # no value
 
 
 @dataclass(frozen=True)
@@ -31,7 +58,7 @@ class Verdict:
     limit: tuple[float, ...]
     margin: float | None
     margin_pct: float | None
-    status: str
+    status: Status
     reason: str | None = None
 
     def as_dict(self) -> dict:
@@ -69,7 +96,7 @@ def evaluate(value: float | None, comparator: str, limit, reason: str | None = N
     elif len(lim) != 1:
         raise ValueError(f"comparator {comparator!r} takes one limit")
     if value is None or not math.isfinite(value):
-        return Verdict(None, comparator, lim, None, None, NOT_EVALUATED, reason or "no value")
+        return Verdict(None, comparator, lim, None, None, Status.NOT_EVALUATED, reason or "no value")
     v = float(value)
     if comparator in ("<=", "<"):
         binding = lim[0]
@@ -88,40 +115,40 @@ def evaluate(value: float | None, comparator: str, limit, reason: str | None = N
         margin, binding = (m_lo, lo) if m_lo <= m_hi else (m_hi, hi)
         ok = margin >= 0.0
     pct = None if binding == 0.0 else 100.0 * margin / abs(binding)
-    return Verdict(v, comparator, lim, margin, pct, PASS if ok else FAIL, None)
+    return Verdict(v, comparator, lim, margin, pct, Status.PASS if ok else Status.FAIL, None)
 
 
 def _badness(v: Verdict) -> tuple:
     """Sort key: fails first, then the smallest margin (in % when known)."""
     m = v.margin_pct if v.margin_pct is not None else v.margin
     if m is None:  # a fail without a margin is a step that never responded: the worst of all
-        m = -math.inf if v.status == FAIL else math.inf
-    return (0 if v.status == FAIL else 1, m)
+        m = -math.inf if v.status == Status.FAIL else math.inf
+    return (0 if v.status == Status.FAIL else 1, m)
 
 
 def worst_index(verdicts) -> int | None:
     """Index of the worst evaluated verdict (a fail with the most negative margin, else the
     smallest margin); None if none was evaluated."""
-    ev = [(i, v) for i, v in enumerate(verdicts) if v.status in (PASS, FAIL)]
+    ev = [(i, v) for i, v in enumerate(verdicts) if v.status in (Status.PASS, Status.FAIL)]
     if not ev:
         return None
     return min(ev, key=lambda iv: _badness(iv[1]))[0]
 
 
-def requirement_status(verdicts) -> str:
+def requirement_status(verdicts) -> Status:
     """Status of one requirement from its rows: fail if any row fails; pass if every row was
     evaluated and passed; not_evaluated if any row could not be evaluated and none failed."""
     st = [v.status for v in verdicts]
     if not st:
-        return NOT_EVALUATED
-    if FAIL in st:
-        return FAIL
-    if NOT_EVALUATED in st:
-        return NOT_EVALUATED
-    return PASS
+        return Status.NOT_EVALUATED
+    if Status.FAIL in st:
+        return Status.FAIL
+    if Status.NOT_EVALUATED in st:
+        return Status.NOT_EVALUATED
+    return Status.PASS
 
 
-def overall_status(items) -> str:
+def overall_status(items) -> Overall:
     """Overall verdict from (severity, status) or (severity, status, basis) tuples.
 
     ``fail`` if a mandatory requirement fails; ``incomplete`` if none fails but a mandatory
@@ -133,8 +160,9 @@ def overall_status(items) -> str:
     """
     mand = [(it[1], it[2] if len(it) > 2 else None) for it in items if it[0] == "mandatory"]
     st = [s for s, _ in mand]
-    if FAIL in st:
-        return "fail"
-    if NOT_EVALUATED in st or UNCERTAIN in st or any(s == PASS and b == "by_construction" for s, b in mand):
-        return "incomplete"
-    return "pass"
+    if Status.FAIL in st:
+        return Overall.FAIL
+    if (Status.NOT_EVALUATED in st or Status.UNCERTAIN in st
+            or any(s == Status.PASS and b == Basis.BY_CONSTRUCTION for s, b in mand)):
+        return Overall.INCOMPLETE
+    return Overall.PASS

@@ -16,6 +16,7 @@ import time
 from compliance.processes import raise_if_stopping
 from compliance.campaign.results_files import write_json
 from compliance.files.atomic import write_json_atomic, write_text_atomic
+from compliance.requirements.verdict import Overall
 from compliance.sweep.candidates.evaluate import make_context
 from compliance.sweep.remedies.smallest_change import find_remedy
 from compliance.sweep.candidates.results import best_index, pareto_front, table, tightest, write_table
@@ -116,7 +117,7 @@ def run_sweep(spec, out_dir, *, scheduler=None, workers=None, progress=True, cli
         "schema": SUMMARY_SCHEMA, "name": spec.name, "title": spec.title, "sweep_file": spec.path,
         "base": spec.base, "requirements": spec.requirements, "method": spec.method, "seed": spec.seed,
         "candidates": len(cands), "counts": {k: int(v) for k, v in counts.items()},
-        "passing": int(counts.get("pass", 0)),
+        "passing": int(counts.get(Overall.PASS, 0)),
         "executor": stats.as_dict() if stats else None,
         "parameters": [{"path": a.param.path, "unit": a.param.unit, "low": a.low, "high": a.high,
                         "base": base[a.param.path]} for a in spec.adjust],

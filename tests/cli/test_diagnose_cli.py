@@ -10,9 +10,9 @@ from tests.bad_inputs import workspace as W
 
 
 class _NoMismatch:
-    verdict, fitted_cfg, saved_model = "no_mismatch", None, None
+    verdict, fitted_cfg = "no_mismatch", None
 
-    def to_dict(self):
+    def to_dict(self, saved_model=None):
         return {"schema": "govcheck-diagnosis/1", "verdict": "no_mismatch", "winner": None, "reason": "fits within the noise", "explanation": "nothing missing",
                 "effects": [], "fit_before": {}, "fit_after": None, "windows": [],
                 "timing": {"seconds": 1.0, "simulations": 1, "jobs": 1}}

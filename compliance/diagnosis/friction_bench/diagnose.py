@@ -41,6 +41,8 @@ from compliance.diagnosis.evidence.noise_floor import sensor_noise_std
 from compliance.diagnosis.servo.report_data import SCHEMA
 from compliance.diagnosis.friction_bench.residual_structure import friction_structure
 from compliance.diagnosis.servo.selection import EXPLAINED_ENOUGH, NOISE_TOLERANCE, score_all
+from compliance.diagnosis.verdicts.candidate_set import CandidateSet
+from compliance.diagnosis.verdicts.verdict import DiagnosisVerdict
 
 REVERSAL_TRAVEL = 2e-3  # m of travel after a change of direction counted as "after reversal"
 VELOCITY_WINDOW = 0.05  # s; Savitzky-Golay (quadratic) derivative window of the position
@@ -202,7 +204,7 @@ class SealDiagnosis:
             s = self.scores[name]
             cands.append({
                 "rank": rank, "name": name,
-                "effects": [e for e in name.split("+") if e != "baseline"],
+                "effects": list(CandidateSet.parse(name).without("baseline")),
                 "parameters": [{"name": k, "value": json_number(v), "stderr": json_number(f.stderr.get(k)), "unit": UNITS[k], "meaning": MEANING[k]}
                                for k, v in f.params.items()],
                 "k": f.k, "chi2": json_number(s.chi2), "chi2_per_residual": json_number(s.chi2 / f.n), "bic": json_number(s.bic),
@@ -262,33 +264,33 @@ def diagnose_seal(runs: list[Run], jobs: int | None = None) -> SealDiagnosis:
     best = min(cands, key=lambda k: scores[k].bic, default=None)
     from compliance.diagnosis.servo.selection import MIN_GAIN, SIGNIFICANCE
 
-    verdict, winner = "unexplained", None
+    verdict, winner = DiagnosisVerdict.UNEXPLAINED, None
     if rms_norm <= NOISE_TOLERANCE:
-        verdict = "no_mismatch"
+        verdict = DiagnosisVerdict.NO_MISMATCH
     elif best is not None and scores["baseline"].bic - scores[best].bic >= SIGNIFICANCE and \
             (scores["baseline"].chi2 - scores[best].chi2) >= MIN_GAIN * max(scores["baseline"].chi2 - n, 0.0):
         winner = best
         # a simpler candidate inside the winner that is almost as good is preferred (parsimony)
         for k in cands:
-            if k != best and set(k.split("+")) < set(best.split("+")) and scores[k].bic - scores[best].bic < SIGNIFICANCE:
+            if k != best and CandidateSet.parse(k).inside(CandidateSet.parse(best)) and scores[k].bic - scores[best].bic < SIGNIFICANCE:
                 winner = k
-        verdict = "missing_physics" if scores[winner].explained >= EXPLAINED_ENOUGH else "unexplained"
-    proof = prove_out_of_sample(runs, fits, winner or "baseline", verdict != "no_mismatch", jobs=jobs)
+        verdict = DiagnosisVerdict.MISSING_PHYSICS if scores[winner].explained >= EXPLAINED_ENOUGH else DiagnosisVerdict.UNEXPLAINED
+    proof = prove_out_of_sample(runs, fits, winner or "baseline", verdict != DiagnosisVerdict.NO_MISMATCH, jobs=jobs)
     if proof["law"] != (winner or "baseline"):  # position_dependent_friction earned its parameters held out ...
         scores = _scores(fits, n)
         if scores[winner or "baseline"].bic - scores[proof["law"]].bic >= SIGNIFICANCE:  # ... and by BIC
             winner = proof["law"]
             cands.append(winner)
-            verdict = "missing_physics" if scores[winner].explained >= EXPLAINED_ENOUGH else "unexplained"
+            verdict = DiagnosisVerdict.MISSING_PHYSICS if scores[winner].explained >= EXPLAINED_ENOUGH else DiagnosisVerdict.UNEXPLAINED
     ranked = sorted(cands, key=lambda k: scores[k].bic)
     runner = next((k for k in ranked if k != winner), None)
     located_after = locate_friction(runs, fits[winner]) if winner else None
     after = math.sqrt(fits[winner].chi2 / n) if winner else rms_norm
-    if verdict == "missing_physics" and after > FRICTION_RESIDUAL_LIMIT:
-        verdict = "partially_explained"  # as select.honest: complete only within the stated multiple of the noise
+    if verdict == DiagnosisVerdict.MISSING_PHYSICS and after > FRICTION_RESIDUAL_LIMIT:
+        verdict = DiagnosisVerdict.PARTIALLY_EXPLAINED  # as select.honest: complete only within the stated multiple of the noise
     diag = SealDiagnosis(runs[0].seal, runs, fits, scores, verdict, winner, runner, located, located_after, "", floor,
                          holdout=proof["holdout"], position=proof["position"])
-    if verdict != "no_mismatch":
+    if verdict != DiagnosisVerdict.NO_MISMATCH:
         diag.structure = friction_structure(runs, fits[winner or "baseline"])
     diag.explanation = explain_friction(diag)
     if diag.structure:
@@ -317,7 +319,8 @@ class FrictionDiagnosis:
     def to_dict(self) -> dict:
         """JSON document (docs/diagnosis-schema.md, ``kind = "friction"``)."""
         verdicts = [s.verdict for s in self.seals]
-        overall = next((v for v in ("unexplained", "partially_explained", "missing_physics") if v in verdicts), "no_mismatch")
+        worst_first = (DiagnosisVerdict.UNEXPLAINED, DiagnosisVerdict.PARTIALLY_EXPLAINED, DiagnosisVerdict.MISSING_PHYSICS)
+        overall = next((v for v in worst_first if v in verdicts), DiagnosisVerdict.NO_MISMATCH)
         return {"schema": SCHEMA, "kind": "friction", "recordings": self.files, "verdict": overall,
                 "seals": [s.to_dict() for s in self.seals], "timing": {"seconds": self.seconds}}
 

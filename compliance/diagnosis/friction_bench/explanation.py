@@ -10,6 +10,7 @@ from compliance.diagnosis.friction_bench.fit import PRESSURE_EFFECT
 from compliance.diagnosis.friction_bench.position import POSITION_FRICTION
 from compliance.diagnosis.friction_bench.laws import core_equivalent
 from compliance.units.formatting import fmt_si
+from compliance.diagnosis.verdicts.verdict import DiagnosisVerdict
 
 
 def explain_friction(d) -> str:
@@ -35,7 +36,7 @@ def explain_friction(d) -> str:
                  f"- the friction builds up over the first millimetres of travel instead of jumping.")
     else:
         text += "."
-    if d.verdict == "no_mismatch":
+    if d.verdict == DiagnosisVerdict.NO_MISMATCH:
         return text + " The law already fits within the force noise: nothing is missing."
     if d.winner is None:
         tested = "pressure-dependent friction, pre-sliding hysteresis" if PRESSURE_EFFECT in d.fits else (
@@ -62,7 +63,7 @@ def explain_friction(d) -> str:
     text += (f" The missing physics: {' and '.join(parts)}. Adding it cuts the RMS friction error from {fmt_si(np.mean(rb), 'N')} "
              f"to {fmt_si(np.mean(ra), 'N')} ({fmt_si(rb[lo], 'N')} \u2192 {fmt_si(ra[lo], 'N')} at {fmt_si(runs[lo].pressure, 'Pa')} gauge, "
              f"{fmt_si(rb[hi], 'N')} \u2192 {fmt_si(ra[hi], 'N')} at {fmt_si(runs[hi].pressure, 'Pa')} gauge).")
-    if d.verdict == "unexplained":
+    if d.verdict == DiagnosisVerdict.UNEXPLAINED:
         text += " It still leaves most of the error: the rest is physics outside these candidates (e.g. position-dependent friction)."
     return text
 

@@ -19,6 +19,7 @@ from scipy.optimize import least_squares
 from compliance.diagnosis.friction_bench.laws import bias_force, friction_force
 from compliance.diagnosis.friction_bench.position import POSITION_FRICTION, reference_position
 from compliance.diagnosis.friction_bench.runs import Run
+from compliance.diagnosis.verdicts.candidate_set import CandidateSet
 
 
 MAX_NFEV = 40  # least-squares evaluations per candidate law (besides the Jacobian's)
@@ -29,7 +30,7 @@ LAWS = {  # candidate -> (pressure dependent, pre-sliding)
     "baseline": (False, False),
     PRESSURE_EFFECT: (True, False),
     PRESLIDING: (False, True),
-    f"{PRESSURE_EFFECT}+{PRESLIDING}": (True, True),
+    CandidateSet.of((PRESSURE_EFFECT, PRESLIDING)).name: (True, True),
 }
 
 
@@ -67,7 +68,7 @@ _SPEC = {  # name -> (low, high, log); FIT_BOUNDS below is the public name (the 
 
 def law_flags(name: str) -> tuple[bool, bool, bool]:
     """(pressure dependent, pre-sliding, position dependent) of a law named by its effects joined by ``+``."""
-    parts = set(name.split("+"))
+    parts = set(CandidateSet.parse(name).terms)
     return PRESSURE_EFFECT in parts, PRESLIDING in parts, POSITION_EFFECT in parts
 
 

@@ -30,6 +30,7 @@ from compliance.files.jsonable import json_number
 from compliance.diagnosis.friction_bench.fit import LawFit, fit_law, predict, start_from
 from compliance.diagnosis.friction_bench.position import POSITION_FRICTION
 from compliance.units.formatting import fmt_si
+from compliance.diagnosis.verdicts.candidate_set import CandidateSet
 
 MIN_RUNS = 3  # fit on at least two pressures, predict a third
 RATIO_TARGET = 1.5  # median held-out error within this multiple of the in-sample error (issue 24)
@@ -129,8 +130,8 @@ def prove_out_of_sample(runs, fits: dict, law: str, try_position: bool, *, jobs:
         return {"holdout": None, "position": None, "law": law}
     table = holdout_table(runs, fits[law], held)
     position = None
-    if try_position and POSITION_EFFECT not in law:
-        name = f"{law}+{POSITION_EFFECT}" if law != "baseline" else POSITION_EFFECT
+    if try_position and POSITION_EFFECT not in CandidateSet.parse(law).terms:
+        name = CandidateSet.parse(law).plus(POSITION_EFFECT).name if law != "baseline" else POSITION_EFFECT
         fits[name] = fit_law(runs, name, start_from(fits[law].params))
         other = holdout_table(runs, fits[name], held_out_residuals(runs, fits[name], jobs=jobs))
         position = {"candidate": name, **earns(other, table), "holdout": other}

@@ -25,6 +25,8 @@ from compliance.effects import EFFECTS
 from compliance.diagnosis.servo.candidates import FRICTION_LEVEL
 from compliance.diagnosis.scoring.concealed_cases import MISCALIBRATIONS, Case, effect_case, miscalibration_case, null_case
 from compliance.diagnosis.scoring.practice_score import practice_correct
+from compliance.diagnosis.verdicts.candidate_set import CandidateSet
+from compliance.diagnosis.verdicts.verdict import DiagnosisVerdict
 
 
 @dataclass
@@ -55,17 +57,17 @@ class CaseResult:
 
 def predicted_label(diag) -> str:
     """What a diagnosis said, as a confusion-matrix column label."""
-    if diag.verdict == "missing_physics":
-        return diag.winner.split("+")[0]
-    if diag.verdict == "parameters_only":
-        return "parameters_only"
-    if diag.verdict == "no_mismatch":
+    if diag.verdict == DiagnosisVerdict.MISSING_PHYSICS:
+        return CandidateSet.parse(diag.winner).first
+    if diag.verdict == DiagnosisVerdict.PARAMETERS_ONLY:
+        return DiagnosisVerdict.PARAMETERS_ONLY
+    if diag.verdict == DiagnosisVerdict.NO_MISMATCH:
         return "none"
-    if diag.verdict == "ambiguous":
-        return "ambiguous"  # its own column: not a hit, not "unexplained" either
-    if diag.verdict == "instrumentation":
-        return "instrumentation"  # a logger or transducer finding: never a plant effect
-    return "unexplained"
+    if diag.verdict == DiagnosisVerdict.AMBIGUOUS:
+        return DiagnosisVerdict.AMBIGUOUS  # its own column: not a hit, not "unexplained" either
+    if diag.verdict == DiagnosisVerdict.INSTRUMENTATION:
+        return DiagnosisVerdict.INSTRUMENTATION  # a logger or transducer finding: never a plant effect
+    return DiagnosisVerdict.UNEXPLAINED
 
 
 def _main_error(case: Case, diag) -> tuple[dict, float | None]:
@@ -119,11 +121,11 @@ def score_case(case: Case, diag) -> CaseResult:
     if case.kind == "effect":
         correct = label == case.truth
     elif case.kind == "null":
-        correct = diag.verdict == "no_mismatch"
+        correct = diag.verdict == DiagnosisVerdict.NO_MISMATCH
     else:
         fit = diag.fits.get(diag.winner) if diag.winner else None
         keys = {fp.key for fp in fit.params} if fit is not None else set()
-        correct = diag.verdict == "parameters_only" and (case.truth in keys or (case.truth == FRICTION_LEVEL and FRICTION_LEVEL in keys))
+        correct = diag.verdict == DiagnosisVerdict.PARAMETERS_ONLY and (case.truth in keys or (case.truth == FRICTION_LEVEL and FRICTION_LEVEL in keys))
     fitted, err = _main_error(case, diag)
     _, amb = practice_correct(diag, [case.truth] if case.kind != "null" else [])
     red, sig, red_obj = _reduction(case, diag) if correct and case.kind != "null" else (None, None, None)
@@ -251,7 +253,8 @@ def summarise(results: list[CaseResult], effects) -> dict:
     eff = [r for r in results if r.kind == "effect" and r.visible]
     nul = [r for r in results if r.kind == "null"]
     mis = [r for r in results if r.kind == "miscalibration" and r.visible]
-    labels = list(effects) + ["none", "parameters_only", "ambiguous", "unexplained", "error"]
+    labels = list(effects) + ["none", DiagnosisVerdict.PARAMETERS_ONLY, DiagnosisVerdict.AMBIGUOUS, DiagnosisVerdict.UNEXPLAINED,
+                              "error"]
     truths = list(effects) + (["none"] if nul else []) + sorted({r.truth for r in mis})
     confusion = {t: {} for t in truths}
     for r in results:

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 from compliance.effects import EFFECTS
+from compliance.diagnosis.verdicts.candidate_set import CandidateSet
+from compliance.diagnosis.verdicts.verdict import DiagnosisVerdict
 
 # answers given in a unit other than the SI unit of the declared parameter: name -> factor to SI
 # (the practice emulator states its pressure-dependent friction per bar; ours is per Pa)
@@ -18,7 +20,7 @@ def _accepted(d, accept: dict) -> bool:
     """A verdict the answers' ``accept`` lists, or a winner naming only an instrumentation finding."""
     if d.verdict in accept.get("verdicts", ()):
         return True
-    names = [w for w in (d.winner or "").split("+") if w]
+    names = list(CandidateSet.parse(d.winner).terms)
     if not names or any(w in EFFECTS for w in names):
         return False  # a catalogue effect claimed for a truth that is not plant physics
     return any(any(word in w for word in accept.get("named", ())) for w in names)
@@ -35,15 +37,15 @@ def practice_correct(d, truth: list, accept: dict | None = None) -> tuple[bool, 
     """
     if accept:
         return _accepted(d, accept), False
-    winner_effects = [e for e in (d.winner or "").split("+") if e in EFFECTS]
+    winner_effects = CandidateSet.parse(d.winner).effects
     declared = [e for e in truth if e in EFFECTS]
     if declared:
-        right = d.verdict == "missing_physics" and sorted(winner_effects) == sorted(declared)
-        named = {e for k in d.ambiguous for e in k.split("+")}
-        return right, d.verdict == "ambiguous" and set(declared) <= named
+        right = d.verdict == DiagnosisVerdict.MISSING_PHYSICS and sorted(winner_effects) == sorted(declared)
+        named = {e for k in d.ambiguous for e in CandidateSet.parse(k).terms}
+        return right, d.verdict == DiagnosisVerdict.AMBIGUOUS and set(declared) <= named
     if truth:
-        return d.verdict == "parameters_only", d.verdict == "ambiguous" and "base" in d.ambiguous
-    return d.verdict in ("no_mismatch", "parameters_only"), False
+        return d.verdict == DiagnosisVerdict.PARAMETERS_ONLY, d.verdict == DiagnosisVerdict.AMBIGUOUS and "base" in d.ambiguous
+    return d.verdict in (DiagnosisVerdict.NO_MISMATCH, DiagnosisVerdict.PARAMETERS_ONLY), False
 
 
 def main_parameter(d, truth: list, params: dict) -> dict | None:

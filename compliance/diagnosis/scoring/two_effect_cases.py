@@ -25,6 +25,8 @@ import time
 import numpy as np
 
 from compliance.diagnosis.scoring.concealed_cases import _record, draw_effect_params, draw_operating_point
+from compliance.diagnosis.verdicts.candidate_set import CandidateSet
+from compliance.diagnosis.verdicts.verdict import DiagnosisVerdict
 
 # pairs whose signatures sit on different signals or regimes (a leak and a valve null shift, ...)
 PAIRS = (
@@ -57,7 +59,7 @@ def pair_case(cfg, pair, seed: int, variant: str) -> dict:
         op["x0"] = round(float(rng.uniform(WHOLE_STROKE_MARGIN + 0.008, stroke - 0.10 * stroke - 0.008 - WHOLE_STROKE_MARGIN)), 4)
     params = {e: draw_effect_params(rng, e) for e in pair}
     truth = bench_config(cfg, variant).replace(effects=params)
-    frame, meta = _record(truth, op, seed, f"two-effect case {'+'.join(pair)} ({variant})")
+    frame, meta = _record(truth, op, seed, f"two-effect case {CandidateSet.of(pair)} ({variant})")
     if variant == "no_supply" and "supply_pressure" in frame.columns:
         frame = frame.drop(columns=["supply_pressure"])
     return {"pair": list(pair), "variant": variant, "params": params, "operating_point": {**op, "seed": seed},
@@ -96,7 +98,7 @@ def score_pair(case: dict, diag, share: float | None = None) -> dict:
     from compliance.effects import EFFECTS
     from compliance.diagnosis.servo.selection import EXPLAINED_ENOUGH
 
-    named = [e for e in (diag.winner or "").split("+") if e in EFFECTS]
+    named = CandidateSet.parse(diag.winner).effects
     errors = {}
     if diag.winner:
         fit = diag.fits[diag.winner]
@@ -110,7 +112,7 @@ def score_pair(case: dict, diag, share: float | None = None) -> dict:
             "one_named": bool(set(case["pair"]) & set(named)), "main_errors": errors, "seconds": diag.seconds,
             "ambiguous": list(diag.ambiguous), "signals_left": dict(diag.signals_left), "truth_share": share,
             "identifiable": share is None or share >= EXPLAINED_ENOUGH,
-            "honest": diag.verdict in ("partially_explained", "unexplained")}
+            "honest": diag.verdict in (DiagnosisVerdict.PARTIALLY_EXPLAINED, DiagnosisVerdict.UNEXPLAINED)}
 
 
 def _cpu() -> float:
@@ -139,7 +141,7 @@ def run_pairs(cfg, *, cases: int = 6, seed: int = 1, jobs: int = 1, library=None
         rows.append(score_pair(case, d, truth_share(cfg, case)))
         r = rows[-1]
         r["cpu_seconds"] = cpu
-        log(f"{i:2d} {'+'.join(r['pair']):45s} {r['variant']:13s} -> {r['verdict']:20s} {r['winner']} "
+        log(f"{i:2d} {CandidateSet.of(r['pair']).name:45s} {r['variant']:13s} -> {r['verdict']:20s} {r['winner']} "
             f"(both named: {r['both_named']}; truth explains {100*r['truth_share']:.0f} %; {r['seconds']:.0f} s, CPU {cpu:.0f} s)")
     both = sum(r["both_named"] for r in rows)
     ident = [r for r in rows if r["identifiable"]]

@@ -30,22 +30,25 @@ from compliance.errors import InputError, SimulationError
 from compliance.diagnosis.servo.candidates import Candidate, base_params, effect_candidate, signature_order
 from compliance.diagnosis.servo.fit import FitContext, FitResult, chi2_parts
 from compliance.diagnosis.servo.fitted_model import fitted_plant, save_fitted
-from compliance.diagnosis.servo.effect_sets import CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_enough, contributions, set_effects, set_name
+from compliance.diagnosis.servo.effect_sets import CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_enough, contributions, extended_set
 from compliance.diagnosis.evidence.discriminating_test import design_test
 from compliance.diagnosis.evidence.empirical_force import empirical_term
-from compliance.diagnosis.servo.instrument_candidates import (PREFIX, VERDICT, instrument_candidates, instrument_verdict, instrumented,
+from compliance.diagnosis.servo.instrument_candidates import (PREFIX, instrument_candidates, instrument_verdict, instrumented,
                                                        is_instrument)
 from compliance.diagnosis.servo.lag_split import adopted_fit, split_scan
-from compliance.diagnosis.servo.friction_form import OPTION as FORM_OPTION, RETRY_VERDICTS, form_after_effects, friction_form_check
+from compliance.diagnosis.servo.friction_form import OPTION as FORM_OPTION, form_after_effects, friction_form_check
 from compliance.diagnosis.evidence.replay_fit import ReplaySetup, prepare_replay, replay_config, run_replay
 from compliance.diagnosis.evidence.residuals import (UNITS, build_residual_model, null_recording, own_floor_objective, signal_fit,
                                             with_fail_level)
-from compliance.diagnosis.servo.selection import (AMBIGUOUS_BIC, EXPLAINED_ENOUGH, NOISE_TOLERANCE, RESIDUAL_LIMIT, ambiguity_set, honest, same_physics,
+from compliance.diagnosis.servo.selection import (AMBIGUOUS_BIC, EXPLAINED_ENOUGH, NOISE_TOLERANCE, RESIDUAL_LIMIT, ambiguity_set, honest,
                                          score_all, signals_left, verdict)
 from compliance.diagnosis.servo.report_data import SCHEMA
 from compliance.diagnosis.servo.result import Diagnosis
 from compliance.diagnosis.evidence.locate_misfit import event_rms, locate_mismatch, mask_agreement, where_words
-from compliance.diagnosis.servo.parallel_fits import default_jobs, map_tasks
+from compliance.diagnosis.servo.parallel_fits import (ExtendSet, FitEffect, FitWithBase, RecalibrateBase, ScreenAddition,
+                                                     default_jobs, map_tasks)
+from compliance.diagnosis.verdicts.candidate_set import BASE, CandidateSet
+from compliance.diagnosis.verdicts.verdict import EXPLAINED, INCOMPLETE, DiagnosisVerdict
 
 COMBINE_LEVEL = 3.0  # chi2/N of the best single explanation above which effects are refitted with the recalibration
 COMBINE_TOP = 1  # how many effects are refitted with the recalibration
@@ -109,7 +112,7 @@ def _based_search(cfg: PlantConfig, frame, meta: dict, stride: int, jobs: int, n
         st.rebased = True
     _fit_singles(st, names, recalibrate)
     dec = _decide(st)
-    if form and not form["adopted"] and dec["verdict"] in RETRY_VERDICTS:
+    if form and not form["adopted"] and dec["verdict"] in INCOMPLETE:
         form = form_after_effects(form, st.rc, st.setup, st.model, st.fits, jobs)
         if form["adopted"]:  # ... and the whole search runs again on it
             cfg = cfg.replace(options={FORM_OPTION: form["adopted"]})
@@ -136,16 +139,16 @@ def _fit_singles(st: Stage, names, recalibrate: bool) -> None:
     tasks = []
     bparams = base_params(st.rc) if recalibrate else ()
     if bparams:
-        tasks.append(("base", bparams, 2.0 * math.log(n) * max(1.0, chi2 / n)))
-    tasks += [("effect", effect_candidate(e)) for e in signature_order(names, excess)]
-    tasks += [("effect", c) for c in instrument_candidates(st.model.signals, st.setup.closed_loop)]
+        tasks.append(RecalibrateBase(bparams, 2.0 * math.log(n) * max(1.0, chi2 / n)))
+    tasks += [FitEffect(effect_candidate(e)) for e in signature_order(names, excess)]
+    tasks += [FitEffect(c) for c in instrument_candidates(st.model.signals, st.setup.closed_loop)]
     _run(st, tasks)
     base_fit = st.fits.get("base")
     singles = [f for f in st.fits.values() if f.name != "nominal"]
     best = min(singles, key=lambda f: f.chi2, default=None)
     if base_fit is not None and base_fit.k > 0 and best is not None and best.chi2 / n > COMBINE_LEVEL:
         top = sorted((f for f in singles if f.name in EFFECTS), key=lambda f: f.chi2)[:COMBINE_TOP]
-        _run(st, [("combo", Candidate(f"{f.name}+base"), f, base_fit) for f in top])
+        _run(st, [FitWithBase(Candidate(CandidateSet.parse(f.name).plus(BASE).name), f, base_fit) for f in top])
 
 
 def _search_sets(st: Stage, winner: str) -> list[dict]:
@@ -153,21 +156,21 @@ def _search_sets(st: Stage, winner: str) -> list[dict]:
     n = st.model.size
     log = []
     current = st.fits[winner]
-    while len(set_effects(current.name)) < MAX_EFFECTS:
+    while len(CandidateSet.parse(current.name).effects) < MAX_EFFECTS:
         if not signals_left(_objective(st, current.name)):
             break
-        have = set(set_effects(current.name))
+        have = set(CandidateSet.parse(current.name).effects)
         singles = [f for f in st.fits.values() if f.name in EFFECTS and f.name not in have]
-        screened = [r for r, _ in map_tasks([("screen", current, f) for f in singles], st.jobs, st.payload)]
+        screened = [r for r, _ in map_tasks([ScreenAddition(current, f) for f in singles], st.jobs, st.payload)]
         screen = {name: (chi, start) for name, chi, start, _ in screened}
         st.sims += sum(r[3] for r in screened)
         order = sorted(singles, key=lambda f: screen[f.name][0])[:CANDIDATES_PER_ROUND]
-        tasks = [("extend", current, f, screen[f.name][1]) for f in order]
+        tasks = [ExtendSet(current, f, screen[f.name][1]) for f in order]
         if not tasks:
             break
         _run(st, tasks)
         c = max(1.0, min(f.chi2 / max(n - f.k, 1) for f in st.fits.values() if math.isfinite(f.chi2)))
-        tried = sorted((_extended(st, t[1], t[2]) for t in tasks), key=lambda f: f.chi2)
+        tried = sorted((_extended(st, t.current, t.single) for t in tasks), key=lambda f: f.chi2)
         best = tried[0]
         times = np.tile(st.setup.time[st.model.index], len(st.model.signals))  # residuals are signal blocks
         vecs = (st.vecs[current.name], st.vecs[best.name], times) if current.name in st.vecs else None
@@ -180,9 +183,7 @@ def _search_sets(st: Stage, winner: str) -> list[dict]:
 
 
 def _extended(st: Stage, current: FitResult, single: FitResult) -> FitResult:
-    effects = set_effects(current.name) + set_effects(single.name)
-    name = set_name(effects) + ("+base" if any(fp.kind == "base" for fp in current.params) else "")
-    return st.fits[name]
+    return st.fits[extended_set(current, single).name]
 
 
 def _objective(st: Stage, name: str) -> dict:
@@ -200,23 +201,25 @@ def _decide(st: Stage) -> dict:
     # select.NOISE_TOLERANCE), not on the constant floor the JSON reports
     verdict_name, winner, reason = verdict(scores, n, _objective(st, "nominal"), effect_like)
     search = []
-    if winner is not None and winner != "base" and verdict_name != "no_mismatch":
+    if winner is not None and winner != "base" and verdict_name != DiagnosisVerdict.NO_MISMATCH:
         search = _search_sets(st, winner)
         scores = score_all(st.fits, n)  # the sets tried are candidates too
         kept = [r for r in search if r["kept"]]
         if kept:
             winner = kept[-1]["best"]
-            reason = f"{' and '.join(set_effects(winner))} together explain {100*scores[winner].explained:.0f} % of the excess residual"
-            verdict_name = "missing_physics" if scores[winner].explained >= EXPLAINED_ENOUGH else "unexplained"
+            explained = scores[winner].explained
+            reason = f"{' and '.join(CandidateSet.parse(winner).effects)} together explain {100*explained:.0f} % of the excess residual"
+            verdict_name = DiagnosisVerdict.MISSING_PHYSICS if explained >= EXPLAINED_ENOUGH else DiagnosisVerdict.UNEXPLAINED
     verdict_name, winner, reason = instrument_verdict(scores, n, (verdict_name, winner, reason),
                                                       [k for k in st.fits if k.startswith(PREFIX)])
     after = _own_floors(st, winner, verdict_name)
     verdict_name, reason = honest(verdict_name, winner, reason, after)
     objectives = {k: _objective(st, k) for k in st.fits if k != "nominal"}
     plant_scores = {k: v for k, v in scores.items() if not is_instrument(k)}  # instruments were settled by beats()
-    ambiguous = ambiguity_set(plant_scores, winner, objectives) if verdict_name not in ("no_mismatch", VERDICT) else []
-    if ambiguous and verdict_name in ("missing_physics", "parameters_only"):
-        verdict_name = "ambiguous"
+    settled = (DiagnosisVerdict.NO_MISMATCH, DiagnosisVerdict.INSTRUMENTATION)
+    ambiguous = ambiguity_set(plant_scores, winner, objectives) if verdict_name not in settled else []
+    if ambiguous and verdict_name in EXPLAINED:
+        verdict_name = DiagnosisVerdict.AMBIGUOUS
         reason = (f"{' and '.join(ambiguous)} explain the recording equally well (every signal within "
                   f"{RESIDUAL_LIMIT:g} x its floor, or BIC within {AMBIGUOUS_BIC:g}); another test tells them apart")
     return {"scores": scores, "verdict": verdict_name, "winner": winner, "reason": reason, "search": search,
@@ -228,7 +231,7 @@ def _own_floors(st: Stage, winner: str | None, verdict_name: str) -> dict | None
     unless the base is already another friction form (one relaxation of the yardstick at a time: on the pairs
     benchmark, floors from a substitute friction law plus its winner's own passed wrong pairs as complete)."""
     after = _objective(st, winner) if winner else None
-    if verdict_name in ("missing_physics", "parameters_only") and signals_left(after) and winner in st.vecs \
+    if verdict_name in EXPLAINED and signals_left(after) and winner in st.vecs \
             and not st.rebased:
         w = st.fits[winner]
         try:
@@ -261,7 +264,7 @@ def _window_rows(st: Stage, seg_win) -> list:
 
 def _empirical(st: Stage, dec: dict) -> dict | None:
     """Stage 7: outside the library, the missing force the recording implies (evidence/empirical_force.py)."""
-    if dec["verdict"] not in ("unexplained", "partially_explained"):
+    if dec["verdict"] not in INCOMPLETE:
         return None
     w = dec["winner"]
     cfg = apply(st.rc, st.fits[w].params, st.fits[w].values) if w else st.rc
@@ -314,7 +317,7 @@ def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | N
     agreement = {k: mask_agreement(st.model, st.nvec, st.vecs[k], st.event_mask) for k in st.fits if k in st.vecs}
     ranked = sorted((k for k in st.fits if k != "nominal"), key=lambda k: (dec["scores"][k].bic, -agreement.get(k, 0.0)))
     runner = (ranked[0] if ranked else None) if winner is None else next(
-        (k for k in ranked if k != winner and not same_physics(k, winner)), None)
+        (k for k in ranked if k != winner and not CandidateSet.parse(k).same_physics(CandidateSet.parse(winner))), None)
     # full closed-loop replays for the figures a test engineer reproduces
     full = dc_replace(st.setup, resets=np.array([0]))
     full_nom = run_replay(st.rc, full)
@@ -323,38 +326,35 @@ def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | N
     if winner is not None:
         w = st.fits[winner]
         wcfg = apply(st.rc, w.params, w.values)
-        if verdict_name in ("missing_physics", "parameters_only", "partially_explained", "ambiguous", VERDICT):
+        if verdict_name in (*EXPLAINED, DiagnosisVerdict.PARTIALLY_EXPLAINED, DiagnosisVerdict.AMBIGUOUS,
+                            DiagnosisVerdict.INSTRUMENTATION):
             full_win = _safe_replay(wcfg, instrumented(full, w.params, w.values), notes, "full closed-loop replay of the winner")
             fitted_cfg = None if is_instrument(winner) else fitted_plant(cfg, w, meta)
         seg_win = _safe_replay(wcfg, instrumented(st.setup, w.params, w.values), notes, "replay of the winner")
     st.sims += 1 + (full_win is not None) + (seg_win is not None)
-    diag = Diagnosis(
+    contrib = _contributions(st, winner)  # its replays count in st.sims
+    pair = dec["ambiguous"] or ([winner, runner] if suggest_test and winner and runner else [])
+    suggested, empirical = _suggest(st, pair), _empirical(st, dec)
+    return Diagnosis(
         verdict=verdict_name, reason=dec["reason"], winner=winner, runner_up=runner, fits=st.fits, scores=dec["scores"],
         fit_before=signal_fit(st.model, full_nom), fit_after=signal_fit(st.model, full_win) if full_win is not None else None,
         objective_before=_objective(st, "nominal"), objective_after=dec["after"] if winner else None,
-        windows=_window_rows(st, seg_win), floors=dict(st.model.floors), explanation="", cfg=cfg, fitted_cfg=fitted_cfg,
-        recording=st.setup.source, seconds=0.0, simulations=st.sims, jobs=jobs, notes=notes,
+        windows=_window_rows(st, seg_win), floors=dict(st.model.floors), cfg=cfg, fitted_cfg=fitted_cfg,
+        recording=st.setup.source, seconds=time.perf_counter() - t0,
+        simulations=st.sims + (split["replays"] if split else 0), jobs=jobs, notes=notes,
         traces={"time": st.setup.time, "recorded": st.model.recorded, "before": full_nom, "after": full_win,
                 "objective_before": st.nominal_sim, "objective_after": seg_win},
+        agreement=agreement, located_regimes=where_words(st.events), ambiguous=dec["ambiguous"], signals_left=dec["left"],
+        search=dec["search"], contributions=contrib, suggested_test=suggested, empirical=empirical, split=split,
+        friction_form=form,
     )
-    diag.agreement, diag.friction_form = agreement, form
-    diag.located_regimes = where_words(st.events)
-    diag.ambiguous, diag.signals_left, diag.search = dec["ambiguous"], dec["left"], dec["search"]
-    diag.contributions = _contributions(st, winner)
-    pair = dec["ambiguous"] or ([winner, runner] if suggest_test and winner and runner else [])
-    diag.suggested_test, diag.empirical, diag.split = _suggest(st, pair), _empirical(st, dec), split
-    diag.simulations += split["replays"] if split else 0
-    from compliance.diagnosis.servo.explanation import explain
-    diag.explanation = explain(diag)
-    diag.seconds = time.perf_counter() - t0
-    return diag
 
 
 def _split(st: Stage, winner: str | None, verdict_name: str, dec: dict) -> dict | None:
     """Does the recording pin the split of the winner's lag, or its total only (``servo.lag_split.split_scan``)?
     An undetermined split moves to the segments' estimate (the winner's fit, scores and what is left follow)."""
-    lag = next((e for e in (winner or "").split("+") if e in EFFECTS and EFFECTS[e].lumped is not None), None)
-    if lag is None or verdict_name == "unexplained":
+    lag = next((e for e in CandidateSet.parse(winner).effects if EFFECTS[e].lumped is not None), None)
+    if lag is None or verdict_name == DiagnosisVerdict.UNEXPLAINED:
         return None
     ctx = FitContext(st.rc, st.setup, st.model)
     sp = split_scan(ctx, st.fits[winner], lag, st.vecs.get(winner))
@@ -368,7 +368,7 @@ def _split(st: Stage, winner: str | None, verdict_name: str, dec: dict) -> dict 
 
 def _contributions(st: Stage, winner: str | None) -> dict:
     """Effect -> its own share of the nominal excess in the winning set (switched off alone)."""
-    if winner is None or not set_effects(winner):
+    if winner is None or not CandidateSet.parse(winner).effects:
         return {}
     ctx = FitContext(st.rc, st.setup, st.model)
     raw = contributions(ctx, st.fits[winner])

@@ -30,6 +30,7 @@ from compliance.effects import EFFECTS
 from compliance.diagnosis.servo.candidates import effect_candidate
 from compliance.diagnosis.servo.fit import FitContext, FitResult, least_squares_fit, scan_points
 from compliance.diagnosis.servo.selection import RESIDUAL_LIMIT, SIGNIFICANCE
+from compliance.diagnosis.verdicts.candidate_set import BASE, CandidateSet
 
 ADD_GAIN = 0.3  # share of the current set's excess chi-square an added effect must remove
 NO_WORSE = 1.25  # no signal's chi-square may rise by more than this factor when an effect is added
@@ -41,14 +42,11 @@ BURST_WINDOW = 2.0
 SET_SIMPLEX_FEV = 8  # simplex evaluations per parameter of a set refit (it starts near the optimum)
 
 
-def set_name(effects) -> str:
-    """Canonical candidate name of an effect set (``a+b``, in the order they were found)."""
-    return "+".join(effects)
-
-
-def set_effects(name: str) -> list[str]:
-    """Effect names of a candidate name (``base`` and ``nominal`` dropped)."""
-    return [e for e in name.split("+") if e in EFFECTS]
+def extended_set(current: FitResult, single: FitResult) -> CandidateSet:
+    """The set ``extend_fit`` makes: ``current``'s effects, then ``single``'s, then ``base`` when ``current``
+    recalibrates the base parameters."""
+    recalibrated = [BASE] if any(fp.kind == "base" for fp in current.params) else []
+    return CandidateSet.of(CandidateSet.parse(current.name).effects + CandidateSet.parse(single.name).effects + recalibrated)
 
 
 def _start_points(current: FitResult, single: FitResult) -> tuple[tuple, list[list[float]]]:
@@ -99,9 +97,7 @@ def extend_fit(ctx: FitContext, current: FitResult, single: FitResult, start: li
     if start is None:
         chis = scan_points(ctx, params, starts)
         start = starts[min(range(len(chis)), key=chis.__getitem__)]
-    names = set_effects(current.name) + set_effects(single.name)
-    name = set_name(names) + ("+base" if any(fp.kind == "base" for fp in params) else "")
-    return least_squares_fit(ctx, name, params, start, simplex_fev=SET_SIMPLEX_FEV)
+    return least_squares_fit(ctx, extended_set(current, single).name, params, start, simplex_fev=SET_SIMPLEX_FEV)
 
 
 def burst_trimmed(cur_vec, new_vec, times) -> tuple[float, float]:
@@ -151,7 +147,7 @@ def adds_enough(new: FitResult, current: FitResult, n: int, penalty_per_param: f
 def contributions(ctx: FitContext, fit: FitResult) -> dict[str, float]:
     """Effect -> chi-square the fitted set loses when that effect alone is switched off."""
     out = {}
-    names = set_effects(fit.name)
+    names = CandidateSet.parse(fit.name).effects
     if len(names) < 1:
         return out
     for e in names:
@@ -161,5 +157,5 @@ def contributions(ctx: FitContext, fit: FitResult) -> dict[str, float]:
     return out
 
 
-__all__ = ["extend_fit", "adds_enough", "contributions", "set_name", "set_effects", "ADD_GAIN", "NO_WORSE",
+__all__ = ["extend_fit", "adds_enough", "contributions", "extended_set", "ADD_GAIN", "NO_WORSE",
            "CANDIDATES_PER_ROUND", "MAX_EFFECTS", "screen_addition", "burst_trimmed", "BURST_WINDOW"]

@@ -7,6 +7,8 @@ from compliance.diagnosis.servo.candidates import FRICTION_LEVEL
 from compliance.diagnosis.servo.friction_form import form_words
 from compliance.diagnosis.servo.instrument_candidates import PREFIX, finding_words, is_instrument
 from compliance.units.formatting import fmt_dbic, fmt_num, fmt_si
+from compliance.diagnosis.verdicts.candidate_set import CandidateSet
+from compliance.diagnosis.verdicts.verdict import DiagnosisVerdict
 
 # how each effect reads in words, with its main fitted value ({v} is filled in): ``Effect.explanation``
 PHYSICS = {name: eff.explanation for name, eff in EFFECTS.items()}
@@ -25,7 +27,7 @@ def effect_words(key: str | None) -> str:
         return "recalibrating the base parameters"
     # the declaration's meaning up to its colon (the rest is the mechanism, which the signature already gives)
     return " together with ".join(EFFECTS[k].meaning.split(":")[0].strip() if k in EFFECTS else k.replace("_", " ")
-                                  for k in key.split("+"))
+                                  for k in CandidateSet.parse(key).terms)
 
 
 def _param_words(fp) -> str:
@@ -178,18 +180,18 @@ def explain(d) -> str:
     text = _explain_core(d)
     if d.winner and not is_instrument(d.winner) and PREFIX in d.winner:
         text += f" Check your instrumentation too: {finding_words(d.fits[d.winner])}."
-    if d.verdict == "partially_explained":
+    if d.verdict == DiagnosisVerdict.PARTIALLY_EXPLAINED:
         text += f" It does not explain everything: what is left sits on {_left(d)}."
     return text + form_words(getattr(d, "friction_form", None)) + _contribution_words(d) + _ambiguity_words(d) + _empirical(d)
 
 
 def _explain_core(d) -> str:
-    worst_sig, worst = _worst(d, objective=d.verdict == "no_mismatch")
-    if d.verdict == "no_mismatch":
+    worst_sig, worst = _worst(d, objective=d.verdict == DiagnosisVerdict.NO_MISMATCH)
+    if d.verdict == DiagnosisVerdict.NO_MISMATCH:
         return (f"Nothing is wrong: the nominal model reproduces the recording to within the sensor noise on every "
                 f"measured signal (the largest residual is {worst:.2f} times its noise floor, on the {SIGNAL_WORDS[worst_sig]}). "
                 f"No physics is missing and no parameter needs refitting.")
-    if d.verdict == "unexplained" or d.winner is None:
+    if d.verdict == DiagnosisVerdict.UNEXPLAINED or d.winner is None:
         best = d.winner or d.runner_up
         share = d.scores[best].explained * 100 if best in d.scores else 0.0
         return (f"The model misses the recording {_where(d)} (the {SIGNAL_WORDS[worst_sig]} residual is {worst:.1f} times its "
@@ -201,13 +203,13 @@ def _explain_core(d) -> str:
         return (f"Check your instrumentation: the plant is not shown to be wrong. The model misses the recording {_where(d)} "
                 f"(the {SIGNAL_WORDS[worst_sig]} residual is {worst:.1f} times its noise floor) the way an instrument does: "
                 f"{finding_words(fit)}. No plant-physics explanation beats it." + (f" With it, {change}." if change else ""))
-    if d.verdict == "parameters_only" or d.winner == "base":
+    if d.verdict == DiagnosisVerdict.PARAMETERS_ONLY or d.winner == "base":
         return (f"No physics is missing. The model misses the recording {_where(d)} (the {SIGNAL_WORDS[worst_sig]} residual is "
                 f"{worst:.1f} times its noise floor) because base parameters are off: {_base_changes(d, fit)}. "
                 f"With them {change}." if change else f"No physics is missing: {_base_changes(d, fit)}.")
-    if len([e for e in d.winner.split("+") if e in EFFECTS]) > 1:
+    if len(CandidateSet.parse(d.winner).effects) > 1:
         return _explain_set(d, fit, worst_sig, worst, change)
-    effect = d.winner.split("+")[0]
+    effect = CandidateSet.parse(d.winner).first
     eff = EFFECTS[effect]
     main = next(i for i, fp in enumerate(fit.params) if fp.kind == "effect")
     fp = fit.params[main]
@@ -242,7 +244,7 @@ def _explain_core(d) -> str:
 
 def _explain_set(d, fit, worst_sig, worst, change) -> str:
     """Several effects together (the multi-effect search)."""
-    effects = [e for e in d.winner.split("+") if e in EFFECTS]
+    effects = CandidateSet.parse(d.winner).effects
     parts = []
     for e in effects:
         vals = [f"{_param_words(q)} {_pm(v, err, q.unit)}" for q, v, err in zip(fit.params, fit.values, fit.stderr) if q.effect == e]

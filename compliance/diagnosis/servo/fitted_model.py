@@ -29,9 +29,7 @@ def save_fitted(diag, path) -> Path:
     """Write the fitted configuration (never overwrites; ``save_plant`` refuses)."""
     if diag.fitted_cfg is None:
         raise InputError(f"{path}: nothing to save: the verdict is '{diag.verdict}' (no fitted model)")
-    out = save_plant(diag.fitted_cfg, path)
-    diag.saved_model = str(out)
-    return out
+    return save_plant(diag.fitted_cfg, path)
 
 
 __all__ = ["fitted_plant", "save_fitted"]

@@ -16,7 +16,7 @@ replay wanders more). Otherwise nothing changes (one extra replay).
 A dominant effect can hide the form: a valve lag of 30-50 rad/s makes most of the nominal misfit, so
 the other form alone removes little of it, and under the declared form the lag's own fit fails (the
 stick band decides where the piston stalls) while a sensor lag stands in for it. So when the declared
-form keeps the base and the search's verdict is incomplete (``RETRY_VERDICTS``), the form is tried
+form keeps the base and the search's verdict is incomplete (``verdicts.verdict.INCOMPLETE``), the form is tried
 again with the effects on (``form_after_effects``): each single-effect fit is replayed with the other
 form (one replay each, ``friction_form_check`` with the fit as the nominal), the ``FORM_REFITS`` that
 it improves most are refitted under the other form (the declared plant's floors), and the best refit
@@ -37,13 +37,12 @@ from compliance.diagnosis.servo.candidates import effect_candidate
 from compliance.diagnosis.servo.fit import chi2_parts
 from compliance.diagnosis.evidence.replay_fit import run_replay
 from compliance.diagnosis.servo.selection import MIN_GAIN, SIGNIFICANCE, beats, score_all
-from compliance.diagnosis.servo.parallel_fits import map_tasks
+from compliance.diagnosis.servo.parallel_fits import FitEffect, map_tasks
 
 OPTION = "friction.model"
 # forms with one steady-state map (same parameters); the piecewise Stribeck law (seed 001 eq. 8)
 # has its own parameters, so it is not an alternative form of the same plant
 SAME_MAP_FORMS = ("lugre", "variable_viscous")
-RETRY_VERDICTS = ("unexplained", "partially_explained")  # incomplete verdicts after which the form is tried again
 FORM_REFITS = 4  # single effects refitted under the other form (those its replay improves most)
 
 
@@ -130,7 +129,7 @@ def form_after_effects(check: dict, rc, setup, model, fits: dict, jobs: int) -> 
                 screened[name] = tried[other]
     order = sorted(screened, key=screened.get)[:FORM_REFITS]
     payload = (plant_to_toml(rc.replace(options={OPTION: other})), setup, model)
-    tasks = [("effect", effect_candidate(e)) for e in order]
+    tasks = [FitEffect(effect_candidate(e)) for e in order]
     refits = {f"{r.name}@{other}": r for r, _ in map_tasks(tasks, jobs, payload)} if tasks else {}
     replays += sum(r.sims + 1 for r in refits.values())
     out["replays"] = check["replays"] + replays

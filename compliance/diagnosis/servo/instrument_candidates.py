@@ -22,13 +22,13 @@ from dataclasses import replace
 from compliance.model.parameters import ParamHandle
 from compliance.diagnosis.servo.candidates import Candidate
 from compliance.validation.logger_model import FILTERED, PRESSURES, LoggerModel
+from compliance.diagnosis.verdicts.verdict import DiagnosisVerdict
 
 PREFIX = "instrument:"
 KIND = "instrument"
 MAX_OFFSET = 0.02  # s; largest channel time offset fitted
 MAX_GAIN_ERROR = 0.10  # relative; largest transducer gain error fitted
 OFFSET_GRID = (-0.004, 0.0, 0.004)  # s; starting points of an offset fit
-VERDICT = "instrumentation"
 MEANING = {
     "pressure_time_offset": "the pressure channels are logged {v} later than position and command (a time offset "
                             "between channel groups, e.g. a second acquisition module)",
@@ -115,7 +115,7 @@ def instrument_verdict(scores: dict, n: int, decided: tuple, names) -> tuple:
 
     verdict_name, winner, reason = decided
     names = [k for k in names if k in scores]
-    if verdict_name == "no_mismatch" or not names:
+    if verdict_name == DiagnosisVerdict.NO_MISMATCH or not names:
         return decided
     best = min(names, key=lambda k: scores[k].bic)
     if not beats(scores, best, "nominal", n) or scores[best].explained < EXPLAINED_ENOUGH:
@@ -124,5 +124,5 @@ def instrument_verdict(scores: dict, n: int, decided: tuple, names) -> tuple:
         return decided
     why = (f"{best[len(PREFIX):].replace('_', ' ')} explains {100 * scores[best].explained:.0f} % of the excess residual"
            + (f" and {winner} does not beat it" if winner else "") + ": check the instrumentation, not the plant")
-    return VERDICT, best, why
+    return DiagnosisVerdict.INSTRUMENTATION, best, why
 

@@ -37,10 +37,11 @@ from compliance.errors import InputError
 from compliance.files.jsonable import json_number
 from compliance.model.config import PlantConfig, plant_from_dict
 from compliance.diagnosis.servo.candidates import base_params, effect_candidate, signature_order
-from compliance.diagnosis.servo.fit import FitContext, FitResult, chi2_parts, fit_candidate
-from compliance.diagnosis.servo.recalibration import forward_select_base
+from compliance.diagnosis.servo.fit import FitContext, FitResult, chi2_parts
 from compliance.diagnosis.servo.report_data import SCHEMA
 from compliance.diagnosis.servo.selection import AMBIGUOUS_BIC, RESIDUAL_LIMIT, ambiguity_set, honest, score_all, signals_left, verdict
+from compliance.diagnosis.verdicts.verdict import EXPLAINED, DiagnosisVerdict
+from compliance.diagnosis.servo.parallel_fits import FitEffect, RecalibrateBase
 
 _WORKER: dict = {}  # token -> JointContext, built once per worker process
 SCREEN_SHARE = 0.02  # share of the nominal excess chi-square an effect's best grid point must remove to be refined
@@ -126,13 +127,8 @@ def _worker_context(payload) -> JointContext:
 
 
 def _task(payload, task) -> FitResult:
-    """One joint fit on a worker: ('base', params, penalty) or ('effect', name, screen chi-square)."""
-    ctx = _worker_context(payload)
-    if task[0] == "base":
-        res, log = forward_select_base(ctx, task[1], penalty=task[2])
-        res.scan = log
-        return res
-    return fit_candidate(ctx, effect_candidate(task[1]), None, screen=task[2])
+    """One joint fit on a worker: a ``RecalibrateBase`` or a ``FitEffect`` (``servo.parallel_fits``)."""
+    return task.fit(_worker_context(payload))
 
 
 def _prepare_task(context, item):
@@ -238,12 +234,12 @@ def _fit_all(stages, labels, names, recalibrate, jobs, scheduler) -> tuple[dict,
     keys = recalibrate if isinstance(recalibrate, (tuple, list)) else None
     bparams = (base_params(stages[0].rc, keys) if keys else base_params(stages[0].rc)) if recalibrate else ()
     if bparams:
-        tasks.append(("base", bparams, 2.0 * math.log(n) * max(1.0, chi2_nom / n)))
+        tasks.append(RecalibrateBase(bparams, 2.0 * math.log(n) * max(1.0, chi2_nom / n)))
     # an effect none of whose grid points removes SCREEN_SHARE of the nominal excess is not refined (our choice:
     # a candidate must remove select.MIN_GAIN = 25 % to matter; the refinement of one that starts at 2 % costs the
     # same replays as a real one, times the number of recordings)
     screen = chi2_nom - SCREEN_SHARE * max(chi2_nom - n, 0.0)
-    tasks += [("effect", e, screen) for e in signature_order(names, excess)]
+    tasks += [FitEffect(effect_candidate(e), screen) for e in signature_order(names, excess)]
     token = f"joint-{time.time_ns()}"
     payload = (token, tuple(labels), [(plant_to_toml(s.rc), s.setup, s.model) for s in stages])
     results, stats = map_tasks(_task, payload, tasks, workers=jobs, scheduler=scheduler, progress=False,
@@ -297,9 +293,9 @@ def diagnose_joint(cfg: PlantConfig, recordings, *, effects=None, jobs: int | No
     effect_like = [k for k in fits if k not in ("nominal", "base")]
     verdict_name, winner, reason = verdict(scores, n, objectives["nominal"], effect_like)
     verdict_name, reason = honest(verdict_name, winner, reason, objectives.get(winner) if winner else None)
-    ambiguous = ambiguity_set(scores, winner, objectives) if verdict_name != "no_mismatch" else []
-    if ambiguous and verdict_name in ("missing_physics", "parameters_only"):
-        verdict_name = "ambiguous"
+    ambiguous = ambiguity_set(scores, winner, objectives) if verdict_name != DiagnosisVerdict.NO_MISMATCH else []
+    if ambiguous and verdict_name in EXPLAINED:
+        verdict_name = DiagnosisVerdict.AMBIGUOUS
         reason = (f"{' and '.join(ambiguous)} explain the {len(stages)} recording(s) equally well (every signal within "
                   f"{RESIDUAL_LIMIT:g} x its floor, or BIC within {AMBIGUOUS_BIC:g}); another test tells them apart")
     recs = [{"label": lab, "source": s.setup.source, "conditions": {k: json_number(v) if not isinstance(v, str) else v

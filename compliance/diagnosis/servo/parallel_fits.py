@@ -1,7 +1,8 @@
 """Parallel fits of one diagnosis: worker processes that each hold the recording's fit context.
 
 The recording's replay set-up and residual model are sent once per worker (initializer); each
-task then names a candidate to fit (``_run_task``). Processes are forked where the platform
+task is a small frozen record of what to fit (``RecalibrateBase``, ``FitEffect``, ``FitWithBase``,
+``ExtendSet``) or to screen (``ScreenAddition``), run by ``_run_task``. Processes are forked where the platform
 allows it (no re-import of the compiled core).
 """
 
@@ -9,14 +10,76 @@ from __future__ import annotations
 
 import os
 import tomllib
+from dataclasses import dataclass
 
 from compliance.model.config import plant_from_dict
-from compliance.diagnosis.servo.fit import FitContext, fit_candidate, least_squares_fit
+from compliance.diagnosis.servo.candidates import Candidate
+from compliance.model.parameters import ParamHandle
+from compliance.diagnosis.servo.fit import FitContext, FitResult, fit_candidate, least_squares_fit
 from compliance.diagnosis.servo.recalibration import forward_select_base
 from compliance.diagnosis.servo.effect_sets import extend_fit, screen_addition
 from compliance.diagnosis.evidence.replay_fit import ReplaySetup
 
 _WORKER: dict = {}
+
+
+@dataclass(frozen=True)
+class RecalibrateBase:
+    """Greedy forward selection of the base parameters ``params`` (``penalty`` per added parameter)."""
+
+    params: tuple[ParamHandle, ...]
+    penalty: float
+
+    def fit(self, ctx: FitContext) -> FitResult:
+        res, log = forward_select_base(ctx, self.params, penalty=self.penalty)
+        res.scan = log
+        return res
+
+
+@dataclass(frozen=True)
+class FitEffect:
+    """One candidate on the nominal plant; not refined when no grid point gets below ``screen`` (a chi-square)."""
+
+    candidate: Candidate
+    screen: float | None = None
+
+    def fit(self, ctx: FitContext) -> FitResult:
+        return fit_candidate(ctx, self.candidate, None, screen=self.screen)
+
+
+@dataclass(frozen=True)
+class FitWithBase:
+    """An effect refitted together with the recalibrated base parameters, from both fits' values."""
+
+    candidate: Candidate
+    effect_fit: FitResult
+    base_fit: FitResult
+
+    def fit(self, ctx: FitContext) -> FitResult:
+        params = tuple(self.effect_fit.params) + tuple(self.base_fit.params)
+        # start exactly at the effect's optimum (base parameters nominal): the combination can only improve on it
+        start = list(self.effect_fit.values) + [fp.nominal for fp in self.base_fit.params]
+        return least_squares_fit(ctx, self.candidate.name, params, start, simplex_fev=8)
+
+
+@dataclass(frozen=True)
+class ExtendSet:
+    """The effect set ``current`` refitted with ``single``'s effect added, from ``start`` (None: the best start)."""
+
+    current: FitResult
+    single: FitResult
+    start: list[float] | None = None
+
+    def fit(self, ctx: FitContext) -> FitResult:
+        return extend_fit(ctx, self.current, self.single, self.start)
+
+
+@dataclass(frozen=True)
+class ScreenAddition:
+    """``single``'s effect switched on in the set ``current``, unfitted (``effect_sets.screen_addition``)."""
+
+    current: FitResult
+    single: FitResult
 
 
 def _init_worker(toml_text: str, setup: ReplaySetup, model) -> None:
@@ -25,27 +88,12 @@ def _init_worker(toml_text: str, setup: ReplaySetup, model) -> None:
 
 
 def _run_task(task):
-    """One unit of parallel work: ('base', params) | ('effect', Candidate) | ('combo', Candidate, FitResult)
-    | ('extend', FitResult of a set, FitResult of a single effect, start values or None)
-    | ('screen', FitResult of a set, FitResult of a single effect)."""
+    """One unit of parallel work: a fit -> (FitResult, residual vector); a screen -> ((effect, chi-square,
+    start, replays) of ``effect_sets.screen_addition``, None): no fit, no residual."""
     ctx: FitContext = _WORKER["ctx"]
-    kind = task[0]
-    if kind == "screen":  # (effect, chi-square, start, replays) of multi.screen_addition; no fit, no residual
-        return screen_addition(ctx, task[1], task[2]), None
-    if kind == "extend":
-        res = extend_fit(ctx, *task[1:])
-    elif kind == "base":
-        penalty = task[2]
-        res, log = forward_select_base(ctx, task[1], penalty=penalty)
-        res.scan = log
-    elif kind == "effect":
-        res = fit_candidate(ctx, task[1], None)
-    else:  # combination: effect + recalibrated base parameters, from both fits' values
-        cand, eff_fit, base_fit = task[1], task[2], task[3]
-        params = tuple(eff_fit.params) + tuple(base_fit.params)
-        # start exactly at the effect's optimum (base parameters nominal): the combination can only improve on it
-        start = list(eff_fit.values) + [fp.nominal for fp in base_fit.params]
-        res = least_squares_fit(ctx, cand.name, params, start, simplex_fev=8)
+    if isinstance(task, ScreenAddition):
+        return screen_addition(ctx, task.current, task.single), None
+    res = task.fit(ctx)
     vec, _ = ctx.residual(res.params, res.values)
     return res, vec
 

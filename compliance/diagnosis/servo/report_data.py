@@ -10,6 +10,7 @@ from compliance.model.parameters import BASE_BY_KEY
 from compliance.diagnosis.servo.candidates import FRICTION_LEVEL
 from compliance.diagnosis.evidence.residuals import UNITS
 from compliance.diagnosis.servo.selection import RESIDUAL_LIMIT
+from compliance.diagnosis.verdicts.candidate_set import CandidateSet
 
 SCHEMA = "govcheck-diagnosis/1"  # docs/diagnosis-schema.md
 
@@ -39,7 +40,7 @@ def _param_rows(cfg, fit) -> list[dict]:
 def _lumped_rows(fit, name: str) -> list[dict]:
     """The declared lumped combinations (e.g. a total lag) of the effects in a fit, with errors."""
     rows = []
-    for e in name.split("+"):
+    for e in CandidateSet.parse(name).terms:
         got = fit.lumped(e) if e in EFFECTS else None
         if got is not None:
             decl = EFFECTS[e].lumped
@@ -75,7 +76,7 @@ def _ambiguity(d) -> dict | None:
             "suggested_test": _clean(d.suggested_test)}
 
 
-def diagnosis_to_dict(d) -> dict:
+def diagnosis_to_dict(d, saved_model: str | None = None) -> dict:
     """Serialise a ``servo.diagnose.Diagnosis`` (see docs/diagnosis-schema.md)."""
     ranked = d.ranked()
     agreement = d.agreement
@@ -88,7 +89,7 @@ def diagnosis_to_dict(d) -> dict:
             "rank": rank,
             "name": name,
             "kind": kind,
-            "effects": [e for e in name.split("+") if e in EFFECTS],
+            "effects": CandidateSet.parse(name).effects,
             "parameters": _param_rows(d.cfg, f),
             "lumped": _lumped_rows(f, name),
             "k": f.k,
@@ -133,7 +134,7 @@ def diagnosis_to_dict(d) -> dict:
         "empirical": _clean(d.empirical),
         "split": _clean(getattr(d, "split", None)),
         "friction_form": _clean(getattr(d, "friction_form", None)),
-        "saved_model": d.saved_model,
+        "saved_model": saved_model,
         "notes": list(d.notes),
         "timing": {"seconds": json_number(d.seconds), "simulations": d.simulations, "jobs": d.jobs},
     }

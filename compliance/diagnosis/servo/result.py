@@ -1,18 +1,20 @@
-"""The result of one diagnosis of a servo recording (``servo.diagnose.diagnose`` builds it)."""
+"""The result of one diagnosis of a servo recording (``servo.diagnose.diagnose`` builds it once: frozen)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 from compliance.model.config import PlantConfig
 from compliance.diagnosis.servo.report_data import diagnosis_to_dict
+from compliance.diagnosis.verdicts.verdict import DiagnosisVerdict
 
 
-@dataclass
+@dataclass(frozen=True)
 class Diagnosis:
-    """Result of ``diagnose`` (``to_dict`` gives the documented JSON)."""
+    """Result of ``diagnose`` (``to_dict`` gives the documented JSON); every field is known when it is built."""
 
-    verdict: str
+    verdict: DiagnosisVerdict
     reason: str
     winner: str | None
     runner_up: str | None
@@ -24,7 +26,6 @@ class Diagnosis:
     objective_after: dict
     windows: list
     floors: dict
-    explanation: str
     cfg: PlantConfig
     fitted_cfg: PlantConfig | None
     recording: str
@@ -33,7 +34,6 @@ class Diagnosis:
     jobs: int
     notes: list = field(default_factory=list)
     traces: dict = field(default_factory=dict)
-    saved_model: str | None = None
     agreement: dict = field(default_factory=dict)  # candidate -> share of its chi-square gain inside the windows
     located_regimes: list = field(default_factory=list)
     ambiguous: list = field(default_factory=list)  # explanations the recording cannot tell apart (winner first)
@@ -49,10 +49,16 @@ class Diagnosis:
         """Candidate names by BIC, best first (nominal included)."""
         return sorted(self.scores, key=lambda k: self.scores[k].bic)
 
-    def to_dict(self) -> dict:
-        """The JSON document of docs/diagnosis-schema.md."""
+    @cached_property
+    def explanation(self) -> str:
+        """The finding in words (``servo.explanation.explain``), written from the fields above when first read."""
+        from compliance.diagnosis.servo.explanation import explain
 
-        return diagnosis_to_dict(self)
+        return explain(self)
+
+    def to_dict(self, saved_model: str | None = None) -> dict:
+        """The JSON document of docs/diagnosis-schema.md (``saved_model``: where ``save_fitted`` wrote the fitted plant)."""
+        return diagnosis_to_dict(self, saved_model)
 
 
 __all__ = ["Diagnosis"]

@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from compliance.diagnosis.verdicts.candidate_set import CandidateSet
+from compliance.diagnosis.verdicts.verdict import EXPLAINED, DiagnosisVerdict
 
 # nominal normalised RMS at or below which a signal agrees "within the noise floor", judged on the re-synchronised
 # replay with the time-resolved floors (the fits' objective, as RESIDUAL_LIMIT is). Not on the constant floor: a
@@ -116,17 +118,17 @@ def verdict(scores: dict[str, Score], n: int, nominal_rms: dict, effect_names) -
     elif best_eff is not None and ref == "base" and scores[best_eff].bic < scores["base"].bic and beats(scores, best_eff, "nominal", n):
         winner = best_eff  # the effect explains what the recalibration does, more cheaply
     if within:
-        return "no_mismatch", None, (
+        return DiagnosisVerdict.NO_MISMATCH, None, (
             f"the nominal model already fits to within the noise floor (largest normalised RMS "
             f"{max(nominal_rms.values()):.2f} <= {NOISE_TOLERANCE})")
     if winner == "nominal":
-        return "unexplained", None, "the nominal model misses the recording and no candidate improves it significantly"
+        return DiagnosisVerdict.UNEXPLAINED, None, "the nominal model misses the recording and no candidate improves it significantly"
     if scores[winner].explained < EXPLAINED_ENOUGH:
-        return "unexplained", winner, (
+        return DiagnosisVerdict.UNEXPLAINED, winner, (
             f"the best candidate ({winner}) removes only {100*scores[winner].explained:.0f} % of the excess residual")
     if winner == "base":
-        return "parameters_only", "base", "recalibrating base parameters explains the recording; no physics is missing"
-    return "missing_physics", winner, f"{winner} explains {100*scores[winner].explained:.0f} % of the excess residual"
+        return DiagnosisVerdict.PARAMETERS_ONLY, "base", "recalibrating base parameters explains the recording; no physics is missing"
+    return DiagnosisVerdict.MISSING_PHYSICS, winner, f"{winner} explains {100*scores[winner].explained:.0f} % of the excess residual"
 
 
 def signals_left(objective: dict | None) -> dict[str, float]:
@@ -141,29 +143,14 @@ def honest(verdict_name: str, winner: str | None, reason: str, objective_after: 
     winner is within ``RESIDUAL_LIMIT`` times its noise floor; otherwise the verdict is
     ``partially_explained`` and the reason names the signals left and how far above their floors.
     """
-    if verdict_name not in ("missing_physics", "parameters_only"):
+    if verdict_name not in EXPLAINED:
         return verdict_name, reason
     left = signals_left(objective_after)
     if not left:
         return verdict_name, reason
     words = ", ".join(f"{s} {v:.1f} x its floor" for s, v in sorted(left.items(), key=lambda kv: -kv[1]))
-    return "partially_explained", (f"{reason}, but leaves {words} (complete only within {RESIDUAL_LIMIT:g} x the "
+    return DiagnosisVerdict.PARTIALLY_EXPLAINED, (f"{reason}, but leaves {words} (complete only within {RESIDUAL_LIMIT:g} x the "
                                    f"floor on every signal)")
-
-
-def same_physics(a: str, b: str) -> bool:
-    """True when two candidate names hold the same effects (``x`` and ``x+base`` are one explanation)."""
-    ea = {e for e in a.split("+") if e != "base"}
-    eb = {e for e in b.split("+") if e != "base"}
-    return ea == eb
-
-
-def nested(a: str, b: str) -> bool:
-    """True when one candidate's effects contain the other's (a set and its subset are not rivals:
-    the multi-effect search and parsimony decide between them; ``base``, the recalibration, counts
-    as one more term)."""
-    ea, eb = set(a.split("+")), set(b.split("+"))
-    return ea <= eb or eb <= ea
 
 
 def ambiguity_set(scores: dict[str, Score], winner: str | None, objectives: dict | None = None) -> list[str]:
@@ -184,7 +171,7 @@ def ambiguity_set(scores: dict[str, Score], winner: str | None, objectives: dict
         return k in objectives and not signals_left(objectives[k])
 
     def rival(k, s):
-        if k in ("nominal", winner) or nested(k, winner) or s.explained < EXPLAINED_ENOUGH:
+        if k in ("nominal", winner) or CandidateSet.parse(k).nested(CandidateSet.parse(winner)) or s.explained < EXPLAINED_ENOUGH:
             return False
         if s.bic - w.bic < AMBIGUOUS_BIC:
             return True
@@ -194,6 +181,6 @@ def ambiguity_set(scores: dict[str, Score], winner: str | None, objectives: dict
     # one entry per physics (keep the better of x and x+base)
     best: dict[frozenset, str] = {}
     for k in sorted(rivals, key=lambda k: scores[k].bic):
-        key = frozenset(e for e in k.split("+") if e != "base")
+        key = CandidateSet.parse(k).physics
         best.setdefault(key, k)
     return [winner] + list(best.values()) if best else []

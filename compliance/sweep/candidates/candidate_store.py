@@ -12,6 +12,8 @@ import hashlib
 import json
 from pathlib import Path
 
+from compliance.sweep.candidates.evaluate import Unjudged
+
 __all__ = ["CandidateStore"]
 
 
@@ -52,7 +54,7 @@ class CandidateStore:
         """Append (values, row) pairs (failed tasks left out)."""
         lines = []
         for values, row in pairs:
-            if row.get("status") == "failed":
+            if row.get("status") == Unjudged.FAILED:
                 continue
             k = self.key(ctx, values)
             self.rows[k] = row

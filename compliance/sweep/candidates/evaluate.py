@@ -11,18 +11,29 @@ gives it (a pass by construction is no pass: ``sweep.candidates.ranking``, as th
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from enum import StrEnum
 
 from compliance.campaign.judge import judge
 from compliance.campaign.plan import plan
 from compliance.errors import GovcheckError
 from compliance.procedures.outcomes import traces_off
 from compliance.procedures.registry import run as run_procedure
-from compliance.requirements.verdict import DISABLED, FAIL, NOT_EVALUATED, OPEN, PASS, overall_status
+from compliance.requirements.verdict import Status, overall_status
 from compliance.model.parameters import apply
 
-__all__ = ["Context", "INVALID", "evaluate_batch", "evaluate_one", "make_context", "sweep_requirements"]
+__all__ = ["Context", "Unjudged", "evaluate_batch", "evaluate_one", "judged", "make_context", "sweep_requirements"]
 
-INVALID = "invalid"  # the settings make no physical plant (e.g. static below Coulomb friction)
+
+class Unjudged(StrEnum):
+    """A sweep row's status when it carries no overall verdict (in place of pass / fail / incomplete)."""
+
+    INVALID = "invalid"  # the settings make no physical plant (e.g. static below Coulomb friction)
+    FAILED = "failed"  # the worker task failed on every attempt
+
+
+def judged(row: dict) -> bool:
+    """The sweep row carries verdicts: it is neither invalid nor a failed task."""
+    return row.get("status") not in (Unjudged.INVALID, Unjudged.FAILED)
 
 
 @dataclass(frozen=True)
@@ -63,17 +74,17 @@ def evaluate_one(ctx: Context, values: dict) -> dict:
                                       ctx.reqset.operating_points[j.operating_point], j.requests) for j in ctx.jobs]
         bad = next((o for o in outcomes if o.error and o.error_kind == "InputError"), None)
         if bad is not None:
-            return {"status": INVALID, "error": f"run {bad.procedure}@{bad.operating_point}: {bad.error}", "requirements": {}}
+            return {"status": Unjudged.INVALID, "error": f"run {bad.procedure}@{bad.operating_point}: {bad.error}", "requirements": {}}
         entries, _ = judge(cfg, ctx.reqset, list(ctx.jobs), outcomes)
     except GovcheckError as exc:  # settings outside physics: this candidate is invalid, the sweep goes on
-        return {"status": INVALID, "error": str(exc), "requirements": {}}
+        return {"status": Unjudged.INVALID, "error": str(exc), "requirements": {}}
     reqs = {}
     for e in entries:
         w = e["worst"] or {}
         reqs[e["id"]] = {"severity": e["severity"], "status": e["status"], "value": w.get("value"),
                          "margin": w.get("margin"), "margin_pct": w.get("margin_pct"), "where": w.get("run"),
                      "basis": e.get("basis")}
-    judged = [(e["severity"], e["status"], e.get("basis")) for e in entries if e["status"] not in (OPEN, DISABLED)]
+    judged = [(e["severity"], e["status"], e.get("basis")) for e in entries if e["status"] not in (Status.OPEN, Status.DISABLED)]
     return {"status": overall_status(judged), "error": None, "requirements": reqs}
 
 
@@ -81,5 +92,3 @@ def evaluate_batch(ctx: Context, batch: list) -> list:
     """Worker task: ``[(index, settings), ...]`` -> ``[(index, row), ...]``."""
     return [(i, evaluate_one(ctx, values)) for i, values in batch]
 
-
-STATUSES = (PASS, FAIL, NOT_EVALUATED, OPEN, DISABLED, INVALID)

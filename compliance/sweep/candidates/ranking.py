@@ -13,6 +13,9 @@ from __future__ import annotations
 
 import math
 
+from compliance.requirements.verdict import Basis, Status
+from compliance.sweep.candidates.evaluate import judged
+
 __all__ = ["SETTINGS_COST", "candidate_passes", "failing_mandatory", "rank_key", "requirement_passes"]
 
 # cost of moving the settings across the whole of their declared box (normalised change 1):
@@ -22,27 +25,27 @@ SETTINGS_COST = 0.05
 
 def requirement_passes(r: dict) -> bool:
     """A judged requirement row passes: status pass, and not by construction."""
-    return r.get("status") == "pass" and r.get("basis") != "by_construction"
+    return r.get("status") == Status.PASS and r.get("basis") != Basis.BY_CONSTRUCTION
 
 
 def failing_mandatory(row: dict) -> list[str]:
     """Mandatory requirements of a candidate's row that do not pass (open and disabled ones aside)."""
-    if row.get("status") in ("invalid", "failed"):
+    if not judged(row):
         return ["<invalid>"]
     return sorted(rid for rid, r in row["requirements"].items()
-                  if r.get("severity") == "mandatory" and r.get("status") not in ("open", "disabled")
+                  if r.get("severity") == "mandatory" and r.get("status") not in (Status.OPEN, Status.DISABLED)
                   and not requirement_passes(r))
 
 
 def candidate_passes(row: dict) -> bool:
     """Every mandatory requirement passes (and at least one was judged)."""
-    return row.get("status") not in ("invalid", "failed") and not failing_mandatory(row)
+    return judged(row) and not failing_mandatory(row)
 
 
 def _total_shortfall(row: dict) -> float:
     total = 0.0
     for r in row["requirements"].values():
-        if r.get("severity") != "mandatory" or r.get("status") in ("open", "disabled") or requirement_passes(r):
+        if r.get("severity") != "mandatory" or r.get("status") in (Status.OPEN, Status.DISABLED) or requirement_passes(r):
             continue
         m = r.get("margin_pct")
         total += max(0.0, -m / 100.0) if m is not None else 1.0  # not evaluated: a full limit short
@@ -51,6 +54,6 @@ def _total_shortfall(row: dict) -> float:
 
 def rank_key(row: dict, cost: float) -> tuple:
     """Sort key (smaller is better): (failing mandatory count, total shortfall, cost)."""
-    if row.get("status") in ("invalid", "failed"):
+    if not judged(row):
         return (math.inf, math.inf, cost)
     return (len(failing_mandatory(row)), round(_total_shortfall(row), 4), cost)

@@ -18,6 +18,8 @@ import numpy as np
 import pandas as pd
 
 from compliance.files.atomic import write_bytes_atomic, write_text_atomic
+from compliance.requirements.verdict import Status
+from compliance.sweep.candidates.evaluate import judged
 from compliance.sweep.candidates.ranking import rank_key
 from compliance.sweep.candidates.runner import shortfall, total_shortfall
 
@@ -44,7 +46,7 @@ def table(candidates: list[dict], rows: list[dict], req_ids: list[str], adjust=(
             rec[f"{rid}.value"] = r.get("value")
             rec[f"{rid}.margin"] = r.get("margin")
             rec[f"{rid}.margin_pct"] = r.get("margin_pct")
-            rec[f"{rid}.status"] = r.get("status", row["status"] if row["status"] in ("invalid", "failed") else None)
+            rec[f"{rid}.status"] = r.get("status", None if judged(row) else row["status"])
         rec["status"] = row["status"]
         rec["shortfall"] = shortfall(row)
         rec["total_shortfall"] = total_shortfall(row)
@@ -83,7 +85,7 @@ def pareto_front(df: pd.DataFrame, a: str, b: str) -> list[int]:
     judged = np.ones(len(df), dtype=bool)
     for r in (a, b):
         if f"{r}.status" in df:
-            judged &= df[f"{r}.status"].isin(("pass", "fail")).to_numpy()
+            judged &= df[f"{r}.status"].isin((Status.PASS, Status.FAIL)).to_numpy()
     ok = df.loc[judged, cols].dropna()
     pts = ok.to_numpy()
     idx = ok.index.to_numpy()

@@ -11,7 +11,8 @@ from __future__ import annotations
 import math
 
 from compliance.campaign.executor import map_tasks, warm_up
-from compliance.sweep.candidates.evaluate import Context, evaluate_batch
+from compliance.requirements.verdict import Status
+from compliance.sweep.candidates.evaluate import Context, Unjudged, evaluate_batch, judged
 
 __all__ = ["batch_size", "run_candidates", "shortfall", "total_shortfall"]
 
@@ -55,7 +56,7 @@ def run_candidates(ctx: Context, candidates: list[dict], *, scheduler=None, work
     for batch, res in zip(batches, out):
         if res is None:  # every attempt of this task failed
             for i, _ in batch:
-                rows[i] = {"status": "failed", "error": "task failed on every attempt", "requirements": {}}
+                rows[i] = {"status": Unjudged.FAILED, "error": "task failed on every attempt", "requirements": {}}
             continue
         for i, row in res:
             rows[i] = row
@@ -67,14 +68,14 @@ def shortfall(row: dict) -> float:
 
     A requirement not evaluated, or an invalid candidate, counts as infinitely short.
     """
-    if row["status"] in ("invalid", "failed"):
+    if not judged(row):
         return math.inf
     worst = 0.0
     for r in row["requirements"].values():
-        if r["severity"] != "mandatory" or r["status"] in ("open", "disabled"):
+        if r["severity"] != "mandatory" or r["status"] in (Status.OPEN, Status.DISABLED):
             continue
-        if r["status"] == "not_evaluated" or r["margin_pct"] is None:
-            if r["status"] != "pass":
+        if r["status"] == Status.NOT_EVALUATED or r["margin_pct"] is None:
+            if r["status"] != Status.PASS:
                 return math.inf
             continue
         worst = max(worst, -r["margin_pct"] / 100.0)
@@ -86,4 +87,4 @@ def total_shortfall(row: dict) -> float:
     if not math.isfinite(shortfall(row)):
         return math.inf
     return sum(max(0.0, -r["margin_pct"] / 100.0) for r in row["requirements"].values()
-               if r["severity"] == "mandatory" and r["status"] in ("pass", "fail") and r["margin_pct"] is not None)
+               if r["severity"] == "mandatory" and r["status"] in (Status.PASS, Status.FAIL) and r["margin_pct"] is not None)

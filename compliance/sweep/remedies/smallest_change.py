@@ -28,6 +28,8 @@ import math
 
 import numpy as np
 
+from compliance.requirements.verdict import Overall, Status
+from compliance.sweep.candidates.evaluate import judged
 from compliance.sweep.candidates.results import change
 from compliance.sweep.candidates.ranking import SETTINGS_COST, candidate_passes, failing_mandatory, rank_key
 from compliance.sweep.candidates.runner import run_candidates, shortfall
@@ -43,7 +45,7 @@ TARGET = 0.02  # margin (fraction of the limit) the linear step aims for, agains
 def mandatory_margins(row: dict) -> dict:
     """Mandatory requirement id -> margin as a fraction of its limit (judged ones only)."""
     return {rid: r["margin_pct"] / 100.0 for rid, r in row["requirements"].items()
-            if r["severity"] == "mandatory" and r["status"] in ("pass", "fail") and r["margin_pct"] is not None}
+            if r["severity"] == "mandatory" and r["status"] in (Status.PASS, Status.FAIL) and r["margin_pct"] is not None}
 
 
 def binding(row: dict) -> tuple[str | None, float | None]:
@@ -60,7 +62,7 @@ def _sensitivities(adjust, u0, row0, probe_rows, steps):
     ids = sorted(m0)
     J = np.zeros((len(ids), len(adjust)))
     for k, (row, du) in enumerate(zip(probe_rows, steps)):
-        mk = mandatory_margins(row) if row["status"] not in ("invalid", "failed") else {}
+        mk = mandatory_margins(row) if judged(row) else {}
         for r, rid in enumerate(ids):
             if rid in mk and du != 0.0:
                 J[r, k] = (mk[rid] - m0[rid]) / du
@@ -134,7 +136,7 @@ def describe_candidate(adjust, base, values, row) -> dict:
         "binding_margin_pct": marg,
         "binding_where": row["requirements"][rid].get("where") if rid else None,
         "failed_mandatory": failing_mandatory(row),
-        "by_construction": sorted(r for r in failing_mandatory(row) if row["requirements"].get(r, {}).get("status") == "pass"),
+        "by_construction": sorted(r for r in failing_mandatory(row) if row["requirements"].get(r, {}).get("status") == Status.PASS),
         "total_shortfall": rank_key(row, 0.0)[1],
     }
 
@@ -213,7 +215,7 @@ def find_remedy(ctx, adjust, base: dict, *, verify, iterations: int = 4, seeds=(
             remedy = describe_candidate(adjust, start, cand, row)
             remedy["verified"] = {"status": results["summary"]["status"],
                                   "failed_mandatory": results["summary"]["failed_mandatory"]}
-            if results["summary"]["status"] == "pass":
+            if results["summary"]["status"] == Overall.PASS:
                 out.update(status="found", remedy=remedy,
                            note=f"verified by a full campaign of the changed configuration ({len(results['runs'])} runs)")
                 return out

@@ -18,6 +18,7 @@ the remedy (a cheaper stage's pass is never passed over for hardware).
 
 from __future__ import annotations
 
+from compliance.requirements.verdict import Overall
 from compliance.sweep.remedies.limiter_space import limiter_stage_start
 from compliance.sweep.candidates.ranking import SETTINGS_COST, candidate_passes, failing_mandatory, rank_key
 from compliance.sweep.remedies.smallest_change import find_remedy
@@ -34,8 +35,8 @@ def _stage(ctx, adjust, base, verify, run_kw, iterations, fixed=None, cost=0.0, 
     rem["hardware_cost"] = cost
     if rem["status"] == "already_passes" and fixed:  # the hardware alone, at these settings, passes: verify it
         results = verify({**fixed, **rem["closest"]["values"]})
-        if results["summary"]["status"] == "pass":
-            remedy = {**rem["closest"], "verified": {"status": "pass", "failed_mandatory": []}}
+        if results["summary"]["status"] == Overall.PASS:
+            remedy = {**rem["closest"], "verified": {"status": Overall.PASS, "failed_mandatory": []}}
             rem.update(status="found", remedy=remedy, closest=None,
                        note=f"verified by a full campaign of the changed configuration ({len(results['runs'])} runs)")
         else:
@@ -103,7 +104,7 @@ def staged_search(ctx, cfg, adjust, base, catalogue, *, verify, run_kw, iteratio
     ranked = _option_rows(ctx, cfg, options, best_settings, run_kw)
     rem["evaluated"] += len(ranked)
     rem["hardware_tried"] = [{"option": o.name, "group": o.group, "title": o.title, "cost": o.cost,
-                              "status": "pass" if candidate_passes(row) else row["status"],
+                              "status": Overall.PASS if candidate_passes(row) else row["status"],
                               "failed_mandatory": failing_mandatory(row)} for o, _, row in ranked]
     tries = [[ranked[0][0]]] if ranked else []
     pair = [t[0] for t in ranked if t[0].group != ranked[0][0].group][:1] if ranked else []

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from compliance.campaign.uncertainty import _targets, apply_band, ranged_parameters, top_assumptions
-from compliance.sweep.candidates.evaluate import make_context
+from compliance.sweep.candidates.evaluate import judged, make_context
 from compliance.model.parameters import param_handle
 from compliance.sweep.candidates.runner import run_candidates
 from compliance.sweep.candidates.sampling import latin_hypercube
@@ -61,7 +61,7 @@ def monte_carlo_bands(cfg, reqset, results: dict, n: int, *, seed: int = 0, work
     cands = latin_hypercube(adjust, n, seed)
     ctx = make_context(cfg, reqset, paths)
     rows, _ = run_candidates(ctx, cands, workers=workers, progress=progress, label="uncertainty")
-    ok = [(c, r) for c, r in zip(cands, rows) if r["status"] not in ("invalid", "failed")]
+    ok = [(c, r) for c, r in zip(cands, rows) if judged(r)]
     entries = results["requirements"]
     for e in _targets(entries):
         got = [(c, r["requirements"][e["id"]]["value"]) for c, r in ok

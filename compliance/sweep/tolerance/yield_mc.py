@@ -16,6 +16,8 @@ import math
 
 import numpy as np
 
+from compliance.requirements.verdict import Status
+from compliance.sweep.candidates.evaluate import Unjudged, judged
 from compliance.sweep.candidates.ranking import candidate_passes
 from compliance.sweep.candidates.runner import run_candidates, shortfall
 from compliance.sweep.candidates.sampling import draw_units
@@ -85,17 +87,17 @@ def _drivers(units, rows, uncertain, ids):
 
 def _requirement_yield(rows, rid, confidence):
     sts = [r["requirements"][rid]["status"] for r in rows if rid in r["requirements"]]
-    judged = [s for s in sts if s in ("pass", "fail", "not_evaluated")]
-    k = sum(1 for s in judged if s == "pass")
-    lo, hi = wilson(k, len(judged), confidence)
+    units = [s for s in sts if s in (Status.PASS, Status.FAIL, Status.NOT_EVALUATED)]
+    k = sum(1 for s in units if s == Status.PASS)
+    lo, hi = wilson(k, len(units), confidence)
     m = np.array([r["requirements"][rid]["margin_pct"] for r in rows
                   if rid in r["requirements"] and r["requirements"][rid]["margin_pct"] is not None], float)
     hist = None
     if m.size:
         counts, edges = np.histogram(m, bins=HIST_BINS)
         hist = {"counts": counts.tolist(), "edges": edges.tolist()}
-    return {"requirement": rid, "severity": rows[0]["requirements"][rid]["severity"], "units": len(judged), "pass": k,
-            "fraction": k / len(judged) if judged else None, "ci": [lo, hi], "margin_pct_histogram": hist,
+    return {"requirement": rid, "severity": rows[0]["requirements"][rid]["severity"], "units": len(units), "pass": k,
+            "fraction": k / len(units) if units else None, "ci": [lo, hi], "margin_pct_histogram": hist,
             "margin_pct_median": float(np.median(m)) if m.size else None}
 
 
@@ -112,16 +114,16 @@ def run_yield(ctx, cfg, candidate: dict, uncertain, *, units: int, seed: int, co
     draws = draw_units(uncertain, nominal, units, seed)
     settings = [{**candidate, **d} for d in draws]
     rows, stats = run_candidates(ctx, settings, **{"label": "yield", **(run_kw or {})})
-    valid = [r for r in rows if r["status"] not in ("invalid", "failed")]
-    vunits = [d for d, r in zip(draws, rows) if r["status"] not in ("invalid", "failed")]
-    ids = sorted({rid for r in valid for rid, e in r["requirements"].items() if e["status"] not in ("open", "disabled")})
+    valid = [r for r in rows if judged(r)]
+    vunits = [d for d, r in zip(draws, rows) if judged(r)]
+    ids = sorted({rid for r in valid for rid, e in r["requirements"].items() if e["status"] not in (Status.OPEN, Status.DISABLED)})
     k_all = sum(1 for r in valid if candidate_passes(r))
     lo, hi = wilson(k_all, len(valid), confidence)
     out = {
         "candidate": {k: float(v) for k, v in candidate.items()},
         "units": units, "seed": seed, "confidence": confidence,
-        "valid": len(valid), "invalid": sum(1 for r in rows if r["status"] == "invalid"),
-        "failed_tasks": sum(1 for r in rows if r["status"] == "failed"),
+        "valid": len(valid), "invalid": sum(1 for r in rows if r["status"] == Unjudged.INVALID),
+        "failed_tasks": sum(1 for r in rows if r["status"] == Unjudged.FAILED),
         "uncertain": [{"path": u.param.path, "unit": u.param.unit, "distribution": u.distribution,
                        "spread": u.spread, "relative": u.relative, "nominal": nominal[u.param.path]} for u in uncertain],
         "all_mandatory": {"pass": k_all, "fraction": k_all / len(valid) if valid else None, "ci": [lo, hi],
