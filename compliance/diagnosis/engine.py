@@ -27,9 +27,9 @@ from compliance.model.config import PlantConfig, plant_to_toml, _suggest as _sug
 from compliance.effects import EFFECTS
 from compliance.errors import InputError, SimulationError
 from compliance.diagnosis.candidates import Candidate, apply, base_params, effect_candidate, signature_order
-from compliance.diagnosis.fit import FitContext, FitResult, chi2_parts
+from compliance.diagnosis.fit import FitContext, FitResult, chi2_parts, screen_level
 from compliance.diagnosis.fitted_model import fitted_plant, save_fitted
-from compliance.diagnosis.multi import CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_enough, contributions, set_effects, set_name
+from compliance.diagnosis.multi import CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_enough, contributions, full_name, prune, set_effects
 from compliance.diagnosis.discriminate import design_test
 from compliance.diagnosis.empirical import empirical_term
 from compliance.diagnosis.instrument_candidates import (PREFIX, VERDICT, instrument_candidates, instrument_verdict, instrumented,
@@ -131,11 +131,14 @@ def _fit_singles(st: _Stage, names, recalibrate: bool) -> None:
     chi2 = st.fits["nominal"].chi2
     excess = {s: v * v - 1.0 for s, v in st.nominal_rms.items()}
     tasks = []
-    bparams = base_params(st.rc) if recalibrate else ()
+    # within the floor the verdict is no_mismatch whatever the fits: every candidate is shown at its best grid point
+    within = max(_objective(st, "nominal").values(), default=0.0) <= NOISE_TOLERANCE
+    bparams = base_params(st.rc) if recalibrate and not within else ()
     if bparams:
         tasks.append(("base", bparams, 2.0 * math.log(n) * max(1.0, chi2 / n)))
-    tasks += [("effect", effect_candidate(e)) for e in signature_order(names, excess)]
-    tasks += [("effect", c) for c in instrument_candidates(st.model.signals, st.setup.closed_loop)]
+    screen = -math.inf if within else screen_level(chi2, n)
+    tasks += [("effect", effect_candidate(e), screen) for e in signature_order(names, excess)]
+    tasks += [("effect", c, -math.inf if within else None) for c in instrument_candidates(st.model.signals, st.setup.closed_loop)]
     _run(st, tasks)
     base_fit = st.fits.get("base")
     singles = [f for f in st.fits.values() if f.name != "nominal"]
@@ -158,8 +161,9 @@ def _search_sets(st: _Stage, winner: str) -> list[dict]:
         screened = [r for r, _ in map_tasks([("screen", current, f) for f in singles], st.jobs, st.payload)]
         screen = {name: (chi, start) for name, chi, start, _ in screened}
         st.sims += sum(r[3] for r in screened)
-        order = sorted(singles, key=lambda f: screen[f.name][0])[:CANDIDATES_PER_ROUND]
-        tasks = [("extend", current, f, screen[f.name][1]) for f in order]
+        level = screen_level(current.chi2, n)  # an addition whose screen removes too little is not refitted
+        order = sorted((f for f in singles if screen[f.name][0] <= level), key=lambda f: screen[f.name][0])
+        tasks = [("extend", current, f, screen[f.name][1]) for f in order[:CANDIDATES_PER_ROUND]]
         if not tasks:
             break
         _run(st, tasks)
@@ -177,9 +181,7 @@ def _search_sets(st: _Stage, winner: str) -> list[dict]:
 
 
 def _extended(st: _Stage, current: FitResult, single: FitResult) -> FitResult:
-    effects = set_effects(current.name) + set_effects(single.name)
-    name = set_name(effects) + ("+base" if any(fp.kind == "base" for fp in current.params) else "")
-    return st.fits[name]
+    return st.fits[full_name(set_effects(current.name) + set_effects(single.name), current.params)]
 
 
 def _objective(st: _Stage, name: str) -> dict:
@@ -199,10 +201,11 @@ def _decide(st: _Stage) -> dict:
     search = []
     if winner is not None and winner != "base" and verdict_name != "no_mismatch":
         search = _search_sets(st, winner)
-        scores = score_all(st.fits, n)  # the sets tried are candidates too
         kept = [r for r in search if r["kept"]]
+        winner, pruned = prune(st.fits, kept[-1]["best"] if kept else winner, n, lambda tasks: _run(st, tasks))
+        search += pruned
+        scores = score_all(st.fits, n)  # the sets tried are candidates too
         if kept:
-            winner = kept[-1]["best"]
             reason = f"{' and '.join(set_effects(winner))} together explain {100*scores[winner].explained:.0f} % of the excess residual"
             verdict_name = "missing_physics" if scores[winner].explained >= EXPLAINED_ENOUGH else "unexplained"
     verdict_name, winner, reason = instrument_verdict(scores, n, (verdict_name, winner, reason),

@@ -37,13 +37,12 @@ from compliance.errors import InputError
 from compliance.files.jsonable import json_number
 from compliance.model.config import PlantConfig, plant_from_dict
 from compliance.diagnosis.candidates import base_params, effect_candidate, signature_order
-from compliance.diagnosis.fit import FitContext, FitResult, chi2_parts, fit_candidate
+from compliance.diagnosis.fit import FitContext, FitResult, chi2_parts, fit_candidate, screen_level
 from compliance.diagnosis.recalibration import forward_select_base
 from compliance.diagnosis.report_data import SCHEMA
 from compliance.diagnosis.select import AMBIGUOUS_BIC, RESIDUAL_LIMIT, ambiguity_set, honest, score_all, signals_left, verdict
 
 _WORKER: dict = {}  # token -> JointContext, built once per worker process
-SCREEN_SHARE = 0.02  # share of the nominal excess chi-square an effect's best grid point must remove to be refined
 
 
 @dataclass
@@ -239,10 +238,7 @@ def _fit_all(stages, labels, names, recalibrate, jobs, scheduler) -> tuple[dict,
     bparams = (base_params(stages[0].rc, keys) if keys else base_params(stages[0].rc)) if recalibrate else ()
     if bparams:
         tasks.append(("base", bparams, 2.0 * math.log(n) * max(1.0, chi2_nom / n)))
-    # an effect none of whose grid points removes SCREEN_SHARE of the nominal excess is not refined (our choice:
-    # a candidate must remove select.MIN_GAIN = 25 % to matter; the refinement of one that starts at 2 % costs the
-    # same replays as a real one, times the number of recordings)
-    screen = chi2_nom - SCREEN_SHARE * max(chi2_nom - n, 0.0)
+    screen = screen_level(chi2_nom, n)  # an effect none of whose grid points removes SCREEN_SHARE of the excess: not refined
     tasks += [("effect", e, screen) for e in signature_order(names, excess)]
     token = f"joint-{time.time_ns()}"
     payload = (token, tuple(labels), [(plant_to_toml(s.rc), s.setup, s.model) for s in stages])

@@ -18,6 +18,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from compliance.diagnosis.instrument_candidates import is_instrument
+
 # nominal normalised RMS at or below which a signal agrees "within the noise floor", judged on the re-synchronised
 # replay with the time-resolved floors (the fits' objective, as RESIDUAL_LIMIT is). Not on the constant floor: a
 # stick-slip servo's replay error comes in noise-decided bursts at breakaways, so one recording's RMS over the test
@@ -151,18 +153,22 @@ def honest(verdict_name: str, winner: str | None, reason: str, objective_after: 
                                    f"floor on every signal)")
 
 
+def _physics(name: str) -> set[str]:
+    """The plant terms of a candidate name (instrumentation findings on top are not physics)."""
+    return {e for e in name.split("+") if not is_instrument(e)}
+
+
 def same_physics(a: str, b: str) -> bool:
-    """True when two candidate names hold the same effects (``x`` and ``x+base`` are one explanation)."""
-    ea = {e for e in a.split("+") if e != "base"}
-    eb = {e for e in b.split("+") if e != "base"}
-    return ea == eb
+    """True when two candidate names hold the same effects (``x``, ``x+base`` and ``x`` with an instrumentation
+    finding on top are one explanation)."""
+    return _physics(a) - {"base"} == _physics(b) - {"base"}
 
 
 def nested(a: str, b: str) -> bool:
     """True when one candidate's effects contain the other's (a set and its subset are not rivals:
     the multi-effect search and parsimony decide between them; ``base``, the recalibration, counts
-    as one more term)."""
-    ea, eb = set(a.split("+")), set(b.split("+"))
+    as one more term; an instrumentation finding on top, none)."""
+    ea, eb = _physics(a), _physics(b)
     return ea <= eb or eb <= ea
 
 

@@ -13,7 +13,7 @@ import tomllib
 from compliance.model.config import plant_from_dict
 from compliance.diagnosis.fit import FitContext, fit_candidate, least_squares_fit
 from compliance.diagnosis.recalibration import forward_select_base
-from compliance.diagnosis.multi import extend_fit, screen_addition
+from compliance.diagnosis.multi import SET_SIMPLEX_FEV, extend_fit, screen_addition
 from compliance.diagnosis.replay_fit import ReplaySetup
 
 _WORKER: dict = {}
@@ -27,7 +27,7 @@ def _init_worker(toml_text: str, setup: ReplaySetup, model) -> None:
 def _run_task(task):
     """One unit of parallel work: ('base', params) | ('effect', Candidate) | ('combo', Candidate, FitResult)
     | ('extend', FitResult of a set, FitResult of a single effect, start values or None)
-    | ('screen', FitResult of a set, FitResult of a single effect)."""
+    | ('screen', FitResult of a set, FitResult of a single effect) | ('refit', name, params, start values)."""
     ctx: FitContext = _WORKER["ctx"]
     kind = task[0]
     if kind == "screen":  # (effect, chi-square, start, replays) of multi.screen_addition; no fit, no residual
@@ -38,8 +38,10 @@ def _run_task(task):
         penalty = task[2]
         res, log = forward_select_base(ctx, task[1], penalty=penalty)
         res.scan = log
-    elif kind == "effect":
-        res = fit_candidate(ctx, task[1], None)
+    elif kind == "effect":  # ('effect', Candidate, screen chi-square or None: fit_candidate's screen)
+        res = fit_candidate(ctx, task[1], None, screen=task[2] if len(task) > 2 else None)
+    elif kind == "refit":  # a set refitted from a start near its optimum (multi.prune)
+        res = least_squares_fit(ctx, task[1], task[2], task[3], simplex_fev=SET_SIMPLEX_FEV)
     else:  # combination: effect + recalibrated base parameters, from both fits' values
         cand, eff_fit, base_fit = task[1], task[2], task[3]
         params = tuple(eff_fit.params) + tuple(base_fit.params)
