@@ -27,7 +27,7 @@ from compliance.model.config import PlantConfig, plant_to_toml, _suggest as _sug
 from compliance.effects import EFFECTS
 from compliance.errors import InputError, SimulationError
 from compliance.diagnosis.candidates import Candidate, apply, base_params, effect_candidate, signature_order
-from compliance.diagnosis.fit import FitContext, FitResult, chi2_parts, screen_level
+from compliance.diagnosis.fit import FitContext, FitResult, chi2_parts, replays_bound, screen_level
 from compliance.diagnosis.fitted_model import fitted_plant, save_fitted
 from compliance.diagnosis.multi import CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_enough, contributions, full_name, prune, set_effects
 from compliance.diagnosis.discriminate import design_test
@@ -122,7 +122,7 @@ def _run(st: _Stage, tasks) -> None:
     for res, v in map_tasks(tasks, st.jobs, st.payload):
         st.fits[res.name] = res
         st.vecs[res.name] = v
-        st.sims += res.sims + 1
+        st.sims += res.sims
 
 
 def _fit_singles(st: _Stage, names, recalibrate: bool) -> None:
@@ -137,9 +137,9 @@ def _fit_singles(st: _Stage, names, recalibrate: bool) -> None:
     if bparams:
         tasks.append(("base", bparams, 2.0 * math.log(n) * max(1.0, chi2 / n)))
     screen = -math.inf if within else screen_level(chi2, n)
-    tasks += [("effect", effect_candidate(e), screen) for e in signature_order(names, excess)]
-    tasks += [("effect", c, -math.inf if within else None) for c in instrument_candidates(st.model.signals, st.setup.closed_loop)]
-    _run(st, tasks)
+    fits = [("effect", effect_candidate(e), screen) for e in signature_order(names, excess)]
+    fits += [("effect", c, -math.inf if within else None) for c in instrument_candidates(st.model.signals, st.setup.closed_loop)]
+    _run(st, tasks + sorted(fits, key=lambda t: -replays_bound(t[1])))  # the longest fits first
     base_fit = st.fits.get("base")
     singles = [f for f in st.fits.values() if f.name != "nominal"]
     best = min(singles, key=lambda f: f.chi2, default=None)

@@ -313,6 +313,14 @@ def scan_points(ctx: FitContext, params, points: list[list[float]]) -> list[floa
     return out
 
 
+def replays_bound(cand: Candidate) -> int:
+    """Replays a full fit of ``cand`` takes at most: its grid, the simplex, the polish and its Jacobian, twice
+    with a second start (``fit_candidate``). The pool gets the longest fits first (a long fit started last
+    leaves the other workers idle)."""
+    k = len(cand.params)
+    return len(cand.grid or ({},)) + (SIMPLEX_FEV * k + 10 + MAX_NFEV + k) * (2 if k > 1 else 1)
+
+
 def fit_candidate(ctx: FitContext, cand: Candidate, base_fit: FitResult | None, *, max_nfev: int = MAX_NFEV,
                   screen: float | None = None) -> FitResult:
     """Fit one effect on top of the recalibrated base, co-fitting the recalibrated base parameters.
@@ -359,4 +367,4 @@ def fit_candidate(ctx: FitContext, cand: Candidate, base_fit: FitResult | None, 
     return res
 
 
-__all__ = ["FitContext", "FitResult", "fit_candidate", "least_squares_fit", "scan_points", "chi2_parts"]
+__all__ = ["FitContext", "FitResult", "fit_candidate", "replays_bound", "screen_level", "least_squares_fit", "scan_points", "chi2_parts"]

@@ -48,7 +48,9 @@ def _run_task(task):
         # start exactly at the effect's optimum (base parameters nominal): the combination can only improve on it
         start = list(eff_fit.values) + [fp.nominal for fp in base_fit.params]
         res = least_squares_fit(ctx, cand.name, params, start, simplex_fev=8)
-    vec, _ = ctx.residual(res.params, res.values)
+    sims = ctx.sims
+    vec, _ = ctx.residual(res.params, res.values)  # the fit's own last replay, remembered (FitContext.memo)
+    res.sims += ctx.sims - sims
     return res, vec
 
 
