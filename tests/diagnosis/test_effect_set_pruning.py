@@ -1,5 +1,5 @@
-"""An effect set's effects each beat the instrumentation explanation of the same misfit (multi.prune), fits
-not refined where they cannot matter (fit.screen_level), and no parameter set replayed twice (FitContext memo).
+"""An effect set's effects each beat the instrumentation explanation of the same misfit (servo.effect_sets.prune), fits
+not refined where they cannot matter (servo.fit.screen_level), and no parameter set replayed twice (FitContext memo).
 
 The selection rules are checked on constructed fit results (the chi-squares a diagnosis would produce), so
 each test runs in milliseconds; the end-to-end proof is the field practice recording with an external leak,
@@ -10,12 +10,12 @@ from __future__ import annotations
 
 import pytest
 
-from compliance.diagnosis import fit as fit_module
-from compliance.diagnosis.candidates import effect_params
-from compliance.diagnosis.fit import SCREEN_SHARE, FitContext, FitResult, screen_level
-from compliance.diagnosis.instrument_candidates import instrument_candidates
-from compliance.diagnosis.multi import full_name, prune, reduced_sets
-from compliance.diagnosis.select import nested, same_physics
+from compliance.diagnosis.servo import fit as fit_module
+from compliance.diagnosis.servo.candidates import effect_params
+from compliance.diagnosis.servo.fit import SCREEN_SHARE, FitContext, FitResult, screen_level
+from compliance.diagnosis.servo.instrument_candidates import instrument_candidates
+from compliance.diagnosis.servo.effect_sets import full_name, prune, reduced_sets
+from compliance.diagnosis.servo.selection import nested, same_physics
 from compliance.model.config import load_plant
 
 N = 10000  # residuals
