@@ -208,10 +208,10 @@ def save_remedy(args, cfg, rem) -> None:
         print(f"--save-remedy {args.save_remedy}: nothing written (no verified remedy in the declared space)", file=sys.stderr)
         return
     from compliance.model.config import save_plant
-    from compliance.sweep.candidates.parameter_paths import describe
+    from compliance.model.parameters import param_handle
     from compliance.sweep.remedies.finish import remedy_configuration, remedy_values
 
-    paths = {p: describe(p, "remedy") for p in remedy_values(rem)}
+    paths = {p: param_handle(p, "remedy") for p in remedy_values(rem)}
     save_plant(remedy_configuration(cfg, rem, paths), args.save_remedy, overwrite=True)
     if not args.quiet:
         print(f"remedy written to {args.save_remedy} (govcheck check {args.save_remedy} -r {args.requirements})")

@@ -1,12 +1,21 @@
-"""The base parameter table: every key a plant configuration may hold, with SI unit, meaning, validity.
+"""The base parameter table, and the one handle on any tunable parameter of a plant.
 
-Read by the configuration loader (validation), the simulator assembly (parameter vector),
-the report appendix and the diagnosis (which base parameters it may refit).
+The table (every key a plant configuration may hold, with SI unit, meaning, validity) is read by
+the configuration loader (validation), the simulator assembly (parameter vector), the report
+appendix and the diagnosis (which base parameters it may refit). :class:`ParamHandle` is the one
+handle the diagnosis candidates, the sweep adjustables and tolerances and the calibration table
+share: :func:`param_handle` makes it from any spelling of a parameter path, :func:`apply` sets
+values on a configuration.
 """
 
 from __future__ import annotations
 
+import math
+from dataclasses import dataclass, replace
+
+from compliance.effects import EFFECTS
 from compliance.effects.param import Param
+from compliance.errors import InputError, did_you_mean
 
 
 def _P(key, unit, meaning, default, low=0.0, high=float("inf"), low_open=False, **kw) -> Param:
@@ -85,6 +94,206 @@ BASE_PARAMS: tuple[Param, ...] = (
 )
 
 BASE_BY_KEY: dict[str, Param] = {p.name: p for p in BASE_PARAMS}
+
+
+# ----------------------------------------------------------------------- the one parameter handle
+EFFECTS_PREFIX = "effects."
+# prior width of a refitted parameter: a factor of 2 (log-scaled) or its own size (linear) is one
+# standard deviation; the data must pay for moving it further (govcheck's choice)
+PRIOR_FACTOR = 2.0
+
+
+@dataclass(frozen=True)
+class ParamHandle:
+    """One tunable parameter: where it lives in a plant, its SI unit, bounds and scale, how to set it.
+
+    Attributes
+    ----------
+    path : str
+        The one canonical spelling, the key path of a plant file: ``section.name`` for a base
+        parameter (``controller.kp``), ``effects.NAME.PARAM`` for a declared effect's
+        (``effects.internal_leakage.conductance``). :func:`param_handle` also accepts ``NAME.PARAM``.
+    unit : str
+        SI unit (pint syntax; ``""`` dimensionless).
+    low, high : float
+        Bounds [SI]: the admissible range, or the narrower range a fit or search moves it in
+        (:meth:`within`).
+    log : bool
+        Fitted and searched as log10 of the value (ranges spanning decades).
+    meaning : str
+        One line for reports.
+    kind : str
+        ``"base"``, ``"effect"``, or ``"instrument"`` (a recording-side quantity the diagnosis fits
+        on the logger, never set on the plant).
+    nominal : float or None
+        Value a fit starts from and its prior is centred on (the declared default unless set; None:
+        a required base parameter without one).
+    prior : bool
+        A fit adds a residual pulling it towards ``nominal`` (:meth:`prior_residual`).
+    pressure : bool
+        An absolute pressure: values in files must say ``abs`` or ``gauge``.
+    scales : tuple of str
+        Base paths this one multiplies together (the diagnosis's ``friction.level``, one factor on
+        the static and Coulomb forces); empty: it sets its own path.
+    reason : str
+        Why the bounds are these, when a table narrows them (the calibration's unstated values).
+    """
+
+    path: str
+    unit: str
+    low: float
+    high: float
+    log: bool = False
+    meaning: str = ""
+    kind: str = "base"
+    nominal: float | None = None
+    prior: bool = False
+    pressure: bool = False
+    scales: tuple[str, ...] = ()
+    reason: str = ""
+
+    @property
+    def effect(self) -> str | None:
+        """The effect name of an effect parameter (None otherwise)."""
+        return self.path.split(".")[1] if self.kind == "effect" else None
+
+    @property
+    def name(self) -> str:
+        """The parameter's key inside its effect or section (the last part of the path)."""
+        return self.path.rsplit(".", 1)[-1]
+
+    @property
+    def key(self) -> str:
+        """The name the diagnosis reports print: an effect parameter as ``NAME.PARAM``, others as the path."""
+        return self.path[len(EFFECTS_PREFIX):] if self.kind == "effect" else self.path
+
+    def within(self, low: float, high: float, log: bool | None = None, reason: str = "") -> ParamHandle:
+        """The same parameter moved only inside [low, high] (SI), optionally on another scale, saying why."""
+        return replace(self, low=low, high=high, log=self.log if log is None else log, reason=reason)
+
+    def value_in(self, cfg) -> float:
+        """SI value in configuration ``cfg`` (an effect that is off gives its declared default; a factor 1)."""
+        if self.kind == "effect":
+            here = cfg.effects.get(self.effect, {})
+            return float(here[self.name] if self.name in here else EFFECTS[self.effect].param(self.name).default)
+        if self.scales:
+            return 1.0
+        if self.kind == "instrument":
+            return self.nominal
+        return float(cfg.params[self.path])
+
+    def apply(self, cfg, value: float):
+        """``cfg`` with this parameter at ``value`` [SI] (:func:`apply`)."""
+        return apply(cfg, (self,), (value,))
+
+    def to_unit(self, value: float) -> float:
+        """Value [SI] -> search coordinate u in [0, 1] over the bounds (log10 of the value when ``log``)."""
+        v = min(max(value, self.low), self.high)
+        if self.log:
+            return (math.log10(v) - math.log10(self.low)) / (math.log10(self.high) - math.log10(self.low))
+        return (v - self.low) / (self.high - self.low)
+
+    def from_unit(self, u: float) -> float:
+        """Search coordinate u (clipped to [0, 1]) -> value [SI]."""
+        u = min(max(float(u), 0.0), 1.0)
+        if self.log:
+            return 10.0 ** (math.log10(self.low) + u * (math.log10(self.high) - math.log10(self.low)))
+        return self.low + u * (self.high - self.low)
+
+    def prior_residual(self, value: float) -> float:
+        """(value - nominal) in prior standard deviations (``PRIOR_FACTOR``; 0 without a prior)."""
+        if not self.prior:
+            return 0.0
+        if self.log:
+            return math.log(value / self.nominal) / math.log(PRIOR_FACTOR)
+        scale = abs(self.nominal) if self.nominal != 0.0 else (self.high - self.low) / 10.0
+        return (value - self.nominal) / scale
+
+    def stderr(self, value: float, sigma_u: float) -> float:
+        """Standard error [SI] at ``value`` from the standard error ``sigma_u`` of the search coordinate."""
+        if self.log:
+            return value * math.log(10.0) * (math.log10(self.high) - math.log10(self.low)) * sigma_u
+        return (self.high - self.low) * sigma_u
+
+
+def _effect_handle(path: str, effect: str, name: str, where: str) -> ParamHandle:
+    eff = EFFECTS[effect]
+    try:
+        prm = eff.param(name)
+    except KeyError:
+        names = [p.name for p in eff.params]
+        raise InputError(f"{where}: effect {eff.name} has no parameter '{name}' "
+                         f"(it has {', '.join(names)}){did_you_mean(name, names)}") from None
+    return ParamHandle(f"{EFFECTS_PREFIX}{effect}.{name}", prm.unit, prm.bounds[0], prm.bounds[1], prm.log_scale,
+                       prm.meaning, "effect", prm.default, pressure=prm.pressure)
+
+
+def param_handle(path: str, where: str) -> ParamHandle:
+    """The handle of a parameter path in any spelling: the one normaliser of parameter paths.
+
+    Parameters
+    ----------
+    path : str
+        ``section.name`` (a base parameter), ``effects.NAME.PARAM`` (canonical for an effect
+        parameter) or ``NAME.PARAM`` (the diagnosis's spelling).
+    where : str
+        The file and field (or option) the path came from, for the message.
+
+    Raises
+    ------
+    InputError
+        An unknown path (with the nearest spelling), or a bare power-law coefficient (no unit).
+    """
+    parts = path.split(".")
+    if path.startswith(EFFECTS_PREFIX):
+        if len(parts) != 3 or parts[1] not in EFFECTS:
+            name = parts[1] if len(parts) > 1 else ""
+            raise InputError(f"{where}: '{path}' is not a declared parameter path (effects.NAME.PARAM with NAME one of "
+                             f"{', '.join(sorted(EFFECTS))}){did_you_mean(name, EFFECTS)}")
+        return _effect_handle(path, parts[1], parts[2], where)
+    if len(parts) == 2 and parts[0] in EFFECTS:
+        return _effect_handle(path, parts[0], parts[1], where)
+    spec = BASE_BY_KEY.get(path)
+    if spec is None:
+        known = [*BASE_BY_KEY, *(f"{EFFECTS_PREFIX}{e.name}.{q.name}" for e in EFFECTS.values() for q in e.params)]
+        raise InputError(f"{where}: '{path}' is not a known parameter path{did_you_mean(path, known)} "
+                         "(docs/physics.md lists the parameters; effect parameters are effects.NAME.PARAM)")
+    if spec.unit == "number":
+        raise InputError(f"{where}: '{path}' is a bare power-law coefficient; sweep a parameter with a unit")
+    return ParamHandle(path, spec.unit, spec.bounds[0], spec.bounds[1], spec.log_scale, spec.meaning, "base",
+                       spec.default, pressure=spec.pressure)
+
+
+def apply(cfg, handles, values, *, source: str | None = None):
+    """``cfg`` with ``values`` set, one SI float per handle: the one way values reach a configuration.
+
+    Effects named are switched on (their other parameters as in ``cfg``, else at their defaults);
+    a factor (``scales``) multiplies the base values it names; instrument handles are skipped (they
+    act on the logger). Nothing to set returns ``cfg`` itself.
+
+    Parameters
+    ----------
+    cfg : PlantConfig
+    handles : sequence of ParamHandle
+    values : sequence of float
+        SI values, one per handle.
+    source : str, optional
+        Provenance of every base value set (default: ``PlantConfig.replace``'s ``user``).
+    """
+    base: dict[str, float] = {}
+    effects: dict[str, dict[str, float]] = {}
+    for h, v in zip(handles, values):
+        if h.kind == "instrument":
+            continue
+        if h.kind == "effect":
+            effects.setdefault(h.effect, {})[h.name] = float(v)
+        elif h.scales:
+            base.update({k: cfg.p(k) * v for k in h.scales})
+        else:
+            base[h.path] = float(v)
+    if not base and not effects:
+        return cfg
+    return cfg.replace(params=base, effects=effects, sources={k: source for k in base} if source else None)
 
 # option keys (strings / booleans) and their allowed values
 OPTIONS: dict[str, tuple[str, ...]] = {

@@ -37,7 +37,8 @@ from compliance.campaign.executor import available_cores, warm_up
 from compliance.errors import InputError
 from compliance.model.config import PlantConfig
 from compliance.papers.calibration_objective import best_conditions, cost, rows_of
-from compliance.papers.calibration_table import CONDITIONS, Unstated, apply_values, fit_param, unstated_for, value_of
+from compliance.model.parameters import ParamHandle, apply
+from compliance.papers.calibration_table import CALIBRATED_SOURCE, CONDITIONS, held_breakaway, unstated_for
 from compliance.papers.plant_a import Row, conditions_of
 
 SOBOL_POINTS = 128
@@ -88,7 +89,7 @@ class Calibration:
 
     start: PlantConfig
     best: PlantConfig
-    table: tuple[Unstated, ...]
+    table: tuple[ParamHandle, ...]
     values: dict[str, float]
     conditions: dict[str, str]
     cost_before: float
@@ -117,7 +118,7 @@ def _point_cost(task):
 
 
 def _configure(cfg: PlantConfig, params, u) -> PlantConfig:
-    return apply_values(cfg, {fp.key: fp.from_unit(x) for fp, x in zip(params, u)})
+    return apply(cfg, *held_breakaway(cfg, params, [fp.from_unit(x) for fp, x in zip(params, u)]), source=CALIBRATED_SOURCE)
 
 
 def _map(tasks: list, workers: int) -> list[tuple[float, int, tuple[float, ...]]]:
@@ -219,13 +220,13 @@ def _profiles(params, u_best: np.ndarray, c_best: float, workers: int):
             lo -= 1
         while hi < len(us) - 1 and cs[hi + 1] <= c_best + PIN_DELTA:
             hi += 1
-        out.append(ParameterProfile(fp.key, [fp.from_unit(x) for x in us], cs,
+        out.append(ParameterProfile(fp.path, [fp.from_unit(x) for x in us], cs,
                            (fp.from_unit(us[lo]), fp.from_unit(us[hi])), us[hi] - us[lo], c_best))
     return out, better
 
 
 def calibrate(cfg: PlantConfig, *, workers: int | None = None, sobol_points: int = SOBOL_POINTS,
-              table: tuple[Unstated, ...] | None = None, conditions: dict | None = None,
+              table: tuple[ParamHandle, ...] | None = None, conditions: dict | None = None,
               profiles: bool = True, targets: dict | None = None,
               compass_iterations: int = COMPASS_ITERATIONS, seeds: tuple[PlantConfig, ...] = (),
               starts: int = STARTS, restarts: bool = True) -> Calibration:
@@ -239,7 +240,7 @@ def calibrate(cfg: PlantConfig, *, workers: int | None = None, sobol_points: int
         Processes (default: the cores available).
     sobol_points : int
         Size of the global sample (a power of two).
-    table : tuple of Unstated, optional
+    table : tuple of ParamHandle, optional
         What may move (default ``unstated_for(cfg)``).
     conditions : dict, optional
         Test conditions to hold fixed (others are chosen by the fit).
@@ -258,16 +259,16 @@ def calibrate(cfg: PlantConfig, *, workers: int | None = None, sobol_points: int
     """
     workers = max(1, workers or available_cores())
     table = table if table is not None else unstated_for(cfg)
-    params = [fit_param(u, cfg) for u in table]
+    params = list(table)
     warm_up(cfg)
     conds = _condition_sets(conditions)
     _CTX.update(cfg=cfg, params=params, conds=conds, targets=targets)
     start_cond = dict(conditions_of(cfg), **(conditions or {}))
     rows_before = rows_of(cfg, start_cond, targets=targets)
-    u0 = np.array([fp.to_unit(value_of(cfg, fp.key)) for fp in params])
+    u0 = np.array([fp.to_unit(fp.value_in(cfg)) for fp in params])
     from scipy.stats import qmc
 
-    extra = [np.array([fp.to_unit(value_of(s, fp.key)) for fp in params]) for s in (seeds or ())]
+    extra = [np.array([fp.to_unit(fp.value_in(s)) for fp in params]) for s in (seeds or ())]
     sample = [u0] + extra + list(qmc.Sobol(len(params), scramble=True, seed=17).random(sobol_points))
     results = _map(sample, workers)
     n_eval = len(sample)
@@ -292,6 +293,6 @@ def calibrate(cfg: PlantConfig, *, workers: int | None = None, sobol_points: int
     cal = _configure(cfg, params, u_best)
     cond = conds[best[1]]
     rows_after = rows_of(cal, cond, targets=targets)
-    values = {fp.key: value_of(cal, fp.key) for fp in params}
+    values = {fp.path: fp.value_in(cal) for fp in params}
     return Calibration(cfg, cal, tuple(table), values, cond, cost(rows_before), cost(rows_after), rows_before,
                        rows_after, prof, n_eval, workers)

@@ -29,7 +29,8 @@ from compliance.effects import EFFECTS
 from compliance.model.config import PlantConfig
 from compliance.papers import calibration as cal_search
 from compliance.papers.calibration_objective import cost, rows_of, within
-from compliance.papers.calibration_table import EFFECT_UNSTATED, UNSTATED, Unstated, fit_param, value_of
+from compliance.model.parameters import ParamHandle
+from compliance.papers.calibration_table import EFFECT_UNSTATED, UNSTATED, unstated
 from compliance.papers.plant_a import Row, case_test, scaled_miss
 
 REACH_ITERATIONS = 8  # compass iterations per stage (step 0.1 -> 1/64 of the range takes 3 halvings)
@@ -38,26 +39,26 @@ TRIM_POLLS, TRIM_ROUNDS = 3, 3  # pulling a moved value back: 3 fractions a roun
 UNMEASURED = 1e6  # r^2 of a figure the run does not measure
 
 # physical limits of the calibration's parameters (what a plant of this kind can have at all, not what is plausible)
-PHYSICAL: tuple[Unstated, ...] = (
-    Unstated("valve.saturation_voltage", 1.0, 10.0, False,
+PHYSICAL: tuple[ParamHandle, ...] = (
+    unstated("valve.saturation_voltage", 1.0, 10.0, False,
              "the opening must grow beyond the 0.61/0.69 V dead zone and is reached at most at the 10 V command limit"),
-    Unstated("friction.coulomb_force", 10.0, 3000.0, True,
+    unstated("friction.coulomb_force", 10.0, 3000.0, True,
              "from a nearly frictionless seal to a fifth of the 16 kN theoretical force"),
-    Unstated("friction.static_force", 10.0, 4000.0, True, "as the Coulomb force, breakaway up to 1.3 x its top"),
-    Unstated("friction.stribeck_velocity", 1e-4, 0.1, True, "0.1-100 mm/s: beyond, the seal map is flat"),
-    Unstated("friction.viscous_coefficient", 10.0, 10000.0, True, "10 N*s/m-10 kN*s/m per cylinder"),
-    Unstated("controller.filter_cutoff", 2.0, 500.0, True, "2 Hz to the Nyquist frequency of the 1 ms sampling"),
-    Unstated("flow_control.opening_conductance", 3e-10, 2.33e-8, True,
+    unstated("friction.static_force", 10.0, 4000.0, True, "as the Coulomb force, breakaway up to 1.3 x its top"),
+    unstated("friction.stribeck_velocity", 1e-4, 0.1, True, "0.1-100 mm/s: beyond, the seal map is flat"),
+    unstated("friction.viscous_coefficient", 10.0, 10000.0, True, "10 N*s/m-10 kN*s/m per cylinder"),
+    unstated("controller.filter_cutoff", 2.0, 500.0, True, "2 Hz to the Nyquist frequency of the 1 ms sampling"),
+    unstated("flow_control.opening_conductance", 3e-10, 2.33e-8, True,
              "a throttle from nearly shut to fully open (the valve's own 2.33e-8 m^3/(s*Pa))"),
-    Unstated("flow_control.closing_conductance", 3e-10, 2.33e-8, True, "as the opening throttle"),
-    Unstated("effects.valve_null_flow.null_opening", 1e-4, 0.05, True, "declared bounds of the effect"),
-    Unstated("effects.valve_null_flow.null_width", 0.05, 2.0, True, "declared bounds of the effect"),
+    unstated("flow_control.closing_conductance", 3e-10, 2.33e-8, True, "as the opening throttle"),
+    unstated("effects.valve_null_flow.null_opening", 1e-4, 0.05, True, "declared bounds of the effect"),
+    unstated("effects.valve_null_flow.null_width", 0.05, 2.0, True, "declared bounds of the effect"),
 )
 # printed values that set the steady errors and settling times (moving one contradicts the paper)
-PRINTED: tuple[Unstated, ...] = (
-    Unstated("controller.compensation_width", 0.02, 2.0, True, "lc, printed 0.4 V"),
-    Unstated("controller.ki", 0.02, 2000.0, True, "K_I, printed 0.2 (V/(m*s) as read)"),
-    Unstated("controller.kp", 100.0, 2000.0, True, "K_P, printed 280 V/m"),
+PRINTED: tuple[ParamHandle, ...] = (
+    unstated("controller.compensation_width", 0.02, 2.0, True, "lc, printed 0.4 V"),
+    unstated("controller.ki", 0.02, 2000.0, True, "K_I, printed 0.2 (V/(m*s) as read)"),
+    unstated("controller.kp", 100.0, 2000.0, True, "K_P, printed 280 V/m"),
 )
 
 
@@ -157,12 +158,12 @@ def _trim(u0: np.ndarray, u: np.ndarray, workers: int) -> tuple[np.ndarray, int]
     return u, n
 
 
-def _stage(name: str, cfg0: PlantConfig, table: tuple[Unstated, ...], workers: int,
+def _stage(name: str, cfg0: PlantConfig, table: tuple[ParamHandle, ...], workers: int,
            refs: dict[str, tuple[float, float] | None], printed: bool) -> tuple[Stage, PlantConfig]:
     """Compass the figure's r^2 over ``table`` from ``cfg0``; trim; the stage and its configuration."""
-    params = [fit_param(u, cfg0) for u in table]
+    params = list(table)
     cal_search._CTX.update(cfg=cfg0, params=params)
-    u0 = np.array([fp.to_unit(value_of(cfg0, fp.key)) for fp in params])
+    u0 = np.array([fp.to_unit(fp.value_in(cfg0)) for fp in params])
     b0 = cal_search._point_cost(u0)
     u, b, n = cal_search._compass(u0, b0, workers, REACH_ITERATIONS, good_enough=INSIDE)
     n += 1
@@ -179,8 +180,8 @@ def _stage(name: str, cfg0: PlantConfig, table: tuple[Unstated, ...], workers: i
     for fp, a, z in zip(params, u0, u):
         if abs(z - a) > 1e-12:
             start, end = fp.from_unit(a), fp.from_unit(z)
-            ref = refs.get(fp.key)
-            changes.append(Change(fp.key, start, end, ref, _beyond(fp.key, end, ref, printed)))
+            ref = refs.get(fp.path)
+            changes.append(Change(fp.path, start, end, ref, _beyond(fp.path, end, ref, printed)))
     return Stage(name, reached, value, changes, evaluations=n), variant
 
 
@@ -218,7 +219,7 @@ def reach_figure(cfg: PlantConfig, conditions: dict, row: Row, base: list[Row], 
         (test, metric) -> figure replacing the paper's (``calibration_objective.rows_of``).
     """
     plausible = {u.path: (u.low, u.high) for u in UNSTATED + EFFECT_UNSTATED}
-    on = [u for u in UNSTATED + EFFECT_UNSTATED if not u.path.startswith("effects.") or u.path.split(".")[1] in cfg.effects]
+    on = [u for u in UNSTATED + EFFECT_UNSTATED if u.effect is None or u.effect in cfg.effects]
     physical = tuple(u for u in PHYSICAL if any(o.path == u.path for o in on))
     figure = (row.test, row.metric)
     out = Reach(row.test, row.metric, row.unit, row.paper, row.simulated)
@@ -234,13 +235,13 @@ def reach_figure(cfg: PlantConfig, conditions: dict, row: Row, base: list[Row], 
         else:
             if effects:
                 for eff in (e for e in EFFECTS if e not in cfg.effects):
-                    table = tuple(Unstated(f"effects.{eff}.{p.name}", p.bounds[0], p.bounds[1], p.log_scale,
+                    table = tuple(unstated(f"effects.{eff}.{p.name}", p.bounds[0], p.bounds[1], p.log_scale,
                                            "declared bounds") for p in EFFECTS[eff].params)
                     stage, variant = _stage(f"effect {eff}", cfg.replace(effects={eff: {}}), table, workers, {}, False)
                     out.stages.append(stage)
                     if stage.reached:
                         _fill(stage, variant, conditions, base)
-        printed_refs = {u.path: (value_of(cfg, u.path),) * 2 for u in PRINTED}
+        printed_refs = {u.path: (u.value_in(cfg),) * 2 for u in PRINTED}
         stage, variant = _stage("printed", cfg, PRINTED, workers, printed_refs, True)
         out.stages.append(stage)
         _fill(stage, variant, conditions, base)

@@ -58,7 +58,7 @@ def calibration_table(cal: Calibration, columns: list[tuple[str, list]] | None =
     lines += ["", "Fitted values (plausible range; the values the figures allow: local profile, cost within +1)"]
     prof = {p.path: p for p in cal.profiles}
     for u in cal.table:
-        start = _value(cal.start, u.path)
+        start = math.nan if u.effect and u.effect not in cal.start.effects else u.value_in(cal.start)
         got = cal.values[u.path]
         p = prof.get(u.path)
         pin = f"allowed {_si(p.allowed[0], '')}..{_si(p.allowed[1], u.unit)} ({p.verdict})" if p else ""
@@ -75,13 +75,6 @@ def calibration_table(cal: Calibration, columns: list[tuple[str, list]] | None =
     return "\n".join(lines)
 
 
-def _value(cfg: PlantConfig, path: str) -> float:
-    if path.startswith("effects."):
-        _, eff, name = path.split(".")
-        return float(cfg.effects.get(eff, {}).get(name, math.nan))
-    return float(cfg.p(path))
-
-
 def calibrated_config(cal: Calibration) -> PlantConfig:
     """The calibrated configuration with its provenance: parent, objective, test conditions."""
     prov = dict(cal.start.provenance)
@@ -94,7 +87,7 @@ def calibrated_config(cal: Calibration) -> PlantConfig:
     for c in CONDITIONS:
         prov[f"condition_{c.name}"] = f"{cal.conditions[c.name]} (calibrated test condition: {c.reason})"
     for eff in cal.best.effects:
-        if any(u.path.startswith(f"effects.{eff}.") for u in cal.table):
+        if any(u.effect == eff for u in cal.table):
             prov[f"effect_{eff}"] = CALIBRATED_SOURCE
     name = cal.start.name if cal.start.name.endswith("-calibrated") else f"{cal.start.name}-calibrated"
     desc = (f"{cal.start.description} -- calibrated: the values seed 000 leaves unstated fitted to its reported "

@@ -12,7 +12,7 @@ Rooms (dependencies point down this list, never back):
   verdict bands (``uncertainty_mc``);
 - ``sizing/``: a gate servo sized from its duty (``size_servo``, ``throttle_tuning``), the duty file
   and the hardware catalogue (``duty_file``, ``hardware_catalogue``, ``data_file``);
-- ``candidates/``: sweep files (``spec``), the parameter paths a sweep may move, drawing
+- ``candidates/``: sweep files (``spec``; their parameter paths are ``model.parameters.ParamHandle``), drawing
   (``sampling``), judging in workers (``evaluate``) on the one executor (``runner``, resumable with
   ``candidate_store``), ranking and the results table (``ranking``, ``results``).
 

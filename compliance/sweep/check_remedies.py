@@ -14,7 +14,7 @@ physically (``remedies.binding_physics``).
 from __future__ import annotations
 
 from compliance.sweep.candidates.evaluate import make_context
-from compliance.sweep.candidates.parameter_paths import describe
+from compliance.model.parameters import param_handle
 from compliance.sweep.candidates.spec import Adjustable, Uncertain
 from compliance.sweep.tolerance.yield_mc import nominal_values
 
@@ -55,7 +55,7 @@ def default_space(cfg) -> tuple[Adjustable, ...]:
     """The on-site settings of ``cfg`` with ranges around their values (zero-valued ones left out)."""
     out = []
     for path, (f_lo, f_hi, floor) in DEFAULT_SPACE[cfg.options["controller.type"]].items():
-        pp = describe(path, "default remedies space")
+        pp = param_handle(path, "default remedies space")
         v = float(cfg.params[path])
         lo, hi = max(pp.low, f_lo * v), min(pp.high, max(f_hi * v, floor))
         if path == "air.supply_pressure":
@@ -69,7 +69,7 @@ def _space(cfg, reqset, sweep_file):
     """(adjustables, start values, uncertain parameters) of the search."""
     from compliance.sweep.remedies.limiter_space import limiter_space
 
-    uncertain = tuple(Uncertain(describe(p, "remedies tolerances"), d, s, True, None) for p, (d, s) in DEFAULT_TOLERANCES.items())
+    uncertain = tuple(Uncertain(param_handle(p, "remedies tolerances"), d, s, True, None) for p, (d, s) in DEFAULT_TOLERANCES.items())
     if sweep_file and sweep_file != "default":
         from compliance.sweep.candidates.spec import load_sweep
 
@@ -115,7 +115,7 @@ def remedies_for_check(cfg, reqset, sweep_file: str | None, *, workers=None, pro
     paths = {a.param.path: a.param for a in adjust + (limiter[0] if limiter else ())}
     paths.update({u.param.path: u.param for u in uncertain})
     for o in (cat.options if cat else ()):
-        paths.update({p: describe(p, o.where) for p in o.values(cfg)} if o.applies_to(cfg) is None else {})
+        paths.update({p: param_handle(p, o.where) for p in o.values(cfg)} if o.applies_to(cfg) is None else {})
     ctx = make_context(cfg, reqset, paths, linear)
     with dask_session(scheduler, client) as session:
         run_kw = {"workers": workers, "progress": progress, "client": session, "scheduler": scheduler, "store": store}

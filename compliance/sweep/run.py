@@ -39,9 +39,9 @@ def load_inputs(spec):
 def verify_settings(cfg, reqset, paths, values, *, command_line=None, workers=None):
     """The full campaign (traces, linear requirements and all) of ``cfg`` with ``values`` applied."""
     from compliance.campaign.run import run_campaign
-    from compliance.sweep.candidates.parameter_paths import apply_values
+    from compliance.model.parameters import apply
 
-    return run_campaign(apply_values(cfg, paths, values), reqset, workers=workers, progress=False,
+    return run_campaign(apply(cfg, [paths[p] for p in values], values.values()), reqset, workers=workers, progress=False,
                         command_line=command_line)
 
 

@@ -16,7 +16,8 @@ import pytest
 
 from compliance.cli import main
 from compliance.model.config import load_plant
-from compliance.diagnosis.servo.candidates import FitParam, effect_params
+from compliance.diagnosis.servo.candidates import effect_params
+from compliance.model.parameters import ParamHandle
 from compliance.diagnosis.servo.diagnose import diagnose, save_fitted
 from compliance.diagnosis.evidence.replay_fit import prepare_replay, replay_config, run_replay, segment_starts
 from compliance.errors import InputError
@@ -59,7 +60,7 @@ def test_replay_of_the_model_reproduces_its_own_noise_free_recording(cfg):
 
 
 def test_fit_param_unit_cube_round_trips():
-    fp = FitParam("heat_transfer.conductance", "effect", "W/K", 0.01, 500.0, True, 10.0)
+    fp = ParamHandle("effects.heat_transfer.conductance", "W/K", 0.01, 500.0, True, kind="effect", nominal=10.0)
     for v in (0.01, 3.0, 500.0):
         assert fp.from_unit(fp.to_unit(v)) == pytest.approx(v, rel=1e-12)
     lin = effect_params("valve_offset")[0]

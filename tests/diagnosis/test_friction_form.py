@@ -12,7 +12,8 @@ import pytest
 
 from compliance.model.config import load_plant
 from compliance.diagnosis.servo.diagnose import prepare_recording
-from compliance.diagnosis.servo.candidates import apply, effect_params
+from compliance.diagnosis.servo.candidates import effect_params
+from compliance.model.parameters import apply
 from compliance.diagnosis.servo.fit import FitResult, chi2_parts
 from compliance.diagnosis.servo.friction_form import OPTION, form_after_effects, friction_form_check, form_words
 from compliance.diagnosis.evidence.replay_fit import run_replay

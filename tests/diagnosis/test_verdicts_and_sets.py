@@ -262,7 +262,7 @@ def test_a_slow_spool_is_judged_against_its_own_null_floors(cfg):
     generated case that, fitted within 1 %, left its position 2.3 x the declared floor) amplifies the
     error of the injected noise estimate more: its own null bootstrap leaves more position error, so
     judged against the larger floor its leftovers fall, and never rise."""
-    from compliance.diagnosis.servo.candidates import apply
+    from compliance.model.parameters import apply
     from compliance.diagnosis.evidence.residuals import own_floor_objective
 
     spool = {"valve_dynamics": {"natural_frequency": 34.4, "damping": 0.79, "delay": 0.0093}}

@@ -9,7 +9,8 @@ from compliance.model.config import load_plant
 from compliance.papers.calibration import calibrate
 from compliance.papers.calibration_objective import rows_of
 from compliance.papers.calibration_report import save_calibrated
-from compliance.papers.calibration_table import UNSTATED, apply_values, value_of
+from compliance.model.parameters import apply, param_handle
+from compliance.papers.calibration_table import UNSTATED
 from compliance.papers.plant_a import DEFAULT_CONDITIONS, conditions_of
 
 PREFIX = "calibrated to seed 000 figures"
@@ -22,7 +23,7 @@ def test_calibration_recovers_hidden_parameters_from_model_figures():
     cfg = load_plant("plant-a")
     truth = {"flow_control.opening_conductance": 6.0e-9, "flow_control.closing_conductance": 5.0e-9,
              "valve.saturation_voltage": 5.5}
-    rows = rows_of(apply_values(cfg, truth), DEFAULT_CONDITIONS)
+    rows = rows_of(apply(cfg, [param_handle(k, "test") for k in truth], truth.values()), DEFAULT_CONDITIONS)
     targets = {(r.test, r.metric): r.simulated for r in rows if r.paper is not None}
     table = tuple(u for u in UNSTATED if u.path in truth)
     cal = calibrate(cfg, workers=1, sobol_points=8, table=table, conditions=DEFAULT_CONDITIONS, profiles=False,
@@ -40,7 +41,7 @@ def test_calibrated_file_validates_and_records_provenance(tmp_path):
     path = save_calibrated(cal, tmp_path / "plant-a-calibrated.toml")
     back = load_plant(path)
     assert back.name == "plant-a-calibrated"
-    assert back.p("valve.saturation_voltage") == pytest.approx(value_of(cal.best, "valve.saturation_voltage"))
+    assert back.p("valve.saturation_voltage") == pytest.approx(cal.best.p("valve.saturation_voltage"))
     assert back.sources["valve.saturation_voltage"].startswith(PREFIX)
     assert back.sources["cylinder.stroke"] == "paper"  # what the paper states is not touched
     assert conditions_of(back) == {"fig9_sequence": "staircase", "full_stroke_start": "end_stop"}

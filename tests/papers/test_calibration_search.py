@@ -7,7 +7,8 @@ import pytest
 from compliance.model.config import load_plant
 from compliance.papers.calibration import calibrate
 from compliance.papers.calibration_objective import rows_of
-from compliance.papers.calibration_table import UNSTATED, apply_values
+from compliance.model.parameters import apply, param_handle
+from compliance.papers.calibration_table import UNSTATED
 from compliance.papers.plant_a import STROKE_TEST
 
 THROTTLES = ("flow_control.opening_conductance", "flow_control.closing_conductance")
@@ -20,10 +21,10 @@ def test_condition_set_restart_finds_the_basin_a_single_compass_misses():
     end-stop start, held fixed, follows one throttle at a time and recovers both (5 %: the compass stops at 2.5 % of a decade, 6 %, and
     lands within half of that)."""
     # start from the throttles that give 5 s strokes from rest (the idealised start): 0.440/0.347 dm3/(s*bar)
-    cfg = apply_values(load_plant("plant-a"), {THROTTLES[0]: 4.40e-9, THROTTLES[1]: 3.47e-9})
+    cfg = apply(load_plant("plant-a"), [param_handle(k, "test") for k in THROTTLES], (4.40e-9, 3.47e-9))
     truth = {THROTTLES[0]: 8.0e-9, THROTTLES[1]: 6.4e-9}
     end_stop = {"fig9_sequence": "alternating", "full_stroke_start": "end_stop"}
-    rows = rows_of(apply_values(cfg, truth), end_stop)
+    rows = rows_of(apply(cfg, [param_handle(k, "test") for k in truth], truth.values()), end_stop)
     targets = {(r.test, r.metric): r.simulated for r in rows if r.test == STROKE_TEST}
     table = tuple(u for u in UNSTATED if u.path in truth)
     kw = dict(workers=1, sobol_points=2, table=table, conditions={"fig9_sequence": "alternating"}, profiles=False,
@@ -47,7 +48,7 @@ def test_reach_search_finds_the_out_of_range_parameter_that_made_a_figure():
     cfg = load_plant("plant-a")
     truth = 2.0e-8
     cond = {"fig9_sequence": "alternating", "full_stroke_start": "balanced"}
-    made = rows_of(apply_values(cfg, {THROTTLES[0]: truth}), cond)
+    made = rows_of(param_handle(THROTTLES[0], "test").apply(cfg, truth), cond)
     targets = {(r.test, r.metric): r.simulated for r in made if (r.test, r.metric) == (STROKE_TEST, "opening time t_a")}
     base = rows_of(cfg, cond, targets=targets)
     row = next(r for r in base if r.paper is not None)

@@ -7,7 +7,7 @@ import pytest
 from compliance.model.config import load_plant
 from compliance.requirements.loading import load_requirements
 from compliance.sweep.candidates.evaluate import evaluate_one, make_context
-from compliance.sweep.candidates.parameter_paths import describe
+from compliance.model.parameters import param_handle
 from compliance.sweep.candidates.ranking import candidate_passes, failing_mandatory
 
 # plant A's opening throttle was derived to give 5.0 s at 5.7 kN (models/plant-a.toml, derived_for)
@@ -36,7 +36,7 @@ KEY = "flow_control.opening_conductance"
 def ctx(tmp_path_factory):
     p = tmp_path_factory.mktemp("req") / "setup-only.toml"
     p.write_text(SETUP_ONLY)
-    return make_context(load_plant("plant-a"), load_requirements(p), {KEY: describe(KEY, "test")})
+    return make_context(load_plant("plant-a"), load_requirements(p), {KEY: param_handle(KEY, "test")})
 
 
 def test_a_derived_figure_is_by_construction_and_no_pass(ctx):

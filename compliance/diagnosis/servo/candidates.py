@@ -1,9 +1,10 @@
 """Candidate explanations: each declared effect, and the recalibration of a few base parameters.
 
-Every fitted quantity is a ``FitParam`` read from the one declaration it belongs to: effect
-parameters from ``compliance.effects`` (unit, bounds, log scale), base parameters from
-``compliance.model.parameters.BASE_PARAMS`` (``fit_bounds``). The diagnosis fits in a unit cube
-u in [0, 1] per parameter (log10 of the value when declared log-scaled).
+Every fitted quantity is a ``compliance.model.parameters.ParamHandle`` read from the one declaration
+it belongs to: effect parameters from ``compliance.effects`` (unit, bounds, log scale), base
+parameters from ``compliance.model.parameters.BASE_PARAMS`` (``fit_bounds``, a prior on the value
+the plant file gives). The diagnosis fits in a unit cube u in [0, 1] per parameter (log10 of the
+value when declared log-scaled); ``model.parameters.apply`` sets the values on the plant.
 
 The coarse grids are the starting points of each effect's fit: a few physically spread
 values of its main parameter (and of a second parameter when the effect has one that changes
@@ -12,12 +13,11 @@ the signature's shape), cheap to simulate and enough to land least squares in th
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from compliance.model.config import PlantConfig
 from compliance.effects import EFFECTS
-from compliance.model.parameters import BASE_BY_KEY
+from compliance.model.parameters import BASE_BY_KEY, ParamHandle, param_handle
 
 INSTRUMENT_PREFIX = "instrument:"  # names of instrumentation candidates (servo/instrument_candidates.py)
 FRICTION_LEVEL = "friction.level"  # pseudo-parameter: one factor on static and Coulomb friction together
@@ -32,80 +32,11 @@ BASE_REFIT = (
     "friction.bristle_stiffness",
     "friction.bristle_damping",
 )
-# prior width of a recalibrated base parameter: a factor of 2 (log-scaled) or its own size
-# (linear) is one standard deviation; the data must pay for moving it further
-PRIOR_FACTOR = 2.0
 
 
-@dataclass(frozen=True)
-class FitParam:
-    """One fitted quantity.
-
-    Attributes
-    ----------
-    key : str
-        ``effect_name.param`` for an effect, a dotted base key, or ``friction.level``.
-    kind : str
-        ``"effect"`` or ``"base"``.
-    unit : str
-        SI unit (display).
-    low, high : float
-        Bounds [SI].
-    log : bool
-        Fit log10 of the value.
-    nominal : float
-        Value in the configuration the fit starts from (base) or the declared default (effect).
-    prior : bool
-        Add a prior residual pulling towards ``nominal`` (base parameters).
-    """
-
-    key: str
-    kind: str
-    unit: str
-    low: float
-    high: float
-    log: bool
-    nominal: float
-    prior: bool = False
-
-    def to_unit(self, value: float) -> float:
-        """Value [SI] -> fit coordinate u in [0, 1]."""
-        v = min(max(value, self.low), self.high)
-        if self.log:
-            return (math.log10(v) - math.log10(self.low)) / (math.log10(self.high) - math.log10(self.low))
-        return (v - self.low) / (self.high - self.low)
-
-    def from_unit(self, u: float) -> float:
-        """Fit coordinate u -> value [SI]."""
-        u = min(max(float(u), 0.0), 1.0)
-        if self.log:
-            return 10.0 ** (math.log10(self.low) + u * (math.log10(self.high) - math.log10(self.low)))
-        return self.low + u * (self.high - self.low)
-
-    def prior_residual(self, value: float) -> float:
-        """(value - nominal) in prior standard deviations (0 when no prior)."""
-        if not self.prior:
-            return 0.0
-        if self.log:
-            return math.log(value / self.nominal) / math.log(PRIOR_FACTOR)
-        scale = abs(self.nominal) if self.nominal != 0.0 else (self.high - self.low) / 10.0
-        return (value - self.nominal) / scale
-
-    def stderr(self, value: float, sigma_u: float) -> float:
-        """Standard error [SI] from the standard error of u."""
-        if self.log:
-            return value * math.log(10.0) * (math.log10(self.high) - math.log10(self.low)) * sigma_u
-        return (self.high - self.low) * sigma_u
-
-    @property
-    def effect(self) -> str | None:
-        """Effect name of an effect parameter."""
-        return self.key.split(".", 1)[0] if self.kind == "effect" else None
-
-    @property
-    def name(self) -> str:
-        """Parameter name inside its effect or section."""
-        return self.key.split(".", 1)[1]
+def effect_params(name: str) -> tuple[ParamHandle, ...]:
+    """The declared parameters of an effect as fitted quantities (declared bounds, log scale, default)."""
+    return tuple(param_handle(f"{name}.{p.name}", f"effect {name}") for p in EFFECTS[name].params)
 
 
 def is_instrument(name: str | None) -> bool:
@@ -113,20 +44,15 @@ def is_instrument(name: str | None) -> bool:
     return bool(name) and name.startswith(INSTRUMENT_PREFIX)
 
 
-def effect_params(name: str) -> tuple[FitParam, ...]:
-    """The declared parameters of an effect as fitted quantities."""
-    eff = EFFECTS[name]
-    return tuple(FitParam(f"{name}.{p.name}", "effect", p.unit, p.bounds[0], p.bounds[1], p.log_scale, p.default) for p in eff.params)
-
-
-def base_param(cfg: PlantConfig, key: str) -> FitParam | None:
+def base_param(cfg: PlantConfig, key: str) -> ParamHandle | None:
     """A recalibratable base parameter of ``cfg`` (None when it does not apply to this plant)."""
     if key == FRICTION_LEVEL:
         fs = cfg.p("friction.static_force")
         if fs <= 0.0:
             return None
         hi = min(4.0, BASE_BY_KEY["friction.static_force"].fit_bounds[1] / fs)
-        return FitParam(key, "base", "", 0.25, max(hi, 1.01), True, 1.0, True)
+        return ParamHandle(key, "", 0.25, max(hi, 1.01), True, "one factor on the static and Coulomb friction forces",
+                           nominal=1.0, prior=True, scales=("friction.static_force", "friction.coulomb_force"))
     if key.startswith("friction.bristle") and cfg.option("friction.model") != "lugre":
         return None
     spec = BASE_BY_KEY[key]
@@ -139,10 +65,10 @@ def base_param(cfg: PlantConfig, key: str) -> FitParam | None:
         lo, hi = min(lo, nominal), max(hi, nominal)
     if log and nominal <= 0.0:
         return None
-    return FitParam(key, "base", BASE_BY_KEY[key].unit, lo, hi, log, nominal, True)
+    return replace(param_handle(key, "diagnosis"), low=lo, high=hi, log=log, nominal=nominal, prior=True)
 
 
-def base_params(cfg: PlantConfig, keys=BASE_REFIT) -> tuple[FitParam, ...]:
+def base_params(cfg: PlantConfig, keys=BASE_REFIT) -> tuple[ParamHandle, ...]:
     """The recalibratable base parameters that apply to ``cfg``."""
     out = []
     for k in keys:
@@ -150,46 +76,6 @@ def base_params(cfg: PlantConfig, keys=BASE_REFIT) -> tuple[FitParam, ...]:
         if fp is not None:
             out.append(fp)
     return tuple(out)
-
-
-def apply(cfg: PlantConfig, params, values) -> PlantConfig:
-    """Configuration with fitted values set (effects switched on with their other params at default).
-
-    Parameters
-    ----------
-    cfg : PlantConfig
-        Parent configuration.
-    params : sequence of FitParam
-    values : sequence of float
-        SI values, one per parameter.
-    """
-    base: dict[str, float] = {}
-    effects: dict[str, dict[str, float]] = {}
-    for fp, v in zip(params, values):
-        if fp.kind == "instrument":
-            continue  # on the logger, not the plant (instrument_candidates.instrumented)
-        if fp.kind == "effect":
-            effects.setdefault(fp.effect, {})[fp.name] = float(v)
-        elif fp.key == FRICTION_LEVEL:
-            base["friction.static_force"] = cfg.p("friction.static_force") * v
-            base["friction.coulomb_force"] = cfg.p("friction.coulomb_force") * v
-        else:
-            base[fp.key] = float(v)
-    return cfg.replace(params=base or None, effects=effects or None)
-
-
-def expand_base(cfg: PlantConfig, params, values) -> dict[str, float]:
-    """Base-parameter values [SI] a fit set, with ``friction.level`` written as the two forces."""
-    out = {}
-    for fp, v in zip(params, values):
-        if fp.kind != "base":
-            continue
-        if fp.key == FRICTION_LEVEL:
-            out["friction.static_force"] = cfg.p("friction.static_force") * v
-            out["friction.coulomb_force"] = cfg.p("friction.coulomb_force") * v
-        else:
-            out[fp.key] = float(v)
-    return out
 
 
 # ------------------------------------------------------------------------------- coarse grids
@@ -219,7 +105,7 @@ BASE_SCAN_FACTORS = {
 DEFAULT_BASE_FACTORS = (0.5, 0.75, 1.33, 2.0)
 
 
-def base_scan_values(fp: FitParam, current: float) -> list[float]:
+def base_scan_values(fp: ParamHandle, current: float) -> list[float]:
     """Values tried in the 1-D scan of a base parameter around ``current``."""
     factors = BASE_SCAN_FACTORS.get(fp.key, DEFAULT_BASE_FACTORS)
     vals = []
@@ -238,7 +124,7 @@ class Candidate:
     """One explanation to fit: an effect (with its declared parameters) or ``base`` recalibration."""
 
     name: str
-    params: tuple[FitParam, ...] = ()
+    params: tuple[ParamHandle, ...] = ()
     grid: tuple[dict, ...] = field(default_factory=tuple)
 
     @property

@@ -24,9 +24,10 @@ from dataclasses import dataclass, field, replace as dc_replace
 import numpy as np
 
 from compliance.model.config import PlantConfig, plant_to_toml, _suggest as _suggest_name
+from compliance.model.parameters import apply
 from compliance.effects import EFFECTS
 from compliance.errors import InputError, SimulationError
-from compliance.diagnosis.servo.candidates import Candidate, apply, base_params, effect_candidate, signature_order
+from compliance.diagnosis.servo.candidates import Candidate, base_params, effect_candidate, signature_order
 from compliance.diagnosis.servo.fit import FitContext, FitResult, chi2_parts, replays_bound, screen_level
 from compliance.diagnosis.servo.fitted_model import fitted_plant, save_fitted
 from compliance.diagnosis.servo.effect_sets import (CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_enough, contributions, full_name,

@@ -4,7 +4,7 @@ One fit: a coarse scan of the candidate's starting grid (cheap, finds the basin)
 Nelder-Mead simplex (Nelder & Mead 1965) from the best grid point with steps of 5 % of each
 parameter's range, then ``scipy.optimize.least_squares`` (trust-region reflective, bounds)
 to polish and to give the Jacobian. All of it runs in the unit cube of
-``servo.candidates.FitParam`` on the stacked residuals of every measured signal divided by its
+``model.parameters.ParamHandle`` on the stacked residuals of every measured signal divided by its
 noise floor, plus prior residuals holding recalibrated base parameters near their
 data-sheet values.
 
@@ -33,9 +33,10 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from compliance.model.config import PlantConfig
+from compliance.model.parameters import ParamHandle, apply
 from compliance.effects import EFFECTS
 from compliance.errors import InputError
-from compliance.diagnosis.servo.candidates import Candidate, FitParam, apply
+from compliance.diagnosis.servo.candidates import Candidate
 from compliance.diagnosis.servo.instrument_candidates import instrumented
 from compliance.diagnosis.evidence.replay_fit import ReplaySetup
 from compliance.diagnosis.evidence.residuals import ResidualModel, evaluate
@@ -107,7 +108,7 @@ class FitResult:
     ----------
     name : str
         Effect name, ``base`` (recalibration alone) or ``nominal``.
-    params : tuple of FitParam
+    params : tuple of ParamHandle
     values, stderr : list of float
         Fitted values and standard errors [SI].
     chi2 : float
@@ -218,7 +219,7 @@ def _nelder_mead(fun, u0: np.ndarray, maxfev: int, step: float = 0.05) -> np.nda
     return np.clip(res.x, 0.0, 1.0)
 
 
-def least_squares_fit(ctx: FitContext, name: str, params: tuple[FitParam, ...], start: list[float], *,
+def least_squares_fit(ctx: FitContext, name: str, params: tuple[ParamHandle, ...], start: list[float], *,
                       max_nfev: int = MAX_NFEV, diff_step: float = DIFF_STEP, simplex_fev: int = SIMPLEX_FEV) -> FitResult:
     """Fit ``params`` from ``start`` (SI values): simplex search, then bounded least squares.
 

@@ -7,17 +7,12 @@ from pathlib import Path
 
 from compliance.errors import InputError
 from compliance.model.config import PlantConfig, save_plant
-from compliance.diagnosis.servo.candidates import expand_base
+from compliance.model.parameters import apply
 from compliance.diagnosis.servo.fit import FitResult
 
 
 def fitted_plant(cfg: PlantConfig, fit: FitResult, meta: dict) -> PlantConfig:
     """The plant (not the test's controller overrides) with the winner's values, with provenance."""
-    params = expand_base(cfg, fit.params, fit.values)
-    effects: dict[str, dict] = {}
-    for fp, v in zip(fit.params, fit.values):
-        if fp.kind == "effect":
-            effects.setdefault(fp.effect, {})[fp.name] = v
     prov = dict(cfg.provenance)
     prov.update({
         "fitted_by": "govcheck diagnose",
@@ -27,8 +22,7 @@ def fitted_plant(cfg: PlantConfig, fit: FitResult, meta: dict) -> PlantConfig:
         "date": datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
         "explanation": fit.name,
     })
-    return cfg.replace(params=params or None, effects=effects or None, provenance=prov,
-                       sources={k: "derived" for k in params}, name=f"{cfg.name}-fitted")
+    return apply(cfg, fit.params, fit.values, source="derived").replace(provenance=prov, name=f"{cfg.name}-fitted")
 
 
 def save_fitted(diag, path) -> Path:

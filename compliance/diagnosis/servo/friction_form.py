@@ -30,9 +30,10 @@ import math
 from types import SimpleNamespace
 
 from compliance.model.config import plant_to_toml
+from compliance.model.parameters import apply
 from compliance.effects import EFFECTS
 from compliance.errors import InputError, SimulationError
-from compliance.diagnosis.servo.candidates import apply, effect_candidate
+from compliance.diagnosis.servo.candidates import effect_candidate
 from compliance.diagnosis.servo.fit import chi2_parts
 from compliance.diagnosis.evidence.replay_fit import run_replay
 from compliance.diagnosis.servo.selection import MIN_GAIN, SIGNIFICANCE, beats, score_all

@@ -19,7 +19,8 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from compliance.diagnosis.servo.candidates import INSTRUMENT_PREFIX as PREFIX, Candidate, FitParam, is_instrument  # noqa: F401 (public here)
+from compliance.model.parameters import ParamHandle
+from compliance.diagnosis.servo.candidates import INSTRUMENT_PREFIX as PREFIX, Candidate, is_instrument  # noqa: F401 (public here)
 from compliance.validation.logger_model import FILTERED, PRESSURES, LoggerModel
 
 KIND = "instrument"
@@ -39,7 +40,7 @@ MEANING = {
 
 
 def _offset(name: str, low: float = -MAX_OFFSET) -> Candidate:
-    fp = FitParam(f"{PREFIX}{name}.delay", KIND, "s", low, MAX_OFFSET, False, 0.0)
+    fp = ParamHandle(f"{PREFIX}{name}.delay", "s", low, MAX_OFFSET, kind=KIND, nominal=0.0)
     grid = tuple({"delay": d} for d in OFFSET_GRID if d >= low)
     return Candidate(PREFIX + name, (fp,), grid)
 
@@ -50,7 +51,7 @@ def instrument_candidates(signals, closed_loop: bool) -> list[Candidate]:
     out = []
     if pressures:
         out.append(_offset("pressure_time_offset"))
-        gains = tuple(FitParam(f"{PREFIX}pressure_gain.{p}", KIND, "", 1.0 - MAX_GAIN_ERROR, 1.0 + MAX_GAIN_ERROR, False, 1.0)
+        gains = tuple(ParamHandle(f"{PREFIX}pressure_gain.{p}", "", 1.0 - MAX_GAIN_ERROR, 1.0 + MAX_GAIN_ERROR, kind=KIND, nominal=1.0)
                       for p in pressures)
         out.append(Candidate(PREFIX + "pressure_gain", gains, ({},)))
     if closed_loop and "position" in signals and "valve_command" in signals:

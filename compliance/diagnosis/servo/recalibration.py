@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import time
 
-from compliance.diagnosis.servo.candidates import FitParam, base_scan_values
+from compliance.model.parameters import ParamHandle
+from compliance.diagnosis.servo.candidates import base_scan_values
 from compliance.diagnosis.servo.fit import MAX_NFEV, SIMPLEX_FEV, FitContext, FitResult, least_squares_fit, scan_points
 
 REFINE_TOP = 3  # base parameters refined in 1-D per forward-selection round
@@ -21,7 +22,7 @@ JOIN_GAIN = 0.25  # share of the excess chi-square a base parameter must remove 
 AT_FLOOR = 1.2  # chi2/N at which the recalibration stops: the fit is at the noise floor
 
 
-def forward_select_base(ctx: FitContext, params: tuple[FitParam, ...], *, penalty: float, max_params: int = 2,
+def forward_select_base(ctx: FitContext, params: tuple[ParamHandle, ...], *, penalty: float, max_params: int = 2,
                         max_nfev: int = MAX_NFEV, map_fn=None) -> tuple[FitResult, list[dict]]:
     """Greedy recalibration: add the base parameter whose 1-D scan helps most, refit, repeat.
 
@@ -36,7 +37,7 @@ def forward_select_base(ctx: FitContext, params: tuple[FitParam, ...], *, penalt
     map_fn = map_fn or default_map
     t0 = time.perf_counter()
     sims0 = ctx.sims
-    chosen: list[FitParam] = []
+    chosen: list[ParamHandle] = []
     values: list[float] = []
     current = least_squares_fit(ctx, "base", (), [])
     log = []
@@ -50,7 +51,7 @@ def forward_select_base(ctx: FitContext, params: tuple[FitParam, ...], *, penalt
         if not trials:
             break
         chis = list(map_fn(_scan_task, [(tp, tv) for _, tp, tv in trials], ctx=ctx))
-        best_by_param: dict[str, tuple[float, float, FitParam]] = {}
+        best_by_param: dict[str, tuple[float, float, ParamHandle]] = {}
         for (fp, tp, tv), c in zip(trials, chis):
             if fp.key not in best_by_param or c < best_by_param[fp.key][0]:
                 best_by_param[fp.key] = (c, tv[-1], fp)
@@ -82,7 +83,7 @@ def forward_select_base(ctx: FitContext, params: tuple[FitParam, ...], *, penalt
     return current, log
 
 
-def _refine_1d(ctx: FitContext, chosen: tuple, values: list, fp: FitParam, start: float) -> tuple[float, float]:
+def _refine_1d(ctx: FitContext, chosen: tuple, values: list, fp: ParamHandle, start: float) -> tuple[float, float]:
     """Bounded 1-D minimisation of chi-square (+ prior) over ``fp`` around ``start``, others held."""
     from scipy.optimize import minimize_scalar
 

@@ -1,1 +1,1 @@
-"""Candidates of a sweep: declared (sweep files, parameter paths), drawn, judged on the one executor, ranked, tabulated."""
+"""Candidates of a sweep: declared (sweep files), drawn, judged on the one executor, ranked, tabulated."""

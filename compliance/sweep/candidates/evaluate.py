@@ -18,7 +18,7 @@ from compliance.errors import GovcheckError
 from compliance.procedures.outcomes import traces_off
 from compliance.procedures.registry import run as run_procedure
 from compliance.requirements.verdict import DISABLED, FAIL, NOT_EVALUATED, OPEN, PASS, overall_status
-from compliance.sweep.candidates.parameter_paths import apply_values
+from compliance.model.parameters import apply
 
 __all__ = ["Context", "INVALID", "evaluate_batch", "evaluate_one", "make_context", "sweep_requirements"]
 
@@ -57,7 +57,7 @@ def make_context(cfg, reqset, paths: dict, linear: bool = False) -> Context:
 def evaluate_one(ctx: Context, values: dict) -> dict:
     """Judge one candidate: ``{"status", "error", "requirements": {id: {...}}}``."""
     try:
-        cfg = apply_values(ctx.cfg, ctx.paths, values)
+        cfg = apply(ctx.cfg, [ctx.paths[p] for p in values], values.values())
         with traces_off():
             outcomes = [run_procedure(cfg, ctx.reqset.procedures[j.procedure],
                                       ctx.reqset.operating_points[j.operating_point], j.requests) for j in ctx.jobs]

@@ -18,7 +18,7 @@ from typing import Literal, Union
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from compliance.errors import InputError, did_you_mean
-from compliance.sweep.candidates.parameter_paths import ParamPath, describe
+from compliance.model.parameters import ParamHandle, param_handle
 from compliance.units import parse_quantity
 
 __all__ = ["Adjustable", "SweepSpec", "Uncertain", "load_sweep", "SCHEMA"]
@@ -74,7 +74,7 @@ class _SweepIn(_Strict):
 class Adjustable:
     """An adjustable parameter: SI ``low``/``high`` (range) or ``values`` (list); ``base`` filled later."""
 
-    param: ParamPath
+    param: ParamHandle
     low: float
     high: float
     values: tuple[float, ...] | None  # a list of allowed settings instead of a range
@@ -90,7 +90,7 @@ class Adjustable:
 class Uncertain:
     """An uncertain parameter: a distribution around the candidate's value."""
 
-    param: ParamPath
+    param: ParamHandle
     distribution: str  # normal | uniform | list
     spread: float  # std (normal) or half width (uniform); relative when ``relative``
     relative: bool
@@ -119,7 +119,7 @@ class SweepSpec:
 
     @property
     def paths(self) -> dict:
-        """Every parameter path the sweep moves -> :class:`ParamPath`."""
+        """Every parameter path the sweep moves (canonical spelling) -> its :class:`ParamHandle`."""
         out = {a.param.path: a.param for a in self.adjust}
         out.update({u.param.path: u.param for u in self.uncertain})
         return out
@@ -142,7 +142,7 @@ def _where_of(path: Path, loc) -> str:
     return f"{path}: {'.'.join(parts)}"
 
 
-def _si(text, pp: ParamPath, where: str) -> float:
+def _si(text, pp: ParamHandle, where: str) -> float:
     v = parse_quantity(text, pp.unit, where, pressure=pp.pressure)
     if not (pp.low <= v <= pp.high):
         raise InputError(f"{where}: {v:g} {pp.unit} is outside the admissible {pp.low:g} .. {pp.high:g} {pp.unit} ({pp.meaning})")
@@ -150,7 +150,7 @@ def _si(text, pp: ParamPath, where: str) -> float:
 
 
 def _adjustable(path: str, a: _AdjustIn, where: str) -> Adjustable:
-    pp = describe(path, where)
+    pp = param_handle(path, where)
     if (a.range is None) == (a.values is None):
         raise InputError(f"{where}: give either range = [low, high] or values = [...]")
     if a.values is not None:
@@ -166,7 +166,7 @@ def _adjustable(path: str, a: _AdjustIn, where: str) -> Adjustable:
     return Adjustable(pp, lo, hi, None, a.steps)
 
 
-def _spread(text, pp: ParamPath, where: str) -> tuple[float, bool]:
+def _spread(text, pp: ParamHandle, where: str) -> tuple[float, bool]:
     relative = isinstance(text, str) and text.strip().endswith("%")
     v = parse_quantity(text, "" if relative else pp.unit, where)  # a difference: no abs/gauge
     if v < 0 or not math.isfinite(v):
@@ -175,7 +175,7 @@ def _spread(text, pp: ParamPath, where: str) -> tuple[float, bool]:
 
 
 def _uncertain(path: str, u: _UncertainIn, where: str) -> Uncertain:
-    pp = describe(path, where)
+    pp = param_handle(path, where)
     if u.distribution == "list":
         if not u.values:
             raise InputError(f"{where}.values: distribution 'list' needs a non-empty list of values")
@@ -186,6 +186,16 @@ def _uncertain(path: str, u: _UncertainIn, where: str) -> Uncertain:
         raise InputError(f"{where}: distribution '{u.distribution}' needs {key} (e.g. \"10 %\" or a quantity in {pp.unit})")
     spread, relative = _spread(text, pp, f"{where}.{key}")
     return Uncertain(pp, u.distribution, spread, relative, None)
+
+
+def _once(path: Path, table: str, written, items) -> None:
+    """Refuse two spellings of one parameter in a table (``effects.NAME.PARAM`` and ``NAME.PARAM``)."""
+    seen: dict[str, str] = {}
+    for key, item in zip(written, items):
+        if item.param.path in seen:
+            raise InputError(f'{path}: {table}."{key}": the same parameter as "{seen[item.param.path]}" '
+                             f"({item.param.path}); name it once")
+        seen[item.param.path] = key
 
 
 def _resolve_file(text: str, folder: Path) -> str:
@@ -222,6 +232,8 @@ def load_sweep(source) -> SweepSpec:
         raise InputError(f"{path}: adjust: no adjustable parameter; name at least one")
     adjust = tuple(_adjustable(k, v, f'{path}: adjust."{k}"') for k, v in raw.adjust.items())
     uncertain = tuple(_uncertain(k, v, f'{path}: uncertain."{k}"') for k, v in raw.uncertain.items())
+    _once(path, "adjust", raw.adjust, adjust)
+    _once(path, "uncertain", raw.uncertain, uncertain)
     folder = path.parent
     return SweepSpec(
         path=str(path), name=raw.name, title=raw.title or raw.name,

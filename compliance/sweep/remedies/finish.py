@@ -72,10 +72,11 @@ def _yield(rem, ctx, cfg, uncertain, run_kw, units):
 
 def _closest_configuration(cfg, ctx, closest):
     """``cfg`` with the closest candidate's hardware and settings: its binding physics is told with its own numbers."""
-    from compliance.sweep.candidates.parameter_paths import apply_values
+    from compliance.model.parameters import apply
 
     values = {**closest.get("hardware_values", {}), **closest.get("values", {})}
-    return apply_values(cfg, ctx.paths, {k: v for k, v in values.items() if k in ctx.paths})
+    known = [k for k in values if k in ctx.paths]
+    return apply(cfg, [ctx.paths[k] for k in known], [values[k] for k in known])
 
 
 def finish(rem, given, ctx, cfg, reqset, uncertain, catalogue, *, run_kw, yield_units) -> dict:
@@ -106,10 +107,10 @@ def finish(rem, given, ctx, cfg, reqset, uncertain, catalogue, *, run_kw, yield_
 
 def remedy_configuration(cfg, rem, paths):
     """The configuration with the remedy applied, named ``<name>-remedy`` (for ``--save-remedy``)."""
-    from compliance.sweep.candidates.parameter_paths import apply_values
+    from compliance.model.parameters import apply
 
     values = remedy_values(rem)
-    changed = apply_values(cfg, paths, values)
+    changed = apply(cfg, [paths[p] for p in values], values.values())
     note = "remedies search of govcheck check --remedies: " + ", ".join(
         f"{c['path']} {c['from']:.4g} -> {c['to']:.4g}" for c in rem["remedy"]["changes"])
     hw = ", ".join(h["title"] for h in rem["remedy"].get("hardware", []))

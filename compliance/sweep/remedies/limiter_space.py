@@ -12,7 +12,7 @@ competing with it. The box spans 0.8-1.2 times those rates and 0.5-10 % of the s
 
 from __future__ import annotations
 
-from compliance.sweep.candidates.parameter_paths import describe
+from compliance.model.parameters import param_handle
 from compliance.sweep.candidates.spec import Adjustable
 
 __all__ = ["LIMITER_PATHS", "limiter_space", "limiter_stage_start", "limiter_start"]
@@ -68,7 +68,7 @@ def limiter_space(cfg, reqset) -> tuple[tuple[Adjustable, ...], dict]:
     L = cfg.params["cylinder.stroke"]
     adjust = []
     for path in LIMITER_PATHS:
-        pp = describe(path, "remedies space")
+        pp = param_handle(path, "remedies space")
         lo, hi = (0.005 * L, 0.10 * L) if path == LIMITER_PATHS[2] else (0.8 * start[path], 1.2 * start[path])
         adjust.append(Adjustable(pp, lo, hi, None, 3))
     return tuple(adjust), start

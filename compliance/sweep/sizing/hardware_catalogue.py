@@ -20,7 +20,7 @@ from compliance.effects import EFFECTS
 from compliance.errors import InputError
 from compliance.sweep.sizing.data_file import read_validated
 from compliance.physics.valve_rating import NL_MIN, conductance_of_rating
-from compliance.sweep.candidates.parameter_paths import describe
+from compliance.model.parameters import param_handle
 from compliance.units import parse_quantity
 
 __all__ = ["Catalogue", "HardwareOption", "load_catalogue", "DEFAULT_CATALOGUE"]
@@ -82,8 +82,8 @@ class HardwareOption:
         atm = cfg.params["air.atmospheric_pressure"]
         out = {}
         for path, text in self.sets:
-            pp = describe(path, self.where)
-            out[path] = parse_quantity(text, pp.unit, f"{self.where}.sets.{path}", pressure=pp.pressure, atmosphere=atm)
+            pp = param_handle(path, self.where)
+            out[pp.path] = parse_quantity(text, pp.unit, f"{self.where}.sets.{path}", pressure=pp.pressure, atmosphere=atm)
         if self.valve_rating is not None:
             out["valve.sonic_conductance"] = conductance_of_rating(self.valve_rating, atm,
                                                                    cfg.params["valve.critical_pressure_ratio"])
@@ -114,7 +114,7 @@ def _option(name: str, raw: _OptionIn, where: str) -> HardwareOption:
     if not raw.sets and raw.valve_rating is None:
         raise InputError(f"{where}: an option must set something (sets = {{...}} or valve_rating)")
     for path, text in raw.sets.items():
-        pp = describe(path, f"{where}.sets")
+        pp = param_handle(path, f"{where}.sets")
         v = parse_quantity(text, pp.unit, f"{where}.sets.{path}", pressure=pp.pressure)
         if not pp.low <= v <= pp.high:
             raise InputError(f"{where}.sets.{path}: {v:g} {pp.unit} is outside {pp.low:g} .. {pp.high:g} ({pp.meaning})")

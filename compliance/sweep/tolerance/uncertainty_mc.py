@@ -14,7 +14,7 @@ import numpy as np
 
 from compliance.campaign.uncertainty import _targets, apply_band, ranged_parameters, top_assumptions
 from compliance.sweep.candidates.evaluate import make_context
-from compliance.sweep.candidates.parameter_paths import describe
+from compliance.model.parameters import param_handle
 from compliance.sweep.candidates.runner import run_candidates
 from compliance.sweep.candidates.sampling import latin_hypercube
 from compliance.sweep.candidates.spec import Adjustable
@@ -56,7 +56,7 @@ def monte_carlo_bands(cfg, reqset, results: dict, n: int, *, seed: int = 0, work
         The ``uncertainty`` section: method, parameters, candidates judged and invalid, top assumptions.
     """
     ranged = ranged_parameters(cfg)
-    paths = {k: describe(k, f"{cfg.path}: {k}.range") for k, _ in ranged}
+    paths = {k: param_handle(k, f"{cfg.path}: {k}.range") for k, _ in ranged}
     adjust = tuple(Adjustable(paths[k], rng["low"], rng["high"], None, 2) for k, rng in ranged)
     cands = latin_hypercube(adjust, n, seed)
     ctx = make_context(cfg, reqset, paths)

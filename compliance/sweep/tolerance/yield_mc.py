@@ -55,16 +55,7 @@ def lower_bound(k: int, n: int, confidence: float) -> float:
 
 def nominal_values(cfg, paths: dict) -> dict:
     """SI value of each path in ``cfg`` (an effect that is off gives its declared default)."""
-    from compliance.effects import EFFECTS
-
-    out = {}
-    for path, pp in paths.items():
-        if pp.effect:
-            out[path] = float(cfg.effects.get(pp.effect, EFFECTS[pp.effect].defaults()).get(pp.name,
-                                                                                             EFFECTS[pp.effect].param(pp.name).default))
-        else:
-            out[path] = float(cfg.params[path])
-    return out
+    return {path: pp.value_in(cfg) for path, pp in paths.items()}
 
 
 def _drivers(units, rows, uncertain, ids):
