@@ -129,6 +129,9 @@ def test_null_recording_gives_no_mismatch(cfg):
     assert d.verdict == "no_mismatch"
     assert d.winner is None
     assert "Nothing is wrong" in d.explanation
+    # within the floor nothing is refined: each candidate is shown at its best grid point (6 + 6 replays)
+    assert all(f.message.startswith("screened") for k, f in d.fits.items() if k != "nominal")
+    assert d.simulations < 40
 
 
 def test_a_miscalibrated_valve_is_called_parameters_only(cfg):

@@ -384,7 +384,8 @@ def run_practice(directory, cfg: PlantConfig, *, library=None, jobs: int = 1, pr
             params[alias] = {"true": value, "fitted": got, "error": None if got is None else abs(got - value) / abs(value)}
         rows.append({"name": name, "truth": ", ".join(truth) or "none", "verdict": d.verdict, "winner": d.winner,
                      "correct": bool(correct), "ambiguous_with_truth": ambiguous_ok, "ambiguity": list(d.ambiguous),
-                     "signals_left": dict(d.signals_left), "parameters": params, "seconds": d.seconds, "explanation": d.explanation,
+                     "signals_left": dict(d.signals_left), "parameters": params, "seconds": d.seconds, "simulations": d.simulations,
+                     "explanation": d.explanation,
                      "fit_before": d.fit_before, "fit_after": d.fit_after, "main": main_parameter(d, truth, params),
                      # the verdict's own yardstick (re-synchronised replay, x floor), every fitted value, the lag scan
                      "objective_before": d.objective_before, "objective_after": d.objective_after, "fitted": fitted,

@@ -28,9 +28,9 @@ from compliance.model.parameters import apply
 from compliance.effects import EFFECTS
 from compliance.errors import InputError, SimulationError
 from compliance.diagnosis.servo.candidates import Candidate, base_params, effect_candidate, signature_order
-from compliance.diagnosis.servo.fit import FitContext, FitResult, chi2_parts
+from compliance.diagnosis.servo.fit import FitContext, FitResult, chi2_parts, replays_bound, screen_level
 from compliance.diagnosis.servo.fitted_model import fitted_plant, save_fitted
-from compliance.diagnosis.servo.effect_sets import CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_enough, contributions, extended_set
+from compliance.diagnosis.servo.effect_sets import CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_enough, contributions, full_name, prune
 from compliance.diagnosis.evidence.discriminating_test import design_test
 from compliance.diagnosis.evidence.empirical_force import empirical_term
 from compliance.diagnosis.servo.instrument_candidates import (PREFIX, instrument_candidates, instrument_verdict, instrumented,
@@ -45,7 +45,7 @@ from compliance.diagnosis.servo.selection import (AMBIGUOUS_BIC, EXPLAINED_ENOUG
 from compliance.diagnosis.servo.report_data import SCHEMA
 from compliance.diagnosis.servo.result import Diagnosis
 from compliance.diagnosis.evidence.locate_misfit import event_rms, locate_mismatch, mask_agreement, where_words
-from compliance.diagnosis.servo.parallel_fits import (ExtendSet, FitEffect, FitWithBase, RecalibrateBase, ScreenAddition,
+from compliance.diagnosis.servo.parallel_fits import (ExtendSet, FitEffect, FitWithBase, RecalibrateBase, RefitSet, ScreenAddition,
                                                      default_jobs, map_tasks)
 from compliance.diagnosis.verdicts.candidate_set import BASE, CandidateSet
 from compliance.diagnosis.verdicts.verdict import EXPLAINED, INCOMPLETE, DiagnosisVerdict
@@ -128,7 +128,7 @@ def _run(st: Stage, tasks) -> None:
     for res, v in map_tasks(tasks, st.jobs, st.payload):
         st.fits[res.name] = res
         st.vecs[res.name] = v
-        st.sims += res.sims + 1
+        st.sims += res.sims
 
 
 def _fit_singles(st: Stage, names, recalibrate: bool) -> None:
@@ -137,12 +137,15 @@ def _fit_singles(st: Stage, names, recalibrate: bool) -> None:
     chi2 = st.fits["nominal"].chi2
     excess = {s: v * v - 1.0 for s, v in st.nominal_rms.items()}
     tasks = []
-    bparams = base_params(st.rc) if recalibrate else ()
+    # within the floor the verdict is no_mismatch whatever the fits: every candidate is shown at its best grid point
+    within = max(_objective(st, "nominal").values(), default=0.0) <= NOISE_TOLERANCE
+    bparams = base_params(st.rc) if recalibrate and not within else ()
     if bparams:
         tasks.append(RecalibrateBase(bparams, 2.0 * math.log(n) * max(1.0, chi2 / n)))
-    tasks += [FitEffect(effect_candidate(e)) for e in signature_order(names, excess)]
-    tasks += [FitEffect(c) for c in instrument_candidates(st.model.signals, st.setup.closed_loop)]
-    _run(st, tasks)
+    screen = -math.inf if within else screen_level(chi2, n)
+    fits = [FitEffect(effect_candidate(e), screen) for e in signature_order(names, excess)]
+    fits += [FitEffect(c, -math.inf if within else None) for c in instrument_candidates(st.model.signals, st.setup.closed_loop)]
+    _run(st, tasks + sorted(fits, key=lambda t: -replays_bound(t.candidate)))  # the longest fits first
     base_fit = st.fits.get("base")
     singles = [f for f in st.fits.values() if f.name != "nominal"]
     best = min(singles, key=lambda f: f.chi2, default=None)
@@ -164,8 +167,9 @@ def _search_sets(st: Stage, winner: str) -> list[dict]:
         screened = [r for r, _ in map_tasks([ScreenAddition(current, f) for f in singles], st.jobs, st.payload)]
         screen = {name: (chi, start) for name, chi, start, _ in screened}
         st.sims += sum(r[3] for r in screened)
-        order = sorted(singles, key=lambda f: screen[f.name][0])[:CANDIDATES_PER_ROUND]
-        tasks = [ExtendSet(current, f, screen[f.name][1]) for f in order]
+        level = screen_level(current.chi2, n)  # an addition whose screen removes too little is not refitted
+        order = sorted((f for f in singles if screen[f.name][0] <= level), key=lambda f: screen[f.name][0])
+        tasks = [ExtendSet(current, f, screen[f.name][1]) for f in order[:CANDIDATES_PER_ROUND]]
         if not tasks:
             break
         _run(st, tasks)
@@ -183,7 +187,7 @@ def _search_sets(st: Stage, winner: str) -> list[dict]:
 
 
 def _extended(st: Stage, current: FitResult, single: FitResult) -> FitResult:
-    return st.fits[extended_set(current, single).name]
+    return st.fits[full_name(CandidateSet.parse(current.name).effects + CandidateSet.parse(single.name).effects, current.params)]
 
 
 def _objective(st: Stage, name: str) -> dict:
@@ -203,10 +207,11 @@ def _decide(st: Stage) -> dict:
     search = []
     if winner is not None and winner != "base" and verdict_name != DiagnosisVerdict.NO_MISMATCH:
         search = _search_sets(st, winner)
-        scores = score_all(st.fits, n)  # the sets tried are candidates too
         kept = [r for r in search if r["kept"]]
+        winner, pruned = prune(st.fits, kept[-1]["best"] if kept else winner, n, lambda sets: _run(st, [RefitSet(*s) for s in sets]))
+        search += pruned
+        scores = score_all(st.fits, n)  # the sets tried are candidates too
         if kept:
-            winner = kept[-1]["best"]
             explained = scores[winner].explained
             reason = f"{' and '.join(CandidateSet.parse(winner).effects)} together explain {100*explained:.0f} % of the excess residual"
             verdict_name = DiagnosisVerdict.MISSING_PHYSICS if explained >= EXPLAINED_ENOUGH else DiagnosisVerdict.UNEXPLAINED

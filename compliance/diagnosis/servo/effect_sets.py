@@ -18,6 +18,13 @@ move with the added one). An added effect is kept only when
   ``servo.selection.RESIDUAL_LIMIT`` times its floor (a third effect that lowers the pooled chi-square by
   trading one signal for another is not physics; a signal that stays at its floor may wobble).
 
+Once the forward search stops, each effect of the set must still earn its place (``prune``,
+stepwise backward elimination after the forward steps, Efroymson 1960): an effect found early can be
+made redundant by the ones added after it. Every effect is removed in turn and the rest refitted
+with the recording's best instrumentation finding on top (a transducer gain, a channel delay:
+``instrument_candidates``), so a physical effect stays only when it beats the instrumentation
+explanation of the same misfit (``select.beats``); a removed effect's place may go to the finding.
+
 Each effect's own contribution in the final set is the chi-square the set loses when that
 effect alone is switched off (the others at their fitted values): one replay per effect.
 """
@@ -29,8 +36,9 @@ import numpy as np
 from compliance.effects import EFFECTS
 from compliance.diagnosis.servo.candidates import effect_candidate
 from compliance.diagnosis.servo.fit import FitContext, FitResult, least_squares_fit, scan_points
-from compliance.diagnosis.servo.selection import RESIDUAL_LIMIT, SIGNIFICANCE
-from compliance.diagnosis.verdicts.candidate_set import BASE, CandidateSet
+from compliance.diagnosis.servo.instrument_candidates import KIND as INSTRUMENT
+from compliance.diagnosis.servo.selection import RESIDUAL_LIMIT, SIGNIFICANCE, beats, score_all
+from compliance.diagnosis.verdicts.candidate_set import BASE, CandidateSet, is_instrument
 
 ADD_GAIN = 0.3  # share of the current set's excess chi-square an added effect must remove
 NO_WORSE = 1.25  # no signal's chi-square may rise by more than this factor when an effect is added
@@ -47,6 +55,13 @@ def extended_set(current: FitResult, single: FitResult) -> CandidateSet:
     recalibrates the base parameters."""
     recalibrated = [BASE] if any(fp.kind == "base" for fp in current.params) else []
     return CandidateSet.of(CandidateSet.parse(current.name).effects + CandidateSet.parse(single.name).effects + recalibrated)
+
+
+def full_name(effects, params) -> str:
+    """Candidate name of ``effects`` fitted with ``params``: the instrumentation findings and ``base`` among them
+    appended (``a+b+instrument:pressure_gain+base``)."""
+    instruments = list(dict.fromkeys(fp.key.split(".", 1)[0] for fp in params if fp.kind == INSTRUMENT))
+    return CandidateSet.of(list(effects) + instruments + ([BASE] if any(fp.kind == "base" for fp in params) else [])).name
 
 
 def _start_points(current: FitResult, single: FitResult) -> tuple[tuple, list[list[float]]]:
@@ -97,7 +112,8 @@ def extend_fit(ctx: FitContext, current: FitResult, single: FitResult, start: li
     if start is None:
         chis = scan_points(ctx, params, starts)
         start = starts[min(range(len(chis)), key=chis.__getitem__)]
-    return least_squares_fit(ctx, extended_set(current, single).name, params, start, simplex_fev=SET_SIMPLEX_FEV)
+    name = full_name(CandidateSet.parse(current.name).effects + CandidateSet.parse(single.name).effects, params)
+    return least_squares_fit(ctx, name, params, start, simplex_fev=SET_SIMPLEX_FEV)
 
 
 def burst_trimmed(cur_vec, new_vec, times) -> tuple[float, float]:
@@ -157,5 +173,51 @@ def contributions(ctx: FitContext, fit: FitResult) -> dict[str, float]:
     return out
 
 
-__all__ = ["extend_fit", "adds_enough", "contributions", "extended_set", "ADD_GAIN", "NO_WORSE",
+def reduced_sets(current: FitResult, instrument: FitResult | None) -> list[tuple[str, tuple, list[float]]]:
+    """(name, parameters, start) of ``current`` without each of its effects in turn, ``instrument``'s finding on top.
+
+    The start is the set's own optimum for the parameters kept and the finding's single fit (its values
+    where the plant is nominal); a finding already in the set keeps the set's value.
+    """
+    extra = [(fp, v) for fp, v in zip(instrument.params, instrument.values)] if instrument is not None else []
+    out = []
+    for e in CandidateSet.parse(current.name).effects:
+        kept = [(fp, v) for fp, v in zip(current.params, current.values) if fp.effect != e]
+        have = {fp.key for fp, _ in kept}
+        kept += [(fp, v) for fp, v in extra if fp.key not in have]
+        params = tuple(fp for fp, _ in kept)
+        out.append((full_name([x for x in CandidateSet.parse(current.name).effects if x != e], params), params, [v for _, v in kept]))
+    return out
+
+
+def prune(fits: dict, winner: str, n: int, run) -> tuple[str, list[dict]]:
+    """Backward elimination of the winning set's effects against the instrumentation (module doc).
+
+    ``fits``: every fitted candidate (name -> FitResult; the instrumentation singles among them);
+    ``run(sets)`` fits ``(name, params, start)`` triples into ``fits``. Returns the winner
+    (the set, or the best reduced set it does not beat) and the rounds in the search log's form.
+    """
+    scores = score_all(fits, n)
+    found = [k for k in fits if is_instrument(k) and beats(scores, k, "nominal", n)]
+    instrument = fits[min(found, key=lambda k: scores[k].bic)] if found else None
+    log = []
+    while len(CandidateSet.parse(winner).effects) > 1:
+        sets = reduced_sets(fits[winner], instrument)
+        if any(name not in fits for name, _, _ in sets):
+            run([s for s in sets if s[0] not in fits])
+        scores = score_all(fits, n)
+        tried = [name for name, _, _ in sets]
+        level = [k for k in tried if not beats(scores, winner, k, n)]  # the set does not beat it
+        best = min(level, key=lambda k: scores[k].bic, default=None)
+        words = (f"{' and '.join(e for e in CandidateSet.parse(winner).effects if e not in CandidateSet.parse(best).effects)} does not beat "
+                 f"{best} (BIC {scores[best].bic - scores[winner].bic:+.0f})" if best else
+                 "every effect of the set beats the set without it" + (f" and {instrument.name}" if instrument else ""))
+        log.append({"round": "prune", "tried": tried, "best": best or winner, "kept": best is not None, "why": words})
+        if best is None:
+            break
+        winner = best
+    return winner, log
+
+
+__all__ = ["extend_fit", "prune", "reduced_sets", "full_name", "adds_enough", "contributions", "extended_set", "ADD_GAIN", "NO_WORSE",
            "CANDIDATES_PER_ROUND", "MAX_EFFECTS", "screen_addition", "burst_trimmed", "BURST_WINDOW"]

@@ -45,7 +45,16 @@ DIFF_STEP = 0.01  # forward-difference step, 1 % of each parameter's (log) range
 MAX_NFEV = 6  # least-squares polishing evaluations (besides the Jacobian's)
 SIMPLEX_FEV = 16  # simplex evaluations per fitted parameter
 SECOND_START = 2.0  # a second local fit starts from a grid point within this chi-square ratio of the best
+MEMO = 16  # replays a fit context remembers (each its residuals and simulated signals: ~2 MB for 30 s at 1 kHz)
 HAC_SECONDS = 1.0  # s; Newey-West bandwidth: residual correlation of about one stick-slip episode
+# share of the nominal excess chi-square an effect's best grid point must remove to be refined (our choice: a candidate
+# must remove select.MIN_GAIN = 25 % to matter; the refinement of one that starts at 2 % costs as many replays as a real one)
+SCREEN_SHARE = 0.02
+
+
+def screen_level(chi2_nominal: float, n: int) -> float:
+    """Chi-square a candidate's best grid point must reach to be refined (``fit_candidate``'s ``screen``)."""
+    return chi2_nominal - SCREEN_SHARE * max(chi2_nominal - n, 0.0)
 
 
 @dataclass
@@ -64,20 +73,31 @@ class FitContext:
     setup: ReplaySetup
     model: ResidualModel
     sims: int = 0
+    memo: dict = field(default_factory=dict, repr=False)  # (keys, values) -> (residuals, replay): the latest MEMO
 
     def residual(self, params, values) -> tuple[np.ndarray, dict | None]:
         """Normalised data residuals of a parameter set, and the replay (None if it failed).
 
         Instrumentation parameters (``servo.instrument_candidates``) act on the logger model and on the
-        states the re-synchronisations read (the plant's, not the instrument's).
+        states the re-synchronisations read (the plant's, not the instrument's). A parameter set
+        replayed moments ago (a fit's best grid point where its simplex starts, the fitted values
+        the caller replays again) is not replayed twice: values equal to 10 significant digits
+        (a round trip through the fit's unit cube) give the same replay.
         """
+        key = (tuple(fp.key for fp in params), tuple(float(f"{v:.10g}") for v in values))
+        if key in self.memo:
+            return self.memo[key]
         setup = instrumented(self.setup, params, values)
         self.sims += 1
         try:
             cfg = apply(self.cfg, params, values)
         except InputError:
             return self.model.vector(None), None
-        return evaluate(self.model, cfg, setup)
+        out = evaluate(self.model, cfg, setup)
+        self.memo[key] = out
+        while len(self.memo) > MEMO:
+            self.memo.pop(next(iter(self.memo)))
+        return out
 
 
 @dataclass
@@ -294,6 +314,14 @@ def scan_points(ctx: FitContext, params, points: list[list[float]]) -> list[floa
     return out
 
 
+def replays_bound(cand: Candidate) -> int:
+    """Replays a full fit of ``cand`` takes at most: its grid, the simplex, the polish and its Jacobian, twice
+    with a second start (``fit_candidate``). The pool gets the longest fits first (a long fit started last
+    leaves the other workers idle)."""
+    k = len(cand.params)
+    return len(cand.grid or ({},)) + (SIMPLEX_FEV * k + 10 + MAX_NFEV + k) * (2 if k > 1 else 1)
+
+
 def fit_candidate(ctx: FitContext, cand: Candidate, base_fit: FitResult | None, *, max_nfev: int = MAX_NFEV,
                   screen: float | None = None) -> FitResult:
     """Fit one effect on top of the recalibrated base, co-fitting the recalibrated base parameters.
@@ -340,4 +368,4 @@ def fit_candidate(ctx: FitContext, cand: Candidate, base_fit: FitResult | None, 
     return res
 
 
-__all__ = ["FitContext", "FitResult", "fit_candidate", "least_squares_fit", "scan_points", "chi2_parts"]
+__all__ = ["FitContext", "FitResult", "fit_candidate", "replays_bound", "screen_level", "least_squares_fit", "scan_points", "chi2_parts"]

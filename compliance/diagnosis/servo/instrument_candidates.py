@@ -21,10 +21,10 @@ from dataclasses import replace
 
 from compliance.model.parameters import ParamHandle
 from compliance.diagnosis.servo.candidates import Candidate
+from compliance.diagnosis.verdicts.candidate_set import INSTRUMENT_PREFIX as PREFIX, is_instrument  # noqa: F401 (public here)
 from compliance.validation.logger_model import FILTERED, PRESSURES, LoggerModel
 from compliance.diagnosis.verdicts.verdict import DiagnosisVerdict
 
-PREFIX = "instrument:"
 KIND = "instrument"
 MAX_OFFSET = 0.02  # s; largest channel time offset fitted
 MAX_GAIN_ERROR = 0.10  # relative; largest transducer gain error fitted
@@ -38,11 +38,6 @@ MEANING = {
                     "anti-alias filter or transmission delay)",
     "pressure_gain": "a pressure transducer's gain is off: {v}",
 }
-
-
-def is_instrument(name: str | None) -> bool:
-    """True for the name of an instrumentation candidate."""
-    return bool(name) and name.startswith(PREFIX)
 
 
 def _offset(name: str, low: float = -MAX_OFFSET) -> Candidate:

@@ -37,14 +37,13 @@ from compliance.errors import InputError
 from compliance.files.jsonable import json_number
 from compliance.model.config import PlantConfig, plant_from_dict
 from compliance.diagnosis.servo.candidates import base_params, effect_candidate, signature_order
-from compliance.diagnosis.servo.fit import FitContext, FitResult, chi2_parts
+from compliance.diagnosis.servo.fit import FitContext, FitResult, chi2_parts, screen_level
 from compliance.diagnosis.servo.report_data import SCHEMA
 from compliance.diagnosis.servo.selection import AMBIGUOUS_BIC, RESIDUAL_LIMIT, ambiguity_set, honest, score_all, signals_left, verdict
 from compliance.diagnosis.verdicts.verdict import EXPLAINED, DiagnosisVerdict
 from compliance.diagnosis.servo.parallel_fits import FitEffect, RecalibrateBase
 
 _WORKER: dict = {}  # token -> JointContext, built once per worker process
-SCREEN_SHARE = 0.02  # share of the nominal excess chi-square an effect's best grid point must remove to be refined
 
 
 @dataclass
@@ -235,10 +234,7 @@ def _fit_all(stages, labels, names, recalibrate, jobs, scheduler) -> tuple[dict,
     bparams = (base_params(stages[0].rc, keys) if keys else base_params(stages[0].rc)) if recalibrate else ()
     if bparams:
         tasks.append(RecalibrateBase(bparams, 2.0 * math.log(n) * max(1.0, chi2_nom / n)))
-    # an effect none of whose grid points removes SCREEN_SHARE of the nominal excess is not refined (our choice:
-    # a candidate must remove select.MIN_GAIN = 25 % to matter; the refinement of one that starts at 2 % costs the
-    # same replays as a real one, times the number of recordings)
-    screen = chi2_nom - SCREEN_SHARE * max(chi2_nom - n, 0.0)
+    screen = screen_level(chi2_nom, n)  # an effect none of whose grid points removes SCREEN_SHARE of the excess: not refined
     tasks += [FitEffect(effect_candidate(e), screen) for e in signature_order(names, excess)]
     token = f"joint-{time.time_ns()}"
     payload = (token, tuple(labels), [(plant_to_toml(s.rc), s.setup, s.model) for s in stages])

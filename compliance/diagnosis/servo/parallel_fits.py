@@ -17,7 +17,7 @@ from compliance.diagnosis.servo.candidates import Candidate
 from compliance.model.parameters import ParamHandle
 from compliance.diagnosis.servo.fit import FitContext, FitResult, fit_candidate, least_squares_fit
 from compliance.diagnosis.servo.recalibration import forward_select_base
-from compliance.diagnosis.servo.effect_sets import extend_fit, screen_addition
+from compliance.diagnosis.servo.effect_sets import SET_SIMPLEX_FEV, extend_fit, screen_addition
 from compliance.diagnosis.evidence.replay_fit import ReplaySetup
 
 _WORKER: dict = {}
@@ -75,6 +75,18 @@ class ExtendSet:
 
 
 @dataclass(frozen=True)
+class RefitSet:
+    """The set ``name`` refitted from a start near its optimum (``effect_sets.prune``)."""
+
+    name: str
+    params: tuple[ParamHandle, ...]
+    start: list[float]
+
+    def fit(self, ctx: FitContext) -> FitResult:
+        return least_squares_fit(ctx, self.name, self.params, self.start, simplex_fev=SET_SIMPLEX_FEV)
+
+
+@dataclass(frozen=True)
 class ScreenAddition:
     """``single``'s effect switched on in the set ``current``, unfitted (``effect_sets.screen_addition``)."""
 
@@ -94,7 +106,9 @@ def _run_task(task):
     if isinstance(task, ScreenAddition):
         return screen_addition(ctx, task.current, task.single), None
     res = task.fit(ctx)
-    vec, _ = ctx.residual(res.params, res.values)
+    sims = ctx.sims
+    vec, _ = ctx.residual(res.params, res.values)  # the fit's own last replay, remembered (FitContext.memo)
+    res.sims += ctx.sims - sims
     return res, vec
 
 

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from compliance.diagnosis.verdicts.candidate_set import CandidateSet
 from compliance.diagnosis.verdicts.verdict import EXPLAINED, DiagnosisVerdict
 
+
 # nominal normalised RMS at or below which a signal agrees "within the noise floor", judged on the re-synchronised
 # replay with the time-resolved floors (the fits' objective, as RESIDUAL_LIMIT is). Not on the constant floor: a
 # stick-slip servo's replay error comes in noise-decided bursts at breakaways, so one recording's RMS over the test

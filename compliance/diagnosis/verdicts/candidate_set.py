@@ -13,11 +13,17 @@ from dataclasses import dataclass
 
 from compliance.effects import EFFECTS
 
-__all__ = ["BASE", "NOMINAL", "SEPARATOR", "CandidateSet"]
+__all__ = ["BASE", "INSTRUMENT_PREFIX", "NOMINAL", "SEPARATOR", "CandidateSet", "is_instrument"]
 
 SEPARATOR = "+"
 NOMINAL = "nominal"  # the plant as given: no term added
 BASE = "base"  # recalibrating the base parameters (the plant's own, no new physics)
+INSTRUMENT_PREFIX = "instrument:"  # names of instrumentation findings (servo/instrument_candidates.py)
+
+
+def is_instrument(name: str | None) -> bool:
+    """True for the name of an instrumentation candidate (or of a term of a set, ``instrument:pressure_gain``)."""
+    return bool(name) and name.startswith(INSTRUMENT_PREFIX)
 
 
 @dataclass(frozen=True)
@@ -65,18 +71,23 @@ class CandidateSet:
         return tuple(t for t in self.terms if t not in drop)
 
     @property
+    def plant_terms(self) -> frozenset[str]:
+        """Its terms without instrumentation findings (a finding on top claims nothing of the plant)."""
+        return frozenset(t for t in self.terms if not is_instrument(t))
+
+    @property
     def physics(self) -> frozenset[str]:
-        """What the explanation claims of the plant: its terms without the base recalibration (order
-        does not make other physics)."""
-        return frozenset(self.without(BASE))
+        """What the explanation claims of the plant: its terms without the base recalibration and
+        instrumentation findings (order does not make other physics)."""
+        return self.plant_terms - {BASE}
 
     def same_physics(self, other: CandidateSet) -> bool:
-        """Both hold the same effects (``x`` and ``x+base`` are one explanation)."""
+        """Both hold the same effects (``x``, ``x+base`` and ``x`` with a finding on top are one explanation)."""
         return self.physics == other.physics
 
     def nested(self, other: CandidateSet) -> bool:
-        """One's terms contain the other's (``base`` counting as one more term)."""
-        a, b = frozenset(self.terms), frozenset(other.terms)
+        """One's plant terms contain the other's (``base`` counting as one more term, a finding as none)."""
+        a, b = self.plant_terms, other.plant_terms
         return a <= b or b <= a
 
     def inside(self, other: CandidateSet) -> bool:
