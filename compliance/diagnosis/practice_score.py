@@ -73,6 +73,12 @@ def main_parameter(d, truth: list, params: dict) -> dict | None:
     return out
 
 
+def _percent(fraction: float) -> str:
+    """A relative error in % with the digits it needs: 0.05 %, 4.1 %, 23 %."""
+    v = 100 * fraction
+    return f"{v:.2f} %" if v < 1 else f"{v:.1f} %" if v < 10 else f"{v:.0f} %"
+
+
 def practice_table(rep: dict, timings: bool = True) -> str:
     """The scored practice recordings as a Markdown table (``benchmark.run_practice``'s result).
 
@@ -84,7 +90,7 @@ def practice_table(rep: dict, timings: bool = True) -> str:
         after = r.get("objective_after") or r.get("objective_before") or {}
         worst = max(after.items(), key=lambda kv: kv[1], default=None)
         main = r.get("main") or {}
-        err = f"{100 * main['error']:.0f} % ({main['parameter']})" if main.get("error") is not None else "-"
+        err = f"{_percent(main['error'])} ({main['parameter']})" if main.get("error") is not None else "-"
         lines.append(f"| {r['name']} | {r['truth']} | {r['verdict']} | {r['winner'] or '-'} | "
                      f"{'yes' if r['correct'] else 'no'} | {f'{worst[1]:.2f} ({worst[0]})' if worst else '-'} | {err} |"
                      + (f" {r['seconds']:.0f} |" if timings else ""))

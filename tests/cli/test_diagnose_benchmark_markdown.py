@@ -31,7 +31,7 @@ def test_practice_results_are_written_as_markdown_without_times_when_reproducibl
     capsys.readouterr()
     assert code == 0 and len(fake_practice) == 1
     text = out.read_text()
-    assert "| practice_valve_offset | valve_offset | missing_physics | valve_offset | yes | 1.21 (position) | 2 % (u0) |\n" in text
+    assert "| practice_valve_offset | valve_offset | missing_physics | valve_offset | yes | 1.21 (position) | 2.0 % (u0) |\n" in text
     assert " s |" not in text and "31" not in text  # no wall-time column: the same text on every run
     assert "1/1 right." in text and "Main parameter within 25 % of the truth: 1 of 1." in text
 

@@ -56,3 +56,9 @@ def test_the_generated_benchmark_is_written_as_markdown_tables():
     assert "| truth | valve_offset | none | ambiguous |" in text and "| valve_offset | 3 |  | 1 |" in text
     assert "time per case" not in text
     assert "| time per case, median / max | 40 s / 90 s |" in benchmark_markdown({"summary": s, "seconds": 200.0})
+
+
+def test_a_relative_error_keeps_the_digits_it_needs():
+    from compliance.diagnosis.practice_score import _percent
+
+    assert [_percent(x) for x in (0.0005, 0.041, 0.23, 1.0)] == ["0.05 %", "4.1 %", "23 %", "100 %"]
