@@ -156,3 +156,19 @@ def test_the_effects_table_is_generated_from_the_declarations():
     assert text[start:text.index("<!-- end generated -->", start)] == table, (
         "docs/diagnosis.md: the effects table differs from compliance.effects; "
         "rewrite it with GOVCHECK_WRITE_DOCS=1 python -m pytest tests/test_docs.py")
+
+
+LINK = re.compile(r"\]\(([^)#\s]+)(?:#[^)]*)?\)")
+
+
+@pytest.mark.parametrize("doc", DOCS + [ROOT / "README.md"], ids=lambda p: p.name)
+def test_every_relative_link_of_a_page_reaches_a_file(doc):
+    links = [m.group(1) for m in LINK.finditer(doc.read_text(encoding="utf-8")) if "://" not in m.group(1)]
+    missing = [link for link in links if not (doc.parent / link).exists()]
+    assert not missing, f"{doc.name}: links to nothing: {', '.join(missing)}"
+
+
+def test_the_guide_index_links_every_page():
+    index = (ROOT / "docs" / "README.md").read_text(encoding="utf-8")
+    linked = {m.group(1) for m in LINK.finditer(index)}
+    assert not [d.name for d in DOCS if d.name != "README.md" and d.name not in linked]
