@@ -94,6 +94,15 @@ def test_a_page_describes_the_product_not_its_history(doc):
     assert "../shared/" not in text and "/work/" not in text, f"{doc.name}: links outside the repository"
 
 
+CODE_HISTORY = re.compile(r"\bissue \d+|\bsessions? \d|\bthis session\b|\bprevious session\b|\bbrief, issue\b", re.I)
+
+
+def test_code_comments_and_docstrings_give_reasons_not_history():
+    found = [f"{p.relative_to(ROOT)}:{n}: {m.group(0)}" for p in sorted(PACKAGE.rglob("*.py"))
+             for n, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1) for m in CODE_HISTORY.finditer(line)]
+    assert not found, "process history in the code (keep it in git history):\n" + "\n".join(found)
+
+
 # ---------------------------------------------------------------------------------- generated blocks
 def _markers():
     for doc in DOCS:
@@ -119,7 +128,7 @@ def test_every_generation_marker_names_a_real_command_and_its_options():
 
 
 def test_the_practice_tables_are_the_benchmark_formatter_output():
-    from compliance.diagnosis.practice_score import practice_table
+    from compliance.diagnosis.scoring.practice_score import practice_table
 
     header = practice_table({"recordings": [], "correct": 0}, timings=False).splitlines()[0]
     blocks = [(doc, block) for doc, command, block in _markers() if "diagnose-benchmark --practice" in command]

@@ -5,9 +5,9 @@
     govcheck diagnose FILE1 FILE2 ... --column-map zillen-friction --friction-bore "25.7 mm"
 
 A servo recording (time, position, valve command; reference for a closed-loop test) gets the
-replay diagnosis (``compliance.diagnosis.engine``); friction-bench recordings (position,
+replay diagnosis (``compliance.diagnosis.servo.diagnose``); friction-bench recordings (position,
 chamber pressure and drive force, no valve command) get the friction-model diagnosis
-(``compliance.diagnosis.friction_diagnosis``). Exit 0 when the diagnosis ran (whatever it
+(``compliance.diagnosis.friction_bench.diagnose``). Exit 0 when the diagnosis ran (whatever it
 found), 2 on bad input.
 """
 
@@ -90,7 +90,7 @@ def run(args) -> int:
         return _run_joint(args, plant_arg, effects)
     frame, meta = read_recording(args.recordings[0], args.column_map)
     from compliance.model.config import load_plant
-    from compliance.diagnosis.engine import diagnose, save_fitted
+    from compliance.diagnosis.servo.diagnose import diagnose, save_fitted
 
     plant = plant_arg or sidecar_plant(meta, args.recordings[0])
     if not plant:
@@ -118,7 +118,7 @@ def run(args) -> int:
     if unsaved:
         print(f"note: {unsaved}")
     if args.suggest_test:
-        from compliance.diagnosis.discriminate import suggestion_lines
+        from compliance.diagnosis.evidence.discriminating_test import suggestion_lines
 
         print("\n".join(suggestion_lines(diag.suggested_test)))
     return 0
@@ -165,7 +165,7 @@ def _render_servo_report(cfg, frame, meta, diag, data: dict, args) -> None:
     diag_entry = {"explanation": data["explanation"], "verdict": data["verdict"], "added": [], "effects_ranked": data["effects"]}
     if diag.fitted_cfg is not None:
         diag_entry["after"] = validate(diag.fitted_cfg, frame, meta, settings)
-        from compliance.diagnosis.explain import explain_with_table
+        from compliance.diagnosis.servo.explanation import explain_with_table
 
         mode = settings.modes[0]  # the explanation quotes the fits of the table printed beside it
         diag_entry["explanation"] = explain_with_table(diag, result["modes"][mode]["fits"], diag_entry["after"]["modes"][mode]["fits"])
@@ -187,7 +187,7 @@ def _render_servo_report(cfg, frame, meta, diag, data: dict, args) -> None:
 
 
 def _run_friction(args, first, meta) -> int:
-    from compliance.diagnosis.friction_diagnosis import diagnose_friction, format_friction
+    from compliance.diagnosis.friction_bench.diagnose import diagnose_friction, format_friction
     from compliance.recordings.reader import read_recording
     from compliance.units import parse_quantity
 
@@ -219,10 +219,10 @@ def _run_friction(args, first, meta) -> int:
 
 
 def _run_joint(args, plant_arg, effects) -> int:
-    """Several closed-loop recordings of one plant: one diagnosis with shared physics (diagnosis.joint)."""
+    """Several closed-loop recordings of one plant: one diagnosis with shared physics (diagnosis.servo.joint_recordings)."""
     from compliance.campaign.executor import parse_scheduler
     from compliance.cli.progress import progress
-    from compliance.diagnosis.joint import diagnose_joint, format_joint
+    from compliance.diagnosis.servo.joint_recordings import diagnose_joint, format_joint
     from compliance.model.config import load_plant
     from compliance.recordings.reader import read_recording
 

@@ -90,8 +90,8 @@ def _write(args, data: dict, markdown) -> None:
 
 def run(args) -> int:
     """Run the benchmark; 0 when the targets are met, 1 when not."""
-    from compliance.diagnosis.benchmark import format_summary, run_benchmark, run_practice
-    from compliance.diagnosis.engine import default_jobs
+    from compliance.diagnosis.scoring.benchmark import format_summary, run_benchmark, run_practice
+    from compliance.diagnosis.servo.diagnose import default_jobs
 
     check_args_outputs(args, (args.markdown, *MARKDOWN_OUTPUT))
     if args.cases < 1:
@@ -116,7 +116,7 @@ def run(args) -> int:
         print(f"main parameter within 25 %: {rep['main_within_25']} of {rep['main_scored']}"
               + (f"; not a hit but not identifiable by the test (split interval contains the truth): "
                  f"{rep['main_split_open_interval_contains_truth']}" if rep["main_split_open_interval_contains_truth"] else ""))
-        from compliance.diagnosis.practice_score import practice_markdown, practice_table
+        from compliance.diagnosis.scoring.practice_score import practice_markdown, practice_table
 
         print("\n" + practice_table(rep))
         _write(args, rep, practice_markdown)
@@ -136,7 +136,7 @@ def run(args) -> int:
                             jobs=jobs, null=not args.no_null, miscalibrations=not args.no_miscalibrations, progress=progress)
     print()
     print(format_summary(rep))
-    from compliance.diagnosis.practice_score import benchmark_markdown
+    from compliance.diagnosis.scoring.practice_score import benchmark_markdown
 
     _write(args, rep, benchmark_markdown)
     s = rep["summary"]

@@ -18,7 +18,7 @@ REP = {"correct": 1, "main_scored": 1, "main_within_25": 1, "main_split_open_int
 
 @pytest.fixture
 def fake_practice(monkeypatch):
-    import compliance.diagnosis.benchmark as benchmark
+    import compliance.diagnosis.scoring.benchmark as benchmark
 
     calls = []
     monkeypatch.setattr(benchmark, "run_practice", lambda *a, **k: calls.append(a) or REP)

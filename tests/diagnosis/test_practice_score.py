@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from types import SimpleNamespace
 
-from compliance.diagnosis.practice_score import practice_correct, practice_table
+from compliance.diagnosis.scoring.practice_score import practice_correct, practice_table
 
 SENSOR = {"verdicts": ["no_mismatch", "parameters_only", "unexplained"], "named": ["time_offset", "skew"]}
 NONE = {"verdicts": ["no_mismatch", "unexplained"]}
@@ -41,7 +41,7 @@ def test_practice_table_is_markdown_with_one_row_per_recording():
 
 
 def test_the_generated_benchmark_is_written_as_markdown_tables():
-    from compliance.diagnosis.practice_score import benchmark_markdown
+    from compliance.diagnosis.scoring.practice_score import benchmark_markdown
 
     s = {"top1_accuracy": 0.75, "null_accuracy": 1.0, "miscalibration_accuracy": None, "ambiguous_with_truth": 1,
          "median_reduction": 0.081, "median_reduction_objective": 0.06, "median_main_error": 0.007,
@@ -59,6 +59,6 @@ def test_the_generated_benchmark_is_written_as_markdown_tables():
 
 
 def test_a_relative_error_keeps_the_digits_it_needs():
-    from compliance.diagnosis.practice_score import _percent
+    from compliance.diagnosis.scoring.practice_score import _percent
 
     assert [_percent(x) for x in (0.0005, 0.041, 0.23, 1.0)] == ["0.05 %", "4.1 %", "23 %", "100 %"]
