@@ -1,6 +1,6 @@
 """Fit and rank valve flow laws against measured mass flow.
 
-The laws are the lead's scalar kernels in ``compliance.physics.valve_flow`` (so a fitted
+The laws are the simulator's own scalar kernels in ``compliance.physics.valve_flow`` (so a fitted
 coefficient means exactly what the simulator uses), vectorised here with ``numpy.vectorize``:
 
 - ``iso6358``    q = C p1 rho0 sqrt(T0/T1) w(p2/p1; b)          seed 000 eqs. (1)-(2)

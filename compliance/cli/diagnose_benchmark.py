@@ -2,12 +2,15 @@
 
     govcheck diagnose-benchmark [CONFIG] [--cases N] [--seed S] [--effects a,b] [--library a,b] [--jobs N]
                                 [--no-null] [--no-miscalibrations] [--practice DIR] [--json out.json]
+                                [--markdown results.md]
 
 Generates N concealed cases per effect (plus null and miscalibrated-parameter cases) from the
 plant model, diagnoses each, and prints the confusion matrix, top-1 accuracy, null accuracy,
 median fit improvement and parameter recovery. ``--practice DIR`` diagnoses the recordings of a
 directory instead and scores them against its ANSWERS.json. Exit 0 when the targets are met
 (top-1 >= 90 %, null >= 90 %; all practice recordings right), 1 when not, 2 on bad input.
+``--markdown FILE.md`` writes the same results as Markdown tables (the measured tables of
+docs/diagnosis.md are made this way).
 """
 
 from __future__ import annotations
@@ -36,7 +39,8 @@ def register(sub):
             "examples:\n"
             "  govcheck diagnose-benchmark --cases 3 --seed 1 --json bench.json\n"
             "  govcheck diagnose-benchmark --effects heat_transfer,internal_leakage --cases 2 --jobs 2\n"
-            "  govcheck diagnose-benchmark models/plant-a.toml --practice tests/data/practice"
+            "  govcheck diagnose-benchmark models/plant-a.toml --practice tests/data/practice\n"
+            "  govcheck diagnose-benchmark --practice tests/data/practice --reproducible --markdown practice.md"
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -50,6 +54,8 @@ def register(sub):
     p.add_argument("--no-miscalibrations", action="store_true", help="no miscalibrated-parameter cases")
     p.add_argument("--practice", help="diagnose the recordings of this directory and score them against its ANSWERS.json")
     add_outputs(p, "json", help={"json": "write every case and the summary to FILE.json"})
+    p.add_argument("--markdown", metavar="FILE.md",
+                   help="write the results as Markdown tables to FILE.md (without times under --reproducible)")
     add_quiet(p, "no per-case lines; print only the summary")
     add_reproducible(p)
     return p
@@ -67,11 +73,19 @@ def _names(text: str | None, option: str):
     return names
 
 
-def _write(args, data: dict) -> None:
-    from compliance.files.atomic import write_json_atomic
+MARKDOWN_OUTPUT = ("--markdown", (".md", ".markdown"))
+
+
+def _write(args, data: dict, markdown) -> None:
+    """The ``--json`` and ``--markdown`` outputs (``markdown(data, timings)`` formats the tables)."""
+    from compliance.files.atomic import write_json_atomic, write_text_atomic
     from compliance.files.reproducible import is_reproducible, make_reproducible
 
-    write_json_atomic(args.json, make_reproducible(data) if is_reproducible(args.reproducible) else data)
+    reproducible = is_reproducible(args.reproducible)
+    if args.json:
+        write_json_atomic(args.json, make_reproducible(data) if reproducible else data)
+    if args.markdown:
+        write_text_atomic(args.markdown, markdown(data, timings=not reproducible))
 
 
 def run(args) -> int:
@@ -79,7 +93,7 @@ def run(args) -> int:
     from compliance.diagnosis.scoring.benchmark import format_summary, run_benchmark, run_practice
     from compliance.diagnosis.servo.diagnose import default_jobs
 
-    check_args_outputs(args)
+    check_args_outputs(args, (args.markdown, *MARKDOWN_OUTPUT))
     if args.cases < 1:
         raise InputError(f"--cases {args.cases}: expected at least 1")
     if not 0 <= args.seed < 2**32:
@@ -102,11 +116,10 @@ def run(args) -> int:
         print(f"main parameter within 25 %: {rep['main_within_25']} of {rep['main_scored']}"
               + (f"; not a hit but not identifiable by the test (split interval contains the truth): "
                  f"{rep['main_split_open_interval_contains_truth']}" if rep["main_split_open_interval_contains_truth"] else ""))
-        from compliance.diagnosis.scoring.practice_score import practice_table
+        from compliance.diagnosis.scoring.practice_score import practice_markdown, practice_table
 
         print("\n" + practice_table(rep))
-        if args.json:
-            _write(args, rep)
+        _write(args, rep, practice_markdown)
         return 0 if rep["correct"] == len(rep["recordings"]) else 1
 
     from compliance.cli.progress import progress as progress_bar
@@ -123,8 +136,9 @@ def run(args) -> int:
                             jobs=jobs, null=not args.no_null, miscalibrations=not args.no_miscalibrations, progress=progress)
     print()
     print(format_summary(rep))
-    if args.json:
-        _write(args, rep)
+    from compliance.diagnosis.scoring.practice_score import benchmark_markdown
+
+    _write(args, rep, benchmark_markdown)
     s = rep["summary"]
     ok = (s["top1_accuracy"] is None or s["top1_accuracy"] >= TOP1_TARGET) and (s["null_accuracy"] is None or s["null_accuracy"] >= NULL_TARGET)
     return 0 if ok else 1

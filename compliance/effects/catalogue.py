@@ -9,7 +9,7 @@ Bounds are physical ranges cut where the pinned RK4 step (1 ms for plant A) woul
 the fastest eigenvalue of each effect times the step stays below ~2 (RK4's limit is 2.8), e.g.
 a hose node relaxes at R*T*rho0*C*w'/V, so C/V <= 3e-4; the hose conductance is bounded at
 1e-7 m^3/(s*Pa) (a hose is less restrictive than the 2.33e-8 valve: an independent bench's
-7e-4 m^3 hose with 4.5e-8 was outside the former 3e-8 cut), so small volumes with large
+7e-4 m^3 hose has 4.5e-8), so small volumes with large
 conductances (C/V > 3e-4) are admissible but diverge at the 1 ms step: the simulator reports
 it, the diagnosis scores such a trial as a failed fit; linkage damping/(M/2) and regulator
 refill R*T*k/V_r are cut by the same rule. A load

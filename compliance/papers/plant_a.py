@@ -32,7 +32,7 @@ from compliance.simulation import Scenario, simulate
 SETTLING_BAND = 0.05  # fraction of the actual change
 SETTLING_TOLERANCE = 0.35  # relative
 STEADY_TOLERANCE = 0.3e-3  # m
-# the paper's own scatter per metric (issue 17): (kind, width); a row outside it is flagged
+# the paper's own scatter per metric: (kind, width); a row outside it is flagged
 TOLERANCES = {
     "settling time": ("rel", SETTLING_TOLERANCE),
     "steady error": ("abs", STEADY_TOLERANCE),

@@ -187,7 +187,7 @@ def _slow_ramps(cfg, path: Path) -> list[str]:
 
 
 def _compensation_forms(cfg) -> list[str]:
-    """The static-gain compensation (the lead's first reading of G_f) beside the inverse, for the record."""
+    """The static-gain compensation (the other reading of G_f) beside the inverse, for comparison."""
     ts = cfg.p("controller.sample_time")
     t = np.arange(int(6.0 / ts) + 1) * ts
     w = 2 * np.pi * 0.2

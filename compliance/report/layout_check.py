@@ -155,7 +155,7 @@ def pdf_problems(path) -> list[str]:
     return out
 
 
-BODY_PAGES_MAX = 25  # the plant-A body (sign-off page to the signatures of section 7), issue 25
+BODY_PAGES_MAX = 25  # the plant-A body (sign-off page to the signatures of section 7): a document a signer reads in one sitting (our own limit)
 
 
 def body_pages(path) -> dict:

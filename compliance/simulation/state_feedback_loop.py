@@ -1,6 +1,6 @@
 """The compiled tracking loop of one plant-B axis: RK4 plant, seed 001 controller, canonical output.
 
-The plant is ``compliance.model.assembly.plant_rhs`` integrated by ``compliance.simulation.rk4_step``
+The plant is ``compliance.model.assembly.plant_rhs`` integrated by ``compliance.simulation.rk4.rk4_step``
 (the same physics and integrator as ``govcheck simulate``); the controller
 (:mod:`compliance.model.state_feedback`) runs every ``controller.sample_time`` with a
 zero-order hold. In PID mode the loop reproduces ``compliance.simulation.simulate`` sample for

@@ -46,7 +46,7 @@ __all__ = [  # the clock and noise helpers live beside this module and stay impo
 
 MODES = ("closed_loop", "plant_only")
 NOISE_CHOICES = ("auto", "recorded", "none")
-INITIAL_WINDOW = 0.05  # s; initial position = median of the first 50 ms (brief, issue 5)
+INITIAL_WINDOW = 0.05  # s; initial position = median of the first 50 ms (our choice: a few noise samples, before any motion)
 _CONTROLLER_KEYS = {"kp": "controller.kp", "ki": "controller.ki", "kd": "controller.kd", "sample_time": "controller.sample_time"}
 
 

@@ -255,6 +255,11 @@ def test_small_benchmark_runs_and_scores(cfg):
     assert s["median_main_error"] < 0.25
     assert "confusion matrix" in format_summary(rep)
     assert math.isfinite(rep["seconds"])
+    from compliance.diagnosis.scoring.practice_score import benchmark_markdown
+
+    text = benchmark_markdown(rep, timings=False)
+    assert "| top-1 correct effect (effect cases) | 100 % |" in text and "| internal_leakage | 1 | 1 |" in text
+    assert "| none |" in text and "time per case" not in text
 
 
 def test_replay_setup_puts_a_recording_on_the_controller_clock(cfg):

@@ -38,3 +38,27 @@ def test_practice_table_is_markdown_with_one_row_per_recording():
     assert "| a | none | no_mismatch | - | yes | 1.10 (position) | - | 12 |" in text
     assert "| b | valve_offset | missing_physics | valve_offset | no | 1.40 (position) | 50 % (u0) | 30 |" in text
     assert text.endswith("1/2 right.")
+
+
+def test_the_generated_benchmark_is_written_as_markdown_tables():
+    from compliance.diagnosis.scoring.practice_score import benchmark_markdown
+
+    s = {"top1_accuracy": 0.75, "null_accuracy": 1.0, "miscalibration_accuracy": None, "ambiguous_with_truth": 1,
+         "median_reduction": 0.081, "median_reduction_objective": 0.06, "median_main_error": 0.007,
+         "within_25_percent": 1.0, "n_cases": 5, "median_seconds": 40.0, "max_seconds": 90.0,
+         "per_effect": {"valve_offset": {"cases": 4, "correct": 3, "median_main_error": 0.002}},
+         "labels": ["valve_offset", "none", "ambiguous"], "not_visible": [],
+         "confusion": {"valve_offset": {"valve_offset": 3, "ambiguous": 1}, "none": {"none": 1}}}
+    text = benchmark_markdown({"summary": s, "seconds": 200.0}, timings=False)
+    assert "| top-1 correct effect (effect cases) | 75 % |" in text
+    assert "| miscalibrations called `parameters_only` | n/a |" in text
+    assert "| valve_offset | 4 | 3 | 0.2 % |" in text
+    assert "| truth | valve_offset | none | ambiguous |" in text and "| valve_offset | 3 |  | 1 |" in text
+    assert "time per case" not in text
+    assert "| time per case, median / max | 40 s / 90 s |" in benchmark_markdown({"summary": s, "seconds": 200.0})
+
+
+def test_a_relative_error_keeps_the_digits_it_needs():
+    from compliance.diagnosis.scoring.practice_score import _percent
+
+    assert [_percent(x) for x in (0.0005, 0.041, 0.23, 1.0)] == ["0.05 %", "4.1 %", "23 %", "100 %"]

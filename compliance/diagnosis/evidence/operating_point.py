@@ -3,8 +3,8 @@
 A recording's sidecar gives the load *there*, at the operating point the test starts from. The
 core's ``position_dependent_load`` adds its stiffness about mid-stroke (compliance/model/assembly.py),
 so switched on in a replay of a test that starts elsewhere it would also shift the load at the
-start by k (x0 - stroke/2), and no stiffness could fit both the load and its slope (issue 13:
-an effect anchored at a fixed point). Every replay, null recording and predicted test of the
+start by k (x0 - stroke/2), and no stiffness could fit both the load and its slope (an effect
+anchored at a fixed point, not where the data is). Every replay, null recording and predicted test of the
 diagnosis therefore passes the constant load through ``load_at_start``: the constant part is
 set so that the total load at the start position is the stated one, and the stiffness acts
 about the recording's own operating point.

@@ -47,8 +47,8 @@ from compliance.diagnosis.verdicts.verdict import DiagnosisVerdict
 REVERSAL_TRAVEL = 2e-3  # m of travel after a change of direction counted as "after reversal"
 VELOCITY_WINDOW = 0.05  # s; Savitzky-Golay (quadratic) derivative window of the position
 MIN_SLIDING_SPEED = 1e-3  # m/s; slower samples are not "steady sliding"
-# a friction law is complete when its residual is within 3 x the force noise (issue 13's target for the
-# real seals): the floor here is the force sensor alone, while the law is evaluated on a velocity
+# a friction law is complete when its residual is within 3 x the force noise (our target for the real
+# seals): the floor here is the force sensor alone, while the law is evaluated on a velocity
 # differentiated from a noisy position, whose error adds ~1-2 x the force noise near the Stribeck hump
 FRICTION_RESIDUAL_LIMIT = 3.0
 UNITS = {"bias": "N", "bias_per_pressure": "N/Pa", "coulomb": "N", "static": "N", "stribeck_velocity": "m/s",

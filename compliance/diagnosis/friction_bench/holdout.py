@@ -33,7 +33,7 @@ from compliance.units.formatting import fmt_si
 from compliance.diagnosis.verdicts.candidate_set import CandidateSet
 
 MIN_RUNS = 3  # fit on at least two pressures, predict a third
-RATIO_TARGET = 1.5  # median held-out error within this multiple of the in-sample error (issue 24)
+RATIO_TARGET = 1.5  # median held-out error within this multiple of the in-sample error (our target)
 EARN_GAIN = 0.05  # an added effect must lower the median held-out error by 5 % ... (our choice)
 EARN_FOLDS = 0.75  # ... and the held-out error of at least 3 runs in 4 (our choice)
 

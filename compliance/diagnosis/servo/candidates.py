@@ -20,8 +20,9 @@ from compliance.effects import EFFECTS
 from compliance.model.parameters import BASE_BY_KEY, ParamHandle, param_handle
 
 FRICTION_LEVEL = "friction.level"  # pseudo-parameter: one factor on static and Coulomb friction together
-# Base parameters the diagnosis may recalibrate, in the order they are tried (brief, issue 6:
-# valve sonic conductance, friction levels, dead volume, mass; plus the LuGre pre-sliding pair).
+# Base parameters the diagnosis may recalibrate, in the order they are tried (the data-sheet values a
+# test most often corrects: valve sonic conductance, friction levels, dead volume, mass; plus the LuGre
+# pre-sliding pair).
 BASE_REFIT = (
     "valve.sonic_conductance",
     FRICTION_LEVEL,

@@ -23,10 +23,9 @@ trimmed squares over segments (Rousseeuw 1984): the mean normalised chi-square o
 ``1 - TRIM_SHARE`` of segments. The *estimate* is the point of the interval with the lowest
 trimmed score, when that is lower than the pooled fit's by at least ``ESTIMATE_GAIN`` (less is
 within the trimmed score's own wrinkles); the diagnosis adopts it as the lag's fitted values (it explains the recording
-as well as the pooled fit by the rule above, so the verdict stands). On the independent
-sensor-lag recording, before its lagged sensor was reset correctly mid-motion, the pooled optimum
-sat at tau = 20 ms (truth 15 ms), pulled by the slips of the 10 s sine, and the segments agreed
-best at 16 ms (trimmed score 0.85 against 1.06).
+as well as the pooled fit by the rule above, so the verdict stands). Checked on a
+synthetic split the pooled fit misplaces, pulled by the slips of a slow sine, which the segments put
+back (tests/diagnosis/test_split.py).
 
 Why this rule and not a statistical interval: the replay's chi-square has wrinkles along the
 valley (a stall point or breakaway moves when the lag shifts by a millisecond), measured on the
