@@ -130,3 +130,25 @@ def test_the_kept_long_kernels_say_why():
         text = (PACKAGE.parent / (module.replace(".", "/") + ".py")).read_text()
         head = text[: text.index(f"def {func}(")]
         assert "split" in head[-1500:], f"{module}.{func}: the comment with the measured reason is missing"
+
+
+# the one executor (compliance/processes/): nothing else starts processes, counts cores or maps tasks
+_POOL_NAMES = ("ProcessPoolExecutor", "multiprocessing", "worker_pool", "sched_getaffinity", "cpu_count")
+
+
+def test_one_process_pool_implementation():
+    found = []
+    for name, path in _modules().items():
+        if name.startswith("compliance.processes"):
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) and node.name == "map_tasks":
+                found.append(f"{name}: defines map_tasks")
+            elif isinstance(node, ast.Import):
+                found += [f"{name}: imports {a.name}" for a in node.names if a.name.split(".")[0] == "multiprocessing"]
+            elif isinstance(node, ast.ImportFrom) and node.module:
+                found += [f"{name}: imports {node.module}.{a.name}" for a in node.names
+                          if node.module.split(".")[0] == "multiprocessing" or a.name in _POOL_NAMES]
+            elif isinstance(node, ast.Attribute) and node.attr in _POOL_NAMES:
+                found.append(f"{name}: uses .{node.attr}")
+    assert not found, "process pools outside compliance/processes (use compliance.processes.map_tasks):\n" + "\n".join(found)

@@ -23,7 +23,8 @@ from compliance.files.display import display_path
 from compliance.model.identity import identity_dict
 from compliance import __version__
 from compliance.campaign.plan import Job, plan
-from compliance.campaign.executor import available_cores, execute
+from compliance.campaign.executor import execute
+from compliance.processes import available_cores
 from compliance.campaign.judge import fmt, judge, sample_dict
 from compliance.errors import InputError
 from compliance.requirements.consistency import consistency_findings

@@ -17,7 +17,7 @@ from pathlib import Path
 
 from compliance.cli.common import (add_recording_inputs, add_parser, add_jobs, add_outputs, add_quiet, add_reproducible, check_args_outputs,
                                    check_sidecar_conditions, sidecar_plant, split_config, add_document_options,
-                                   document_options)
+                                   document_options, add_scheduler, check_scheduler)
 from compliance.errors import InputError
 from compliance.files.atomic import write_json_atomic
 
@@ -50,8 +50,7 @@ def register(sub):
     p.add_argument("--effects", help="comma-separated candidate effects (default: every declared effect)")
     p.add_argument("--no-recalibration", action="store_true", help="do not consider recalibrating base parameters")
     add_jobs(p)
-    p.add_argument("--scheduler", metavar="ADDR", help="several recordings: run the joint fits on Dask (local:N or "
-                                                        "tcp://host:8786); default the local process pool")
+    add_scheduler(p, "the fits of several recordings (a joint diagnosis)")
     p.add_argument("--friction-bore", help='friction bench: piston bore, e.g. "25.7 mm" (else the column map\'s metadata)')
     add_outputs(p, "json", "report", "pdf", help={"json": "write the diagnosis (docs/diagnosis-schema.md) to FILE.json",
                                                   "report": "write an HTML report with the before/after figures to FILE.html",
@@ -220,7 +219,6 @@ def _run_friction(args, first, meta) -> int:
 
 def _run_joint(args, plant_arg, effects) -> int:
     """Several closed-loop recordings of one plant: one diagnosis with shared physics (diagnosis.joint)."""
-    from compliance.campaign.executor import parse_scheduler
     from compliance.cli.progress import progress
     from compliance.diagnosis.joint import diagnose_joint, format_joint
     from compliance.model.config import load_plant
@@ -229,9 +227,7 @@ def _run_joint(args, plant_arg, effects) -> int:
     for flag, value in (("--save-model", args.save_model), ("--report", args.report), ("--suggest-test", args.suggest_test)):
         if value:
             raise InputError(f"{flag}: not available for a joint diagnosis of several recordings (use --json)")
-    from compliance.cli.sweep import _check_scheme
-
-    _check_scheme(*parse_scheduler(args.scheduler))  # a bad address is exit 2 before any work (the sweep's check)
+    check_scheduler(args)  # a bad address is exit 2 before any work
     seen = set()
     for path in args.recordings:
         key = Path(path).resolve()

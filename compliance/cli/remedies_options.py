@@ -29,7 +29,7 @@ def add_remedies_options(p) -> None:
 
 def check_remedies_options(args) -> None:
     """Refuse inconsistent or bad remedies options before any work (exit 2)."""
-    from compliance.campaign.executor import parse_scheduler
+    from compliance.processes import parse_scheduler
 
     used = [f for f in ("save_remedy", "yield_units", "scheduler", "remedies_state") if getattr(args, f, None) is not None]
     if used and not args.remedies:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import shlex
 from pathlib import Path
 
-from compliance.cli.common import add_jobs, add_parser, add_quiet
+from compliance.cli.common import add_jobs, add_parser, add_quiet, add_scheduler, check_scheduler
 from compliance.errors import InputError
 
 
@@ -29,9 +29,7 @@ def register(subparsers):
     )
     p.add_argument("sweep", help="sweep file (TOML, schema govcheck-sweep/1)")
     p.add_argument("--out", metavar="DIR", help="output folder (default: reports/sweeps/NAME)")
-    p.add_argument("--scheduler", metavar="ADDR",
-                   help="Dask scheduler: tcp://host:8786 for a running cluster, local:N to start a LocalCluster of N "
-                        "workers; default: the local process pool")
+    add_scheduler(p, "the candidates")
     add_jobs(p, "local worker processes")
     p.add_argument("--samples", type=int, default=None, help="override the sweep file's latin-hypercube sample count")
     p.add_argument("--yield", dest="yield_of", metavar="CANDIDATE",
@@ -40,16 +38,6 @@ def register(subparsers):
     p.add_argument("--units", type=int, default=None, help="override the number of Monte Carlo units of --yield")
     add_quiet(p, "no progress; print only the result line")
     return p
-
-
-DASK_SCHEMES = ("tcp", "tls", "inproc", "ucx", "ws", "wss")  # what distributed.comm knows
-
-
-def _check_scheme(kind: str, address) -> None:
-    """A Dask address must name a scheme Dask can connect with (checked before any work or folder)."""
-    if kind == "dask" and str(address).split("://", 1)[0] not in DASK_SCHEMES:
-        raise InputError(f"--scheduler {address}: unknown address scheme; expected one of "
-                         f"{', '.join(s + '://' for s in DASK_SCHEMES)} (e.g. tcp://host:8786) or local:N")
 
 
 def _out_dir(args, spec) -> Path:
@@ -107,7 +95,6 @@ def run(args) -> int:
     """Run the sweep (or yield run), print the summary, exit 0 / 1 / 2."""
     from dataclasses import replace
 
-    from compliance.campaign.executor import parse_scheduler
     from compliance.sweep.run import run_sweep, run_yield_file
     from compliance.sweep.spec import load_sweep
 
@@ -115,8 +102,7 @@ def run(args) -> int:
         v = getattr(args, flag)
         if v is not None and v < 1:
             raise InputError(f"--{flag} {v}: expected a positive number")
-    kind, address = parse_scheduler(args.scheduler)  # a bad address is exit 2 before any work
-    _check_scheme(kind, address)
+    check_scheduler(args)  # a bad address is exit 2 before any work
     spec = load_sweep(args.sweep)
     if args.samples:
         spec = replace(spec, samples=args.samples)

@@ -44,7 +44,8 @@ from compliance.diagnosis.select import (AMBIGUOUS_BIC, EXPLAINED_ENOUGH, NOISE_
 from compliance.diagnosis.report_data import SCHEMA
 from compliance.diagnosis.result import Diagnosis
 from compliance.diagnosis.located import event_rms, locate_mismatch, mask_agreement, where_words
-from compliance.diagnosis.workers import default_jobs, map_tasks
+from compliance.diagnosis.workers import run_fits
+from compliance.processes import available_cores
 
 COMBINE_LEVEL = 3.0  # chi2/N of the best single explanation above which effects are refitted with the recalibration
 COMBINE_TOP = 1  # how many effects are refitted with the recalibration
@@ -119,7 +120,7 @@ def _based_search(cfg: PlantConfig, frame, meta: dict, stride: int, jobs: int, n
 
 
 def _run(st: _Stage, tasks) -> None:
-    for res, v in map_tasks(tasks, st.jobs, st.payload):
+    for res, v in run_fits(tasks, st.jobs, st.payload):
         st.fits[res.name] = res
         st.vecs[res.name] = v
         st.sims += res.sims + 1
@@ -155,7 +156,7 @@ def _search_sets(st: _Stage, winner: str) -> list[dict]:
             break
         have = set(set_effects(current.name))
         singles = [f for f in st.fits.values() if f.name in EFFECTS and f.name not in have]
-        screened = [r for r, _ in map_tasks([("screen", current, f) for f in singles], st.jobs, st.payload)]
+        screened = [r for r, _ in run_fits([("screen", current, f) for f in singles], st.jobs, st.payload)]
         screen = {name: (chi, start) for name, chi, start, _ in screened}
         st.sims += sum(r[3] for r in screened)
         order = sorted(singles, key=lambda f: screen[f.name][0])[:CANDIDATES_PER_ROUND]
@@ -303,7 +304,7 @@ def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | N
         Unknown effect names, a recording the replay cannot use.
     """
     t0 = time.perf_counter()
-    jobs = default_jobs() if jobs is None else max(1, int(jobs))
+    jobs = available_cores() if jobs is None else max(1, int(jobs))
     names = _check_effects(cfg, effects)
     cfg, st, form, dec = _based_search(cfg, frame, meta, stride, jobs, names, recalibrate)
     winner, verdict_name = dec["winner"], dec["verdict"]
@@ -386,4 +387,4 @@ def _safe_replay(cfg: PlantConfig, setup: ReplaySetup, notes: list, what: str):
 # stages 1-2 of one recording and the candidate list, public for the joint diagnosis (joint.py)
 prepare_recording, check_effects = _prepare, _check_effects
 
-__all__ = ["Diagnosis", "diagnose", "prepare_recording", "check_effects", "save_fitted", "default_jobs", "SCHEMA", "UNITS", "NOISE_TOLERANCE"]
+__all__ = ["Diagnosis", "diagnose", "prepare_recording", "check_effects", "save_fitted", "SCHEMA", "UNITS", "NOISE_TOLERANCE"]

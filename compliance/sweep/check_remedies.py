@@ -100,7 +100,7 @@ def remedies_for_check(cfg, reqset, sweep_file: str | None, *, workers=None, pro
     store : str or None
         Folder keeping every judged candidate, so an interrupted search resumes (``candidate_store``).
     """
-    from compliance.campaign.executor import dask_session
+    from compliance.processes import dask_session
     from compliance.sweep.hardware import load_catalogue
     from compliance.sweep.remedy_finish import as_given, finish
     from compliance.sweep.remedy_search import staged_search

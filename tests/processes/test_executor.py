@@ -5,7 +5,7 @@ import os
 import pandas as pd
 import pytest
 
-from compliance.campaign.executor import map_tasks, parse_scheduler
+from compliance.processes import map_tasks, parse_scheduler
 from compliance.sweep.run import load_inputs
 from compliance.sweep.evaluate import make_context
 from compliance.sweep.results import table
@@ -13,7 +13,7 @@ from compliance.sweep.runner import run_candidates
 from compliance.sweep.sampling import grid
 from compliance.sweep.spec import load_sweep
 
-from tests.sweep.conftest import sweep_text
+from tests.sweep.conftest import sweep_text, write_sweep  # noqa: F401 - the sweep file fixture
 
 
 def _fail_first(marker_dir, item):
@@ -34,18 +34,6 @@ def _die_first(marker_dir, item):
     return item + 100
 
 
-@pytest.fixture(scope="module")
-def dask_client():
-    from distributed import Client, LocalCluster
-
-    # in-process workers on the inproc:// transport: nothing leaves this process (loopback only)
-    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address="127.0.0.1:0")
-    client = Client(cluster)
-    yield client
-    client.close()
-    cluster.close()
-
-
 def test_scheduler_addresses():
     assert parse_scheduler(None) == ("local", None)
     assert parse_scheduler("local:3") == ("dask-local", 3)
@@ -56,7 +44,7 @@ def test_unreachable_scheduler_is_refused_at_once():
     import socket
     import time
 
-    from compliance.campaign.executor import CONNECT_TIMEOUT
+    from compliance.processes.dask_cluster import CONNECT_TIMEOUT
     from compliance.errors import InputError
 
     with socket.socket() as s:  # a loopback port that was free a moment ago: nothing listens there
@@ -126,7 +114,7 @@ def _square(ctx, item):
 
 
 def test_progress_is_plain_lines_when_not_a_terminal(monkeypatch, capsys):
-    import compliance.campaign.executor as ex
+    import compliance.processes.executor as ex
 
     monkeypatch.setattr(ex, "_PLAIN_EVERY", 0.0)  # every completion prints (CI logs get one per interval)
     out, _ = map_tasks(_square, None, [1, 2, 3], workers=1, progress=True, label="candidates")
