@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import sys
 
+from compliance.cli.common import add_scheduler, check_scheduler
 from compliance.errors import InputError
 
 __all__ = ["add_remedies_options", "check_remedies_options", "remedies_kwargs", "save_remedy"]
@@ -20,23 +21,19 @@ def add_remedies_options(p) -> None:
     p.add_argument("--yield-units", type=int, default=None, metavar="N",
                    help="with --remedies: Monte Carlo units of the remedy's tolerance yield (default 59: 59/59 passing shows "
                         ">= 95 %% at 95 %% confidence; 0 skips it)")
-    p.add_argument("--scheduler", metavar="ADDR",
-                   help="with --remedies: Dask scheduler (tcp://host:8786, or local:N for a LocalCluster of N workers); "
-                        "default: the local process pool")
+    add_scheduler(p, "the --remedies search (needs --remedies)")
     p.add_argument("--remedies-state", metavar="DIR",
                    help="with --remedies: keep every judged candidate in DIR so an interrupted search resumes there")
 
 
 def check_remedies_options(args) -> None:
     """Refuse inconsistent or bad remedies options before any work (exit 2)."""
-    from compliance.processes import parse_scheduler
-
     used = [f for f in ("save_remedy", "yield_units", "scheduler", "remedies_state") if getattr(args, f, None) is not None]
     if used and not args.remedies:
         raise InputError(f"--{used[0].replace('_', '-')} needs --remedies")
     if args.yield_units is not None and args.yield_units < 0:
         raise InputError(f"--yield-units {args.yield_units}: expected 0 or a positive number of units")
-    parse_scheduler(args.scheduler)
+    check_scheduler(args)
     if args.remedies and args.catalogue not in ("default", "none"):
         from compliance.sweep.hardware import load_catalogue
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from compliance.effects import EFFECTS
 from compliance.diagnosis.instrument_candidates import finding_words, is_instrument
-from compliance.files.jsonable import json_number
+from compliance.files.jsonable import json_number, jsonable
 from compliance.model.parameters import BASE_BY_KEY
 from compliance.diagnosis.candidates import FRICTION_LEVEL
 from compliance.diagnosis.residuals import UNITS
@@ -55,24 +55,13 @@ def _fit_table(fit: dict | None) -> dict | None:
                 "nrmse": json_number(v["nrmse"]), "fit_percent": json_number(v["fit_percent"])} for s, v in fit.items()}
 
 
-def _clean(obj):
-    """Plain JSON of nested dicts/lists (non-finite floats -> null)."""
-    if isinstance(obj, dict):
-        return {str(k): _clean(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_clean(v) for v in obj]
-    if isinstance(obj, (float, int)) and not isinstance(obj, bool):
-        return json_number(obj) if isinstance(obj, float) else obj
-    return obj
-
-
 def _ambiguity(d) -> dict | None:
     """The explanations the recording cannot tell apart and the test that would (docs/diagnosis-schema.md)."""
     if not d.ambiguous:
         return None
     return {"explanations": list(d.ambiguous),
             "delta_bic": {k: json_number(d.scores[k].bic - d.scores[d.ambiguous[0]].bic) for k in d.ambiguous},
-            "suggested_test": _clean(d.suggested_test)}
+            "suggested_test": jsonable(d.suggested_test)}
 
 
 def diagnosis_to_dict(d) -> dict:
@@ -129,10 +118,10 @@ def diagnosis_to_dict(d) -> dict:
         "signals_left": {s: json_number(v) for s, v in d.signals_left.items()},
         "residual_limit": RESIDUAL_LIMIT,
         "contributions": {e: {k: json_number(v) for k, v in c.items()} for e, c in d.contributions.items()},
-        "effect_search": _clean(d.search),
-        "empirical": _clean(d.empirical),
-        "split": _clean(getattr(d, "split", None)),
-        "friction_form": _clean(getattr(d, "friction_form", None)),
+        "effect_search": jsonable(d.search),
+        "empirical": jsonable(d.empirical),
+        "split": jsonable(getattr(d, "split", None)),
+        "friction_form": jsonable(getattr(d, "friction_form", None)),
         "saved_model": d.saved_model,
         "notes": list(d.notes),
         "timing": {"seconds": json_number(d.seconds), "simulations": d.simulations, "jobs": d.jobs},
