@@ -156,31 +156,11 @@ def _print_servo(d: dict, quiet: bool) -> None:
 
 
 def _render_servo_report(cfg, frame, meta, diag, data: dict, args) -> None:
-    from compliance.report.render import render_validation_report
-    from compliance.validation.validate import ValidationSettings, validate
-
-    settings = ValidationSettings(modes=("closed_loop",)) if "reference" in frame.columns else ValidationSettings(modes=("plant_only",))
-    result = validate(cfg, frame, meta, settings)
-    diag_entry = {"explanation": data["explanation"], "verdict": data["verdict"], "added": [], "effects_ranked": data["effects"]}
-    if diag.fitted_cfg is not None:
-        diag_entry["after"] = validate(diag.fitted_cfg, frame, meta, settings)
-        from compliance.diagnosis.explain import explain_with_table
-
-        mode = settings.modes[0]  # the explanation quotes the fits of the table printed beside it
-        diag_entry["explanation"] = explain_with_table(diag, result["modes"][mode]["fits"], diag_entry["after"]["modes"][mode]["fits"])
-        winner = next(e for e in data["effects"] if e["name"] == data["winner"])
-        groups: dict[str, list] = {}
-        for p in winner["parameters"]:
-            group = p["name"].split(".")[0] if p["kind"] == "effect" else "base parameters (recalibrated)"
-            groups.setdefault(group, []).append({"name": p["name"].split(".", 1)[1] if p["kind"] == "effect" else p["name"],
-                                                 "value": p["value"], "unit": p["unit"]})
-        from compliance.effects import EFFECTS
-
-        for g, params in groups.items():
-            diag_entry["added"].append({"name": g, "meaning": EFFECTS[g].meaning if g in EFFECTS else "", "params": params})
-    result["diagnosis"] = diag_entry
     from compliance.model.identity import identity_dict
+    from compliance.report.diagnosis_validation import validation_with_diagnosis
+    from compliance.report.render import render_validation_report
 
+    result = validation_with_diagnosis(cfg, frame, meta, diag, data)
     document = {**document_options(args), "identity": identity_dict(cfg.identity)}
     render_validation_report(result, args.report, args.pdf, document=document)
 
