@@ -2,7 +2,7 @@
 
 Each case switches two declared effects on in the generating bench and adds one structural
 difference from the fitted model (finer integration step, another friction form, no supply
-column, an operating point anywhere on the stroke; ``compliance.diagnosis.pairs``). Target:
+column, an operating point anywhere on the stroke; ``compliance.diagnosis.scoring.two_effect_cases``). Target:
 both effects named in >= 80 % of the cases.
 
 Run: .venv/bin/python benchmarks/diagnose_pairs.py [--cases 6] [--seed 1] [--jobs 2] [--only 9,21] [--json out.json]
@@ -29,7 +29,7 @@ def main() -> int:
     ap.add_argument("--json", dest="json_out")
     args = ap.parse_args()
     from compliance.model.config import load_plant
-    from compliance.diagnosis.pairs import run_pairs
+    from compliance.diagnosis.scoring.two_effect_cases import run_pairs
 
     out = run_pairs(load_plant("plant-a"), cases=args.cases, seed=args.seed, jobs=args.jobs,
                     only=[int(i) for i in args.only.split(",")] if args.only else None)

@@ -37,7 +37,7 @@ sys.path.insert(0, str(ROOT))
 def _simulated_seconds(ctx) -> float:
     """Plant seconds simulated by one candidate's campaign (every simulate() call counted)."""
     import compliance.simulation as sim
-    from compliance.sweep.evaluate import evaluate_one
+    from compliance.sweep.candidates.evaluate import evaluate_one
 
     real, total = sim.simulate, [0.0]
 
@@ -84,11 +84,11 @@ def main(argv=None) -> int:
 
     from compliance.campaign.executor import warm_up
     from compliance.campaign.run import run_campaign
-    from compliance.sweep.evaluate import evaluate_one, make_context
+    from compliance.sweep.candidates.evaluate import evaluate_one, make_context
     from compliance.sweep.run import load_inputs
-    from compliance.sweep.runner import run_candidates
-    from compliance.sweep.sampling import latin_hypercube
-    from compliance.sweep.spec import load_sweep
+    from compliance.sweep.candidates.runner import run_candidates
+    from compliance.sweep.candidates.sampling import latin_hypercube
+    from compliance.sweep.candidates.spec import load_sweep
 
     spec = load_sweep(ROOT / "models" / "sweeps" / "plant-a-remedies.toml")
     cfg, reqset = load_inputs(spec)

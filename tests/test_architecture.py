@@ -1,7 +1,10 @@
 """The package layout as a checked contract (docs/internals.md, "The layout").
 
-Every ``compliance`` package imports only from packages below it in ``LAYERS``; no module
-imports itself back through a cycle. These read the source with ``ast`` (nothing is run), so
+Every ``compliance`` package imports only from packages below it in ``LAYERS`` (a subpackage
+such as ``diagnosis/servo`` is on its parent's layer), reads no resource of a higher package
+through ``importlib.resources``; no module imports itself back through a cycle, the rooms of one
+package (its subpackages and its own top level) import each other without a cycle, and no
+folder holds more than ``MAX_FOLDER_MODULES`` modules. These read the source with ``ast`` (nothing is run), so
 a lazy import inside a function counts like any other.
 """
 
@@ -123,6 +126,79 @@ def test_modules_and_functions_stay_small():
                 if n > MAX_FUNCTION_LINES and (name, node.name) not in LONG_COMPILED:
                     too_big.append(f"{name}.{node.name}: {n} lines")
     assert not too_big, "over the size limits (docs/internals.md):\n" + "\n".join(too_big)
+
+
+# a folder a newcomer can take in at a glance (issue 27); model/ is being brought under the limit
+# on its own branch: remove it from here when that lands
+MAX_FOLDER_MODULES = 15
+FOLDER_EXCEPTIONS = {"compliance/model"}
+
+
+def test_no_folder_holds_too_many_modules():
+    crowded = []
+    for folder in sorted({p.parent for p in PACKAGE.rglob("*.py")}):
+        n = sum(1 for p in folder.glob("*.py") if p.name != "__init__.py")
+        name = folder.relative_to(PACKAGE.parent).as_posix()
+        if n > MAX_FOLDER_MODULES and name not in FOLDER_EXCEPTIONS:
+            crowded.append(f"{name}: {n} modules")
+    assert not crowded, f"folders over {MAX_FOLDER_MODULES} modules (split them into rooms by job):\n" + "\n".join(crowded)
+
+
+def _resource_packages(path: Path) -> set[str]:
+    """``compliance`` packages whose files a module reads through ``importlib.resources``."""
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Call):
+            f = node.func
+            fname = f.attr if isinstance(f, ast.Attribute) else getattr(f, "id", "")
+            if fname in ("files", "open_text", "open_binary", "read_text", "read_binary", "path", "contents",
+                         "is_resource") and node.args:
+                arg = node.args[0]
+                if isinstance(arg, ast.Constant) and isinstance(arg.value, str) and arg.value.startswith("compliance"):
+                    found.add(arg.value)
+    return found
+
+
+def test_no_resources_read_from_a_higher_layer():
+    rank = {name: i for i, name in enumerate(LAYERS)}
+    upward = []
+    for module, path in _modules().items():
+        here = _layer(module)
+        for package in _resource_packages(path):
+            there = _layer(package)
+            if here is not None and there is not None and there != "data" and rank.get(there, -1) > rank[here]:
+                upward.append(f"{module} reads resources of {package}")
+    assert not upward, "resources read against the layer order:\n" + "\n".join(sorted(upward))
+
+
+def _room(path: Path) -> str:
+    """The folder a module sits in (``compliance.diagnosis.servo``; a package's ``__init__`` is its own folder)."""
+    return ".".join(path.parent.relative_to(PACKAGE.parent).parts)
+
+
+def test_rooms_of_a_package_form_no_cycle():
+    modules, rooms = _modules(), {}
+    for module, deps in _graph().items():
+        if _layer(module) is None:
+            continue
+        here = _room(modules[module])
+        rooms.setdefault(here, set())
+        for dep in deps:
+            there = _room(modules[dep])
+            if there != here and _layer(dep) == _layer(module):
+                rooms[here].add(there)
+    cycles = []
+    for start in rooms:  # rooms are few: a depth-first search from each finds any way back
+        seen, todo = set(), list(rooms[start])
+        while todo:
+            r = todo.pop()
+            if r == start:
+                cycles.append(start)
+                break
+            if r not in seen:
+                seen.add(r)
+                todo.extend(rooms.get(r, ()))
+    assert not cycles, f"rooms that import themselves back through another room: {sorted(cycles)}"
 
 
 def test_the_kept_long_kernels_say_why():

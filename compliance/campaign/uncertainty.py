@@ -12,7 +12,7 @@ parameter anywhere in its range, the worst combination):
 A verdict whose band straddles its limit is ``uncertain``; the parameters that decide it are the
 largest swings towards the limit, in order, until they cover the margin. ``govcheck check
 --uncertainty N`` replaces the local band by a Latin-hypercube Monte Carlo over the same ranges
-(``compliance.sweep.uncertainty_mc``). docs/requirements.md, "Uncertainty".
+(``compliance.sweep.tolerance.uncertainty_mc``). docs/requirements.md, "Uncertainty".
 """
 
 from __future__ import annotations

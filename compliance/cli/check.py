@@ -55,7 +55,7 @@ def register(subparsers):
     p.add_argument("--allow-conflicts", action="store_true",
                    help="judge a requirement set even when two mandatory limits cannot hold together (without it such a set "
                         "is refused with exit code 2 before any simulation; docs/requirements.md)")
-    from compliance.cli.remedies_options import add_remedies_options
+    from compliance.cli.sweep import add_remedies_options
 
     add_remedies_options(p)
     add_document_options(p)
@@ -101,7 +101,7 @@ def finish_results(results: dict, args, name: str = "check") -> dict:
 def monte_carlo(cfg, reqset, results: dict, args) -> None:
     """Replace the verdicts' bands by a Monte Carlo of ``args.uncertainty`` plants and re-summarise."""
     from compliance.campaign.run import summary_section
-    from compliance.sweep.uncertainty_mc import monte_carlo_bands
+    from compliance.sweep.tolerance.uncertainty_mc import monte_carlo_bands
 
     results["uncertainty"] = monte_carlo_bands(cfg, reqset, results, args.uncertainty, workers=args.jobs,
                                                progress=not args.quiet)
@@ -132,7 +132,7 @@ def run(args) -> int:
     from compliance.requirements.loading import load_requirements
 
     check_uncertainty_option(args)
-    from compliance.cli.remedies_options import check_remedies_options
+    from compliance.cli.sweep import check_remedies_options
 
     check_args_outputs(args, (getattr(args, "save_remedy", None), "--save-remedy", (".toml",)))
     check_remedies_options(args)
@@ -140,7 +140,7 @@ def run(args) -> int:
         fixed_created()  # a malformed SOURCE_DATE_EPOCH is refused before the work
     render = renderer(args)
     if args.remedies and args.remedies != "default":  # a bad sweep file is exit 2 before any simulation
-        from compliance.sweep.spec import load_sweep
+        from compliance.sweep.candidates.spec import load_sweep
 
         load_sweep(args.remedies)
     cfg = plant_from_args(args)
@@ -166,7 +166,7 @@ def run(args) -> int:
         if args.remedies:
             from compliance.sweep.check_remedies import remedies_for_check
 
-            from compliance.cli.remedies_options import remedies_kwargs
+            from compliance.cli.sweep import remedies_kwargs
 
             results["remedies"] = remedies_for_check(cfg, reqset, args.remedies, workers=args.jobs, progress=not args.quiet,
                                                      **remedies_kwargs(args))
@@ -188,7 +188,7 @@ def run(args) -> int:
 
             sys.stdout.write("\n" + remedies_markdown(results["remedies"]))
     if args.remedies:
-        from compliance.cli.remedies_options import save_remedy
+        from compliance.cli.sweep import save_remedy
 
         save_remedy(args, cfg, results["remedies"])
     if args.json:

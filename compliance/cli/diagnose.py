@@ -5,9 +5,9 @@
     govcheck diagnose FILE1 FILE2 ... --column-map zillen-friction --friction-bore "25.7 mm"
 
 A servo recording (time, position, valve command; reference for a closed-loop test) gets the
-replay diagnosis (``compliance.diagnosis.engine``); friction-bench recordings (position,
+replay diagnosis (``compliance.diagnosis.servo.diagnose``); friction-bench recordings (position,
 chamber pressure and drive force, no valve command) get the friction-model diagnosis
-(``compliance.diagnosis.friction_diagnosis``). Exit 0 when the diagnosis ran (whatever it
+(``compliance.diagnosis.friction_bench.diagnose``). Exit 0 when the diagnosis ran (whatever it
 found), 2 on bad input.
 """
 
@@ -89,7 +89,7 @@ def run(args) -> int:
         return _run_joint(args, plant_arg, effects)
     frame, meta = read_recording(args.recordings[0], args.column_map)
     from compliance.model.config import load_plant
-    from compliance.diagnosis.engine import diagnose, save_fitted
+    from compliance.diagnosis.servo.diagnose import diagnose, save_fitted
 
     plant = plant_arg or sidecar_plant(meta, args.recordings[0])
     if not plant:
@@ -117,7 +117,7 @@ def run(args) -> int:
     if unsaved:
         print(f"note: {unsaved}")
     if args.suggest_test:
-        from compliance.diagnosis.discriminate import suggestion_lines
+        from compliance.diagnosis.evidence.discriminating_test import suggestion_lines
 
         print("\n".join(suggestion_lines(diag.suggested_test)))
     return 0
@@ -157,7 +157,7 @@ def _print_servo(d: dict, quiet: bool) -> None:
 
 def _render_servo_report(cfg, frame, meta, diag, data: dict, args) -> None:
     from compliance.model.identity import identity_dict
-    from compliance.report.diagnosis_validation import validation_with_diagnosis
+    from compliance.diagnosis.servo.report_data import validation_with_diagnosis
     from compliance.report.render import render_validation_report
 
     result = validation_with_diagnosis(cfg, frame, meta, diag, data)
@@ -166,7 +166,7 @@ def _render_servo_report(cfg, frame, meta, diag, data: dict, args) -> None:
 
 
 def _run_friction(args, first, meta) -> int:
-    from compliance.diagnosis.friction_diagnosis import diagnose_friction, format_friction
+    from compliance.diagnosis.friction_bench.diagnose import diagnose_friction, format_friction
     from compliance.recordings.reader import read_recording
     from compliance.units import parse_quantity
 
@@ -198,9 +198,9 @@ def _run_friction(args, first, meta) -> int:
 
 
 def _run_joint(args, plant_arg, effects) -> int:
-    """Several closed-loop recordings of one plant: one diagnosis with shared physics (diagnosis.joint)."""
+    """Several closed-loop recordings of one plant: one diagnosis with shared physics (diagnosis.servo.joint_recordings)."""
     from compliance.cli.progress import progress
-    from compliance.diagnosis.joint import diagnose_joint, format_joint
+    from compliance.diagnosis.servo.joint_recordings import diagnose_joint, format_joint
     from compliance.model.config import load_plant
     from compliance.recordings.reader import read_recording
 

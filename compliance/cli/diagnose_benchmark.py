@@ -78,7 +78,7 @@ def _write(args, data: dict) -> None:
 
 def run(args) -> int:
     """Run the benchmark; 0 when the targets are met, 1 when not."""
-    from compliance.diagnosis.benchmark import format_summary, run_benchmark, run_practice
+    from compliance.diagnosis.scoring.benchmark import format_summary, run_benchmark, run_practice
     from compliance.processes import available_cores
 
     check_args_outputs(args)
@@ -105,7 +105,7 @@ def run(args) -> int:
         print(f"main parameter within 25 %: {rep['main_within_25']} of {rep['main_scored']}"
               + (f"; not a hit but not identifiable by the test (split interval contains the truth): "
                  f"{rep['main_split_open_interval_contains_truth']}" if rep["main_split_open_interval_contains_truth"] else ""))
-        from compliance.diagnosis.practice_score import practice_table
+        from compliance.diagnosis.scoring.practice_score import practice_table
 
         print("\n" + practice_table(rep))
         if args.json:

@@ -32,7 +32,7 @@ def register(subparsers):
     p.add_argument("--no-check", action="store_true", help="propose only; do not run the campaign")
     p.add_argument("--remedies", action="store_const", const="default", default=None,
                    help="hand the proposal to the remedies search (as `govcheck check --remedies`)")
-    from compliance.cli.remedies_options import add_remedies_options
+    from compliance.cli.sweep import add_remedies_options
 
     add_remedies_options(p)
     add_outputs(p, "json")
@@ -59,12 +59,12 @@ def _sizing_text(rec: dict, tune: dict) -> str:
 
 def run(args) -> int:
     """Size, write, check, and optionally search remedies; exit code from the proposal's verdict."""
-    from compliance.cli.remedies_options import check_remedies_options, remedies_kwargs, save_remedy
+    from compliance.cli.sweep import check_remedies_options, remedies_kwargs, save_remedy
     from compliance.model.config import load_plant, save_plant
     from compliance.requirements.loading import load_requirements
-    from compliance.sweep.duty import load_duty
-    from compliance.sweep.sizing import size_servo, time_constant_target
-    from compliance.sweep.sizing_tune import tune_throttles
+    from compliance.sweep.sizing.duty_file import load_duty
+    from compliance.sweep.sizing.size_servo import size_servo, time_constant_target
+    from compliance.sweep.sizing.throttle_tuning import tune_throttles
 
     check_args_outputs(args, (args.out, "--out", (".toml",)), (args.save_remedy, "--save-remedy", (".toml",)))
     check_remedies_options(args)

@@ -1,8 +1,13 @@
-"""``govcheck sweep``: candidate sweeps, the optimise (remedies) search and tolerance yield."""
+"""``govcheck sweep``: candidate sweeps, the optimise (remedies) search and tolerance yield; the remedies options.
+
+The options that shape ``--remedies`` of ``govcheck check`` and ``govcheck size`` (catalogue, yield units,
+scheduler, resumable state, saved remedy) live here too: the same search, the same executor.
+"""
 
 from __future__ import annotations
 
 import shlex
+import sys
 from pathlib import Path
 
 from compliance.cli.common import add_jobs, add_parser, add_quiet, add_scheduler, check_scheduler
@@ -91,12 +96,20 @@ def _command_line(args) -> str:
     return shlex.join(parts)
 
 
+def _write_section(path, title: str, **section) -> None:
+    """The remedies / yield report section as its own page beside the run's files (read without a whole report)."""
+    from compliance.files.atomic import write_text_atomic
+    from compliance.report.render import section_page
+
+    write_text_atomic(path, section_page(title, **section))
+
+
 def run(args) -> int:
     """Run the sweep (or yield run), print the summary, exit 0 / 1 / 2."""
     from dataclasses import replace
 
     from compliance.sweep.run import run_sweep, run_yield_file
-    from compliance.sweep.spec import load_sweep
+    from compliance.sweep.candidates.spec import load_sweep
 
     for flag in ("jobs", "samples", "units"):
         v = getattr(args, flag)
@@ -113,12 +126,74 @@ def run(args) -> int:
 
         cand = _yield_candidate(args.yield_of, out, spec)
         y = run_yield_file(spec, out / f"yield-{args.yield_of}", cand, args.yield_of, units=args.units, **kw)
+        _write_section(out / f"yield-{args.yield_of}" / "yield.html", f"{spec.title}: tolerance yield of '{args.yield_of}'",
+                       tolerance_yield=y)
         text = yield_markdown(y)
         print(text.splitlines()[3] if args.quiet else text)
         return 0
     from compliance.sweep.summary_text import summary_markdown
 
     s = run_sweep(spec, out, command_line=_command_line(args), **kw)
+    if s["remedies"] is not None:
+        _write_section(out / "summary.html", f"{spec.title}: what would make it pass", remedies=s["remedies"])
     text = summary_markdown(s)
     print(text.splitlines()[3] if args.quiet else text)
     return 0 if s["best"] and s["best"]["verified_status"] == "pass" else 1
+
+
+# --------------------------------------------------------------------------- the remedies options of check and size
+def add_remedies_options(p) -> None:
+    """Add the options that shape ``--remedies``."""
+    p.add_argument("--save-remedy", metavar="FILE.toml",
+                   help="with --remedies: write the verified remedy as a configuration file that govcheck check accepts "
+                        "(written only when a remedy is found)")
+    p.add_argument("--catalogue", metavar="FILE.toml", default="default",
+                   help="with --remedies: hardware catalogue of orderable options (default: the shipped "
+                        "models/hardware-catalogue.toml; 'none' for settings only)")
+    p.add_argument("--yield-units", type=int, default=None, metavar="N",
+                   help="with --remedies: Monte Carlo units of the remedy's tolerance yield (default 59: 59/59 passing shows "
+                        ">= 95 %% at 95 %% confidence; 0 skips it)")
+    add_scheduler(p, "the --remedies search (needs --remedies)")
+    p.add_argument("--remedies-state", metavar="DIR",
+                   help="with --remedies: keep every judged candidate in DIR so an interrupted search resumes there")
+
+
+def check_remedies_options(args) -> None:
+    """Refuse inconsistent or bad remedies options before any work (exit 2)."""
+    used = [f for f in ("save_remedy", "yield_units", "scheduler", "remedies_state") if getattr(args, f, None) is not None]
+    if used and not args.remedies:
+        raise InputError(f"--{used[0].replace('_', '-')} needs --remedies")
+    if args.yield_units is not None and args.yield_units < 0:
+        raise InputError(f"--yield-units {args.yield_units}: expected 0 or a positive number of units")
+    check_scheduler(args)
+    if args.remedies and args.catalogue not in ("default", "none"):
+        from compliance.sweep.sizing.hardware_catalogue import load_catalogue
+
+        load_catalogue(args.catalogue)  # a bad catalogue is exit 2 before any simulation
+
+
+def remedies_kwargs(args) -> dict:
+    """Keyword arguments of ``remedies_for_check`` from the options."""
+    from compliance.sweep.candidates.candidate_store import CandidateStore
+    from compliance.sweep.check_remedies import YIELD_UNITS
+
+    return {"catalogue": None if args.catalogue == "none" else args.catalogue, "scheduler": args.scheduler,
+            "yield_units": YIELD_UNITS if args.yield_units is None else args.yield_units,
+            "store": CandidateStore(args.remedies_state) if args.remedies_state else None}
+
+
+def save_remedy(args, cfg, rem) -> None:
+    """Write the remedy configuration (``--save-remedy``) when one was found; say so either way."""
+    if not args.save_remedy:
+        return
+    if rem.get("status") != "found":
+        print(f"--save-remedy {args.save_remedy}: nothing written (no verified remedy in the declared space)", file=sys.stderr)
+        return
+    from compliance.model.config import save_plant
+    from compliance.sweep.candidates.parameter_paths import describe
+    from compliance.sweep.remedies.finish import remedy_configuration, remedy_values
+
+    paths = {p: describe(p, "remedy") for p in remedy_values(rem)}
+    save_plant(remedy_configuration(cfg, rem, paths), args.save_remedy, overwrite=True)
+    if not args.quiet:
+        print(f"remedy written to {args.save_remedy} (govcheck check {args.save_remedy} -r {args.requirements})")

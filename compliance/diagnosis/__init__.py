@@ -11,19 +11,17 @@ Public API:
 - ``run_benchmark(cfg, ...)`` and ``run_practice(directory, cfg)`` (the proof on generated
   concealed-effect cases and on recordings with answers).
 
-Modules, one job each: ``replay_fit`` (fast re-synchronised replay with matched noise),
-``operating_point`` (the stated load holds at the recording's start), ``noise_floor`` /
-``residuals`` (normalised residuals), ``candidates`` (what may be fitted), ``fit`` (scan,
-simplex, least squares), ``recalibration`` (base parameters), ``multi`` (several effects),
-``workers`` (parallel fits), ``select`` (information criteria, honest verdicts, ambiguity),
-``discriminate`` (the test that tells two explanations apart), ``split`` (does the recording
-pin a lag's split or only its total), ``empirical`` (the missing force
-outside the library), ``located`` (where the model misses), ``explain`` (the paragraph),
-``fitted_model`` (the fitted plant), ``engine`` (the chain),
-``joint`` (several recordings at once),
-``concealed`` / ``benchmark`` / ``practice_score`` (the proof), ``friction_models`` / ``friction_fit`` /
-``friction_position`` / ``friction_holdout`` / ``friction_diagnosis`` / ``friction_explain``
-(the friction bench; its report is compliance/report/friction.py).
+Rooms, one job each (dependencies point down this list, never back):
+
+- ``evidence/``: the recording against the nominal model, before any fit: the fast replay with
+  matched noise, the stated operating point, noise floors, normalised residuals, where the model
+  misses, the missing force outside the library, the test that would tell two explanations apart;
+- ``servo/``: closed-loop servo recordings: candidates, fits, effect sets, recalibration, parallel
+  fits, selection and verdicts, the lag split, the friction law's form, the explanation, the
+  fitted plant, the JSON document, the chain (``servo.diagnose``) and several recordings at once;
+- ``friction_bench/``: seal-friction force-bench runs (its report is compliance/report/friction.py);
+- ``scoring/``: the proof against known answers: generated concealed-effect and two-effect cases,
+  the benchmark, the practice recordings' score.
 """
 
 from __future__ import annotations
@@ -33,19 +31,19 @@ __all__ = ["diagnose", "save_fitted", "Diagnosis", "diagnose_friction", "diagnos
 
 def __getattr__(name):  # lazy: importing the package does not compile the simulator
     if name in ("diagnose", "save_fitted", "Diagnosis"):
-        from compliance.diagnosis import engine
+        from compliance.diagnosis.servo import diagnose as servo_diagnose
 
-        return getattr(engine, name)
+        return getattr(servo_diagnose, name)
     if name == "diagnose_friction":
-        from compliance.diagnosis.friction_diagnosis import diagnose_friction
+        from compliance.diagnosis.friction_bench.diagnose import diagnose_friction
 
         return diagnose_friction
     if name == "diagnose_joint":
-        from compliance.diagnosis.joint import diagnose_joint
+        from compliance.diagnosis.servo.joint_recordings import diagnose_joint
 
         return diagnose_joint
     if name in ("run_benchmark", "run_practice"):
-        from compliance.diagnosis import benchmark
+        from compliance.diagnosis.scoring import benchmark
 
         return getattr(benchmark, name)
     raise AttributeError(name)

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from compliance.diagnosis.candidates import effect_candidate
+from compliance.diagnosis.servo.candidates import effect_candidate
 from compliance.effects import EFFECTS
 from compliance.model.config import PlantConfig
 from compliance.papers.calibration import map_configs

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from compliance.diagnosis.candidates import FitParam
+from compliance.diagnosis.servo.candidates import FitParam
 from compliance.effects import EFFECTS
 from compliance.model.config import PlantConfig
 from compliance.model.parameters import BASE_BY_KEY

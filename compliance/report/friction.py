@@ -21,7 +21,7 @@ def seal_figures(seal, prefix: str = "fric") -> list[tuple[str, str]]:
     """(caption, inline SVG) of one ``SealDiagnosis``, in the report's style (text kept, ids prefixed)."""
     from matplotlib.figure import Figure
 
-    from compliance.diagnosis.friction_fit import predict
+    from compliance.diagnosis.friction_bench.fit import predict
 
     class plt:  # the three figure sizes below, without pyplot's global state
         @staticmethod
@@ -98,7 +98,7 @@ DBIC_TEXT = ("\u0394BIC: Bayesian information criterion relative to the best law
 
 def _param_rows(params: list) -> list[dict]:
     """Fitted parameters with SI prefixes, standard errors and a flag when a value sits on its fit bound."""
-    from compliance.diagnosis.friction_fit import FIT_BOUNDS
+    from compliance.diagnosis.friction_bench.fit import FIT_BOUNDS
     from compliance.units.formatting import fmt_si
 
     rows = []

@@ -360,3 +360,16 @@ def render_validation_report(result: dict, html_path, pdf_path=None, *, workers:
            "created": fmt_date(result.get("created")), "identity": document.get("identity") or {},
            "doc": S.document_block(document.get("identity") or {}, files, document)}
     _emit("validation.html.j2", ctx, svgs, html_path, pdf_path)
+
+
+def section_page(title: str, remedies: dict | None = None, tolerance_yield: dict | None = None) -> str:
+    """The report's "What would make it pass" / "Tolerance yield" section as a self-contained HTML page.
+
+    ``govcheck sweep`` writes it beside its files (``summary.html``, ``yield.html``) so the answer
+    can be read without rendering a whole report; same partial and stylesheet as the report.
+    """
+    env = _environment()
+    body = env.get_template("_remedies.html.j2").render(remedies=remedies, tolerance_yield=tolerance_yield)
+    page = env.from_string('<!doctype html>\n<html lang="en"><head><meta charset="utf-8"><title>{{ title }}</title>'
+                           "<style>{{ css }}</style></head><body><main><h1>{{ title }}</h1>{{ body }}</main></body></html>\n")
+    return page.render(title=title, css=jinja2.utils.markupsafe.Markup(_css()), body=jinja2.utils.markupsafe.Markup(body))

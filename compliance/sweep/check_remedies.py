@@ -3,20 +3,20 @@
 The space is a sweep file's ``adjust`` table when one is named, else the settings that can be
 changed on site without new hardware, around the configuration's own values (DEFAULT_SPACE):
 controller gains and dead-zone compensation, the meter-out flow-control valves, the supply
-pressure regulator; for a PID governor also its set-point rate limiter (``limiter_space``).
-Then the options of a hardware catalogue (``sweep.hardware``; the shipped one by default).
+pressure regulator; for a PID governor also its set-point rate limiter (``remedies.limiter_space``).
+Then the options of a hardware catalogue (``sweep.sizing.hardware_catalogue``; the shipped one by default).
 A remedy found is verified by a full campaign and its tolerance yield (DEFAULT_TOLERANCES:
 manufacturing and site tolerances of a delivered unit, our choice, the same as
 models/sweeps/plant-a-remedies.toml); when none is found the binding requirement is explained
-physically (``binding_physics``).
+physically (``remedies.binding_physics``).
 """
 
 from __future__ import annotations
 
-from compliance.sweep.evaluate import make_context
-from compliance.sweep.parameter_paths import describe
-from compliance.sweep.spec import Adjustable, Uncertain
-from compliance.sweep.yield_mc import nominal_values
+from compliance.sweep.candidates.evaluate import make_context
+from compliance.sweep.candidates.parameter_paths import describe
+from compliance.sweep.candidates.spec import Adjustable, Uncertain
+from compliance.sweep.tolerance.yield_mc import nominal_values
 
 __all__ = ["DEFAULT_SPACE", "DEFAULT_TOLERANCES", "YIELD_UNITS", "default_space", "remedies_for_check"]
 
@@ -67,11 +67,11 @@ def default_space(cfg) -> tuple[Adjustable, ...]:
 
 def _space(cfg, reqset, sweep_file):
     """(adjustables, start values, uncertain parameters) of the search."""
-    from compliance.sweep.limiter_space import limiter_space
+    from compliance.sweep.remedies.limiter_space import limiter_space
 
     uncertain = tuple(Uncertain(describe(p, "remedies tolerances"), d, s, True, None) for p, (d, s) in DEFAULT_TOLERANCES.items())
     if sweep_file and sweep_file != "default":
-        from compliance.sweep.spec import load_sweep
+        from compliance.sweep.candidates.spec import load_sweep
 
         spec = load_sweep(sweep_file)
         adjust, uncertain = spec.adjust, spec.uncertain or uncertain
@@ -98,16 +98,16 @@ def remedies_for_check(cfg, reqset, sweep_file: str | None, *, workers=None, pro
     yield_units : int
         Units of the tolerance yield of a remedy found (0: no yield run).
     store : str or None
-        Folder keeping every judged candidate, so an interrupted search resumes (``candidate_store``).
+        Folder keeping every judged candidate, so an interrupted search resumes (``candidates.candidate_store``).
     """
     from compliance.processes import dask_session
-    from compliance.sweep.hardware import load_catalogue
-    from compliance.sweep.remedy_finish import as_given, finish
-    from compliance.sweep.remedy_search import staged_search
+    from compliance.sweep.sizing.hardware_catalogue import load_catalogue
+    from compliance.sweep.remedies.finish import as_given, finish
+    from compliance.sweep.remedies.staged_search import staged_search
     from compliance.sweep.run import verify_settings
 
     if isinstance(store, str):
-        from compliance.sweep.candidate_store import CandidateStore
+        from compliance.sweep.candidates.candidate_store import CandidateStore
 
         store = CandidateStore(store)
     cat = load_catalogue(catalogue) if catalogue else None

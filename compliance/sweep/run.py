@@ -16,13 +16,12 @@ import time
 from compliance.processes import raise_if_stopping
 from compliance.campaign.results_files import write_json
 from compliance.files.atomic import write_json_atomic, write_text_atomic
-from compliance.sweep.evaluate import make_context
-from compliance.sweep.remedies import find_remedy
-from compliance.sweep.results import best_index, pareto_front, table, tightest, write_table
-from compliance.sweep.sampling import grid, latin_hypercube
-from compliance.sweep.section_html import section_html
+from compliance.sweep.candidates.evaluate import make_context
+from compliance.sweep.remedies.smallest_change import find_remedy
+from compliance.sweep.candidates.results import best_index, pareto_front, table, tightest, write_table
+from compliance.sweep.candidates.sampling import grid, latin_hypercube
 from compliance.sweep.summary_text import summary_markdown, yield_markdown
-from compliance.sweep.yield_mc import nominal_values, run_yield
+from compliance.sweep.tolerance.yield_mc import nominal_values, run_yield
 
 __all__ = ["SUMMARY_SCHEMA", "load_inputs", "run_sweep", "run_yield_file", "verify_settings"]
 
@@ -40,7 +39,7 @@ def load_inputs(spec):
 def verify_settings(cfg, reqset, paths, values, *, command_line=None, workers=None):
     """The full campaign (traces, linear requirements and all) of ``cfg`` with ``values`` applied."""
     from compliance.campaign.run import run_campaign
-    from compliance.sweep.parameter_paths import apply_values
+    from compliance.sweep.candidates.parameter_paths import apply_values
 
     return run_campaign(apply_values(cfg, paths, values), reqset, workers=workers, progress=False,
                         command_line=command_line)
@@ -82,7 +81,7 @@ def run_sweep(spec, out_dir, *, scheduler=None, workers=None, progress=True, cli
     ctx = make_context(cfg, reqset, spec.paths, spec.linear)
     base = nominal_values(cfg, spec.paths)
     from compliance.processes import dask_session
-    from compliance.sweep.runner import run_candidates
+    from compliance.sweep.candidates.runner import run_candidates
 
     cands = _candidates(spec)
     remedies = None
@@ -126,8 +125,6 @@ def run_sweep(spec, out_dir, *, scheduler=None, workers=None, progress=True, cli
     }
     write_json_atomic(out / "summary.json", summary)
     write_text_atomic(out / "summary.md", summary_markdown(summary))
-    if remedies is not None:
-        write_text_atomic(out / "summary.html", section_html(f"{spec.title}: what would make it pass", remedies=remedies))
     return summary
 
 
@@ -160,5 +157,4 @@ def run_yield_file(spec, out_dir, candidate: dict, label: str, *, scheduler=None
     write_json(res, out / "results.json")  # the nominal candidate's campaign with the yield: govcheck report renders it
     write_json_atomic(out / "yield.json", y)
     write_text_atomic(out / "yield.md", yield_markdown(y))
-    write_text_atomic(out / "yield.html", section_html(f"{spec.title}: tolerance yield of '{label}'", tolerance_yield=y))
     return y

@@ -17,7 +17,7 @@ import pytest
 from compliance.campaign.run import run_campaign
 from compliance.model.config import load_plant
 from compliance.requirements.loading import load_requirements
-from compliance.sweep.uncertainty_mc import monte_carlo_bands
+from compliance.sweep.tolerance.uncertainty_mc import monte_carlo_bands
 
 REQ = """
 schema = "govcheck-requirements/1"

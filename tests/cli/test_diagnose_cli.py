@@ -19,7 +19,7 @@ class _NoMismatch:
 
 
 def test_save_model_after_no_mismatch_is_a_note(tmp_path, monkeypatch, capsys):
-    import compliance.diagnosis.engine as engine
+    import compliance.diagnosis.servo.diagnose as engine
 
     W.build(tmp_path)
     monkeypatch.chdir(tmp_path)

@@ -16,9 +16,9 @@ import pytest
 
 from compliance.cli import main
 from compliance.model.config import load_plant
-from compliance.diagnosis.candidates import FitParam, effect_params
-from compliance.diagnosis.engine import diagnose, save_fitted
-from compliance.diagnosis.replay_fit import prepare_replay, replay_config, run_replay, segment_starts
+from compliance.diagnosis.servo.candidates import FitParam, effect_params
+from compliance.diagnosis.servo.diagnose import diagnose, save_fitted
+from compliance.diagnosis.evidence.replay_fit import prepare_replay, replay_config, run_replay, segment_starts
 from compliance.errors import InputError
 from compliance.recordings.synth import PRACTICE_NOISE, synthesise, write_recording
 
@@ -69,7 +69,7 @@ def test_fit_param_unit_cube_round_trips():
 def test_lumped_total_lag_propagates_the_full_covariance():
     """Delay and time constant that trade one for one (correlation -1) leave their sum exact,
     while each alone is uncertain; uncorrelated, the errors add in quadrature."""
-    from compliance.diagnosis.fit import FitResult
+    from compliance.diagnosis.servo.fit import FitResult
 
     params = effect_params("sensor_lag")
     sd = np.array([2e-3, 2e-3])
@@ -86,8 +86,8 @@ def test_lumped_total_lag_propagates_the_full_covariance():
 def test_newey_west_information_counts_correlated_residuals_as_fewer():
     """White residuals: S = J^T J var(r). AR(1) residuals with rho = 0.8: S approaches the long-run
     variance (1 + rho)/(1 - rho) = 9 times larger, less the Bartlett truncation 2 rho/((L+1)(1-rho)^2)."""
-    from compliance.diagnosis.fit import hac_information
-    from compliance.diagnosis.residuals import ResidualModel
+    from compliance.diagnosis.servo.fit import hac_information
+    from compliance.diagnosis.evidence.residuals import ResidualModel
 
     m, lag, rho = 40000, 50, 0.8
     model = ResidualModel(signals=("position",), floors={}, sensor_noise={}, index=np.arange(m), recorded={})
@@ -151,7 +151,7 @@ def test_a_miscalibrated_valve_is_called_parameters_only(cfg):
     assert quoted, d.explanation
     assert d.fit_before[quoted[0]]["fit_percent"] == pytest.approx(table[quoted[0]]["fit_percent"], abs=0.05)
     # the report's text quotes the fitted model's own validation table, before and after, digit for digit
-    from compliance.diagnosis.explain import explain_with_table
+    from compliance.diagnosis.servo.explanation import explain_with_table
 
     after = validate(d.fitted_cfg, frame, meta, ValidationSettings(modes=("closed_loop",)))["modes"]["closed_loop"]["fits"]
     s = quoted[0]
@@ -215,7 +215,7 @@ def test_friction_diagnosis_names_pressure_dependence_on_synthetic_runs():
     """Static-map runs with k_p = 2e-6 N/Pa at 1, 4 and 7 bar: pressure dependence found, k_p back within 5 %,
     and no pre-sliding claimed (parsimony: the data has none)."""
     from compliance.characterise.friction_map import piston_area, synthetic_friction_run
-    from compliance.diagnosis.friction_diagnosis import diagnose_friction
+    from compliance.diagnosis.friction_bench.diagnose import diagnose_friction
 
     area = piston_area(0.0257)
     law = {"coulomb": 3.0, "static": 4.0, "stribeck_velocity": 0.003, "viscous": 80.0}
@@ -241,7 +241,7 @@ def test_friction_diagnosis_names_pressure_dependence_on_synthetic_runs():
 
 
 def test_small_benchmark_runs_and_scores(cfg):
-    from compliance.diagnosis.benchmark import format_summary, run_benchmark
+    from compliance.diagnosis.scoring.benchmark import format_summary, run_benchmark
 
     rep = run_benchmark(cfg, effects=["internal_leakage"], cases=1, seed=2, library=["internal_leakage", "heat_transfer"],
                         jobs=1, null=True, miscalibrations=False)
@@ -329,7 +329,7 @@ def test_noise_estimate_keeps_the_low_band_while_holding_and_follows_steps():
     holds, and across the step the estimate stays the short smoother's (no motion leaks in)."""
     from scipy.signal import savgol_filter
 
-    from compliance.diagnosis.noise_floor import HOLD_WINDOW, position_noise_estimate
+    from compliance.diagnosis.evidence.noise_floor import HOLD_WINDOW, position_noise_estimate
 
     rng = np.random.default_rng(5)
     t = np.arange(0.0, 6.0, 1e-3)

@@ -1,4 +1,4 @@
-"""The friction law's other form as the base of the diagnosis (friction_form.py).
+"""The friction law's other form as the base of the diagnosis (servo/friction_form.py).
 
 A bench whose friction is the variable-viscous law with a stick phase (seed 000 eq. 7) while the
 declared plant has LuGre bristles with the same steady-state map: the nominal replay with the other
@@ -11,13 +11,13 @@ from __future__ import annotations
 import pytest
 
 from compliance.model.config import load_plant
-from compliance.diagnosis.engine import _prepare
-from compliance.diagnosis.candidates import apply, effect_params
-from compliance.diagnosis.fit import FitResult, chi2_parts
-from compliance.diagnosis.friction_form import OPTION, form_after_effects, friction_form_check, form_words
-from compliance.diagnosis.replay_fit import run_replay
-from compliance.diagnosis.operating_point import load_at_start
-from compliance.diagnosis.select import MIN_GAIN, SIGNIFICANCE
+from compliance.diagnosis.servo.diagnose import prepare_recording
+from compliance.diagnosis.servo.candidates import apply, effect_params
+from compliance.diagnosis.servo.fit import FitResult, chi2_parts
+from compliance.diagnosis.servo.friction_form import OPTION, form_after_effects, friction_form_check, form_words
+from compliance.diagnosis.evidence.replay_fit import run_replay
+from compliance.diagnosis.evidence.operating_point import load_at_start
+from compliance.diagnosis.servo.selection import MIN_GAIN, SIGNIFICANCE
 from compliance.recordings.synth import PRACTICE_NOISE, synthesise
 
 
@@ -30,7 +30,7 @@ def _check(cfg, bench, x0=0.05, load=6000.0, seed=5):
     frame, meta = synthesise(bench, "steps", x0=x0, load=load_at_start(bench, load, x0), kd=20.0, noise=PRACTICE_NOISE,
                              seed=seed, duration=17.0)
     meta["conditions"]["load_force"] = load
-    st = _prepare(cfg, frame, meta, 5, 1)
+    st = prepare_recording(cfg, frame, meta, 5, 1)
     return friction_form_check(st.rc, st.setup, st.model, st.fits["nominal"])
 
 
@@ -68,7 +68,7 @@ def _after_effects(cfg, form):
     frame, meta = synthesise(bench, "steps", x0=x0, load=load_at_start(bench, load, x0), kd=20.0, noise=PRACTICE_NOISE,
                              seed=5, duration=17.0)
     meta["conditions"]["load_force"] = load
-    st = _prepare(cfg, frame, meta, 5, 1)
+    st = prepare_recording(cfg, frame, meta, 5, 1)
     check = friction_form_check(st.rc, st.setup, st.model, st.fits["nominal"])
     params = effect_params("valve_dynamics")
     values = [LAG[fp.name.split(".")[-1]] for fp in params]

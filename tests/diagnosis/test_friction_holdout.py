@@ -1,4 +1,4 @@
-"""Out-of-sample proof of the seal-friction law (friction_holdout.py) and the declared position_dependent_friction.
+"""Out-of-sample proof of the seal-friction law (friction_bench/holdout.py) and the declared position_dependent_friction.
 
 Synthetic bench runs made from a known law with seeded force noise: a law that is the truth must
 predict a pressure it was not fitted on to the noise, and the position effect must earn its
@@ -13,10 +13,10 @@ import numpy as np
 import pytest
 
 from compliance.characterise.friction_map import piston_area, synthetic_friction_run
-from compliance.diagnosis.friction_diagnosis import FRICTION_RESIDUAL_LIMIT, diagnose_friction, prepare_runs
-from compliance.diagnosis.friction_fit import fit_law
-from compliance.diagnosis.friction_holdout import earns, prove_out_of_sample
-from compliance.diagnosis.friction_models import position_factor
+from compliance.diagnosis.friction_bench.diagnose import FRICTION_RESIDUAL_LIMIT, diagnose_friction, prepare_runs
+from compliance.diagnosis.friction_bench.fit import fit_law
+from compliance.diagnosis.friction_bench.holdout import earns, prove_out_of_sample
+from compliance.diagnosis.friction_bench.laws import position_factor
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 NOISE = 0.05  # N, force noise of the synthetic runs

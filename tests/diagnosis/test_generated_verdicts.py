@@ -1,4 +1,4 @@
-"""Verdicts on generated benchmark cases (concealed.py) that once came out wrong.
+"""Verdicts on generated benchmark cases (scoring/concealed_cases.py) that once came out wrong.
 
 - A null case: the nominal model's own recording, whose stick-slip replay leaves a burst that lifts
   its RMS against the constant floor above ``NOISE_TOLERANCE``; on the time-resolved floors (the
@@ -15,12 +15,12 @@ import math
 import pytest
 
 from compliance.model.config import load_plant
-from compliance.diagnosis.candidates import base_params
-from compliance.diagnosis.concealed import miscalibration_case, null_case
-from compliance.diagnosis.engine import _decide, _prepare
-from compliance.diagnosis.fit import FitContext, scan_points
-from compliance.diagnosis.recalibration import forward_select_base
-from compliance.diagnosis.select import NOISE_TOLERANCE
+from compliance.diagnosis.servo.candidates import base_params
+from compliance.diagnosis.scoring.concealed_cases import miscalibration_case, null_case
+from compliance.diagnosis.servo.diagnose import _decide, prepare_recording
+from compliance.diagnosis.servo.fit import FitContext, scan_points
+from compliance.diagnosis.servo.recalibration import forward_select_base
+from compliance.diagnosis.servo.selection import NOISE_TOLERANCE
 
 
 @pytest.fixture(scope="module")
@@ -30,7 +30,7 @@ def cfg():
 
 def test_the_nominal_models_own_recording_is_no_mismatch_though_a_burst_lifts_its_constant_floor_rms(cfg):
     case = null_case(cfg, 13)  # the benchmark's null case of --cases 1 --seed 1
-    st = _prepare(cfg, case.frame, case.meta, 5, 1)
+    st = prepare_recording(cfg, case.frame, case.meta, 5, 1)
     # against the constant floor (the RMS over the test of two null replays) the position misses...
     assert max(st.nominal_rms.values()) > NOISE_TOLERANCE
     dec = _decide(st)
@@ -43,7 +43,7 @@ def test_the_nominal_models_own_recording_is_no_mismatch_though_a_burst_lifts_it
 def test_a_moving_mass_three_times_the_data_sheet_is_found_beyond_the_flat_stretch(cfg):
     case = miscalibration_case(cfg, "cylinder.moving_mass", 17)  # 3.06 x, K_D = 20
     truth = case.params["cylinder.moving_mass"]
-    st = _prepare(cfg, case.frame, case.meta, 5, 1)
+    st = prepare_recording(cfg, case.frame, case.meta, 5, 1)
     ctx, n = FitContext(st.rc, st.setup, st.model), st.model.size
     mass = next(fp for fp in base_params(st.rc) if fp.key == "cylinder.moving_mass")
     nominal = st.fits["nominal"].chi2
@@ -61,8 +61,8 @@ def test_a_miscalibration_called_ambiguous_with_the_truth_named_is_counted_apart
     """Friction level vs pressure-dependent friction at one supply pressure: not a hit, not a plain miss."""
     from types import SimpleNamespace
 
-    from compliance.diagnosis.benchmark import format_summary, score_case, summarise
-    from compliance.diagnosis.concealed import Case
+    from compliance.diagnosis.scoring.benchmark import format_summary, score_case, summarise
+    from compliance.diagnosis.scoring.concealed_cases import Case
 
     case = Case("miscalibration", "friction.level", {"friction.level": 1.5, "factor": 1.5}, None, {}, {"seed": 41})
     diag = SimpleNamespace(verdict="ambiguous", winner="base", fits={}, ambiguous=["base", "pressure_dependent_friction"],

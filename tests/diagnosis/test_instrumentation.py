@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from compliance.diagnosis.engine import diagnose
-from compliance.diagnosis.instrument_candidates import instrument_candidates, instrumented
-from compliance.diagnosis.practice_score import practice_correct
-from compliance.diagnosis.replay_fit import prepare_replay
+from compliance.diagnosis.servo.diagnose import diagnose
+from compliance.diagnosis.servo.instrument_candidates import instrument_candidates, instrumented
+from compliance.diagnosis.scoring.practice_score import practice_correct
+from compliance.diagnosis.evidence.replay_fit import prepare_replay
 from compliance.model.config import load_plant
 from compliance.recordings.synth import PRACTICE_NOISE, synthesise
 

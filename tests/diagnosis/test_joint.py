@@ -17,9 +17,9 @@ import pytest
 
 from compliance.cli import main
 from compliance.model.config import load_plant
-from compliance.diagnosis.discriminate import SUPPLY_FACTOR
-from compliance.diagnosis.joint import JointModel, diagnose_joint
-from compliance.diagnosis.select import RESIDUAL_LIMIT
+from compliance.diagnosis.evidence.discriminating_test import SUPPLY_FACTOR
+from compliance.diagnosis.servo.joint_recordings import JointModel, diagnose_joint
+from compliance.diagnosis.servo.selection import RESIDUAL_LIMIT
 from compliance.recordings.synth import PRACTICE_NOISE, synthesise, write_recording
 
 K_TRUE = 1.5e-6  # 1/Pa: friction levels x 1.6 at 4 bar mean gauge pressure

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from types import SimpleNamespace
 
-from compliance.diagnosis.practice_score import practice_correct, practice_table
+from compliance.diagnosis.scoring.practice_score import practice_correct, practice_table
 
 SENSOR = {"verdicts": ["no_mismatch", "parameters_only", "unexplained"], "named": ["time_offset", "skew"]}
 NONE = {"verdicts": ["no_mismatch", "unexplained"]}

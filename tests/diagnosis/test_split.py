@@ -1,4 +1,4 @@
-"""The scan along a lag's lumped valley (compliance.diagnosis.split) and how practice scoring keeps it apart."""
+"""The scan along a lag's lumped valley (compliance.diagnosis.servo.lag_split) and how practice scoring keeps it apart."""
 
 from __future__ import annotations
 
@@ -7,10 +7,10 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from compliance.diagnosis.candidates import effect_params
-from compliance.diagnosis.fit import FitResult
-from compliance.diagnosis.practice_score import answer_in_si, main_parameter
-from compliance.diagnosis.split import split_scan
+from compliance.diagnosis.servo.candidates import effect_params
+from compliance.diagnosis.servo.fit import FitResult
+from compliance.diagnosis.scoring.practice_score import answer_in_si, main_parameter
+from compliance.diagnosis.servo.lag_split import split_scan
 
 M = 100  # residuals per signal
 SIGNALS = ("position", "pressure_a")
@@ -84,7 +84,7 @@ def test_a_pinned_split_is_bracketed_by_the_values_that_fit_worse():
 
 
 def test_trimmed_chi2_leaves_out_the_worst_fifth_of_the_segments():
-    from compliance.diagnosis.split import trimmed_chi2
+    from compliance.diagnosis.servo.lag_split import trimmed_chi2
 
     segments = np.repeat(np.arange(10), 20)
     vec = np.ones(200)

@@ -13,15 +13,15 @@ import numpy as np
 import pytest
 
 from compliance.model.config import load_plant
-from compliance.diagnosis.discriminate import design_test
-from compliance.diagnosis.empirical import sparse_fit
-from compliance.diagnosis.engine import diagnose
-from compliance.diagnosis.candidates import effect_params
-from compliance.diagnosis.engine import _prepare
-from compliance.diagnosis.multi import ADD_GAIN, BURST_WINDOW, NO_WORSE, adds_enough, screen_addition
-from compliance.diagnosis.fit import FitContext, FitResult, chi2_parts, scan_points
-from compliance.diagnosis.operating_point import load_at_start
-from compliance.diagnosis.select import RESIDUAL_LIMIT, Score, ambiguity_set, honest
+from compliance.diagnosis.evidence.discriminating_test import design_test
+from compliance.diagnosis.evidence.empirical_force import sparse_fit
+from compliance.diagnosis.servo.diagnose import diagnose
+from compliance.diagnosis.servo.candidates import effect_params
+from compliance.diagnosis.servo.diagnose import prepare_recording
+from compliance.diagnosis.servo.effect_sets import ADD_GAIN, BURST_WINDOW, NO_WORSE, adds_enough, screen_addition
+from compliance.diagnosis.servo.fit import FitContext, FitResult, chi2_parts, scan_points
+from compliance.diagnosis.evidence.operating_point import load_at_start
+from compliance.diagnosis.servo.selection import RESIDUAL_LIMIT, Score, ambiguity_set, honest
 from compliance.recordings.synth import PRACTICE_NOISE, synthesise
 
 DURATION = 17.0  # s: the practice steps without the sinusoid
@@ -144,7 +144,7 @@ def test_the_screen_finds_a_small_leak_whose_single_fit_a_dominant_valve_lag_dra
     leak = 4.5e-11
     frame, meta = _recording(cfg, {"valve_dynamics": {"natural_frequency": 50.7, "damping": 0.63, "delay": 0.0124},
                                    "external_leakage": {"conductance": leak}}, x0=0.027, load=6000.0)
-    st = _prepare(cfg, frame, meta, 5, 1)
+    st = prepare_recording(cfg, frame, meta, 5, 1)
     ctx, n = FitContext(st.rc, st.setup, st.model), st.model.size
     pv, pl = effect_params("valve_dynamics"), effect_params("external_leakage")
     lag = [44.4, 0.6, 0.00814]  # the lag's single fit: it absorbs part of the leak's signature
@@ -166,7 +166,7 @@ def test_a_pair_is_identifiable_on_a_model_bench_and_not_under_a_stick_band_fric
     case's right outcome is an honest incomplete verdict, which ``score_pair`` scores."""
     from types import SimpleNamespace
 
-    from compliance.diagnosis.pairs import bench_config, score_pair, truth_share
+    from compliance.diagnosis.scoring.two_effect_cases import bench_config, score_pair, truth_share
 
     params = {"valve_offset": {"offset": 0.25}, "external_leakage": {"conductance": 3e-10}}
     shares = {}
@@ -262,13 +262,13 @@ def test_a_slow_spool_is_judged_against_its_own_null_floors(cfg):
     generated case that, fitted within 1 %, left its position 2.3 x the declared floor) amplifies the
     error of the injected noise estimate more: its own null bootstrap leaves more position error, so
     judged against the larger floor its leftovers fall, and never rise."""
-    from compliance.diagnosis.candidates import apply
-    from compliance.diagnosis.residuals import own_floor_objective
+    from compliance.diagnosis.servo.candidates import apply
+    from compliance.diagnosis.evidence.residuals import own_floor_objective
 
     spool = {"valve_dynamics": {"natural_frequency": 34.4, "damping": 0.79, "delay": 0.0093}}
     truth_cfg = cfg.replace(effects=spool)
     frame, meta = synthesise(truth_cfg, "practice", x0=0.0488, load=1551.0, kd=20.0, noise=PRACTICE_NOISE, seed=2)
-    st = _prepare(cfg, frame, meta, 5, 1)
+    st = prepare_recording(cfg, frame, meta, 5, 1)
     params = effect_params("valve_dynamics")
     truth = [34.4, 0.79, 0.0093]
     vec, _ = FitContext(st.rc, st.setup, st.model).residual(params, truth)

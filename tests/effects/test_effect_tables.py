@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 import compliance.model.vector_slots as vs
-from compliance.diagnosis.benchmark import ANSWER_ALIASES
-from compliance.diagnosis.candidates import SCAN_GRIDS, effect_candidate
-from compliance.diagnosis.concealed import EFFECT_RANGES, SIGNED, draw_effect_params
-from compliance.diagnosis.explain import PHYSICS
+from compliance.diagnosis.scoring.benchmark import ANSWER_ALIASES
+from compliance.diagnosis.servo.candidates import SCAN_GRIDS, effect_candidate
+from compliance.diagnosis.scoring.concealed_cases import EFFECT_RANGES, SIGNED, draw_effect_params
+from compliance.diagnosis.servo.explanation import PHYSICS
 from compliance.effects import EFFECTS
 from compliance.errors import InputError
 from compliance.linear.analysis import PADE_ORDER, _augment

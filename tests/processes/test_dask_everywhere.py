@@ -58,7 +58,7 @@ def test_calibration_points_on_dask_equal_the_local_ones(dask_cluster):
 
 @pytest.mark.slow
 def test_benchmark_cases_on_dask_equal_the_local_ones(dask_cluster):
-    from compliance.diagnosis.benchmark import run_benchmark
+    from compliance.diagnosis.scoring.benchmark import run_benchmark
 
     cfg = load_plant("plant-a")
     kw = {"effects": ["internal_leakage"], "library": ["internal_leakage"], "cases": 1, "seed": 4, "null": False,

@@ -7,11 +7,11 @@ import pytest
 
 from compliance.processes import map_tasks, parse_scheduler
 from compliance.sweep.run import load_inputs
-from compliance.sweep.evaluate import make_context
-from compliance.sweep.results import table
-from compliance.sweep.runner import run_candidates
-from compliance.sweep.sampling import grid
-from compliance.sweep.spec import load_sweep
+from compliance.sweep.candidates.evaluate import make_context
+from compliance.sweep.candidates.results import table
+from compliance.sweep.candidates.runner import run_candidates
+from compliance.sweep.candidates.sampling import grid
+from compliance.sweep.candidates.spec import load_sweep
 
 from tests.sweep.conftest import sweep_text, write_sweep  # noqa: F401 - the sweep file fixture
 

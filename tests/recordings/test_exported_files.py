@@ -136,7 +136,7 @@ def test_bom_in_requirement_sweep_and_column_map(ws, monkeypatch, capsys):
     (ws / "bom-map.toml").write_text(BOM + W.COLUMN_MAP, encoding="utf-8")
     assert load_requirements(ws / "bom-req.toml").name == "tiny"
     assert load_column_map(ws / "bom-map.toml").spec("position").unit == "mm"
-    from compliance.sweep.spec import load_sweep
+    from compliance.sweep.candidates.spec import load_sweep
     from tests.bad_inputs.cases import SWEEP
 
     (ws / "bom-sweep.toml").write_text(BOM + SWEEP, encoding="utf-8")

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from compliance.model.config import load_plant
 from compliance.requirements.loading import load_requirements
-from compliance.sweep.candidate_store import CandidateStore
-from compliance.sweep.evaluate import make_context
-from compliance.sweep.parameter_paths import describe
-from compliance.sweep.runner import run_candidates
+from compliance.sweep.candidates.candidate_store import CandidateStore
+from compliance.sweep.candidates.evaluate import make_context
+from compliance.sweep.candidates.parameter_paths import describe
+from compliance.sweep.candidates.runner import run_candidates
 
 from tests.sweep.conftest import SMALL_TC
 

@@ -9,7 +9,7 @@ import pytest
 
 from compliance.campaign.results_files import read_results
 from compliance.cli import main
-from compliance.sweep.yield_mc import wilson
+from compliance.sweep.tolerance.yield_mc import wilson
 
 from tests.sweep.conftest import sweep_text
 

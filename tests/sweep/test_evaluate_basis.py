@@ -6,9 +6,9 @@ import pytest
 
 from compliance.model.config import load_plant
 from compliance.requirements.loading import load_requirements
-from compliance.sweep.evaluate import evaluate_one, make_context
-from compliance.sweep.parameter_paths import describe
-from compliance.sweep.ranking import candidate_passes, failing_mandatory
+from compliance.sweep.candidates.evaluate import evaluate_one, make_context
+from compliance.sweep.candidates.parameter_paths import describe
+from compliance.sweep.candidates.ranking import candidate_passes, failing_mandatory
 
 # plant A's opening throttle was derived to give 5.0 s at 5.7 kN (models/plant-a.toml, derived_for)
 SETUP_ONLY = """

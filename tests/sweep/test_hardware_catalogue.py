@@ -9,7 +9,7 @@ import pytest
 from compliance.errors import InputError
 from compliance.model.config import load_plant
 from compliance.physics.valve_rating import conductance_of_rating, rating_of_conductance
-from compliance.sweep.hardware import load_catalogue
+from compliance.sweep.sizing.hardware_catalogue import load_catalogue
 
 ROOT = Path(__file__).resolve().parents[2]
 

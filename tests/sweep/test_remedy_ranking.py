@@ -9,9 +9,9 @@ import pandas as pd
 import pytest
 
 from compliance.cli import main
-from compliance.sweep.ranking import candidate_passes, failing_mandatory, rank_key
-from compliance.sweep.remedy_finish import _never_worse
-from compliance.sweep.results import best_index
+from compliance.sweep.candidates.ranking import candidate_passes, failing_mandatory, rank_key
+from compliance.sweep.remedies.finish import _never_worse
+from compliance.sweep.candidates.results import best_index
 
 from tests.sweep.conftest import SMALL_TC, sweep_text
 
@@ -43,7 +43,7 @@ def test_uncertain_and_by_construction_are_not_passes():
 
 
 def test_closest_worse_than_given_is_replaced_by_the_configuration_as_given():
-    from compliance.sweep.remedies import describe_candidate
+    from compliance.sweep.remedies.smallest_change import describe_candidate
 
     rem = {"evaluated": 10, "closest": describe_candidate((), {}, {}, SEVEN)}
     given = {"row": GIVEN, "candidate": describe_candidate((), {}, {}, GIVEN)}
@@ -78,7 +78,7 @@ def test_requirement_set_conflict_arithmetic_of_the_shipped_file():
     from compliance.model.config import load_plant
     from compliance.requirements.consistency import RATE_SPLIT
     from compliance.requirements.loading import load_requirements
-    from compliance.sweep.binding_physics import explain_closest, set_findings
+    from compliance.sweep.remedies.binding_physics import explain_closest, set_findings
 
     reqset = load_requirements("shpp-400kw")
     found = {(f["procedure"], f["requirements"][1]): f for f in set_findings(reqset, 0.16, ["IEC61362-TC"])}
@@ -96,7 +96,7 @@ def test_explanation_names_a_pass_by_construction():
     """A closest candidate that fails only because a mandatory requirement passes by construction says so."""
     from compliance.model.config import load_plant
     from compliance.requirements.loading import load_requirements
-    from compliance.sweep.binding_physics import explain_closest
+    from compliance.sweep.remedies.binding_physics import explain_closest
 
     closest = {"failed_mandatory": ["IEC61362-INDEP"], "by_construction": ["IEC61362-INDEP"], "binding": "IEC61362-INDEP",
                "binding_where": "independent-adjustment@governor-setup"}
@@ -107,7 +107,7 @@ def test_a_rate_limited_time_constant_is_explained_by_the_ramp():
     """With the set-point limiter at 31.2 mm/s a 16 mm step reaches 63.2 % no sooner than 0.632 x 16 / 31.2 = 0.324 s."""
     from compliance.model.config import load_plant
     from compliance.requirements.loading import load_requirements
-    from compliance.sweep.binding_physics import explain
+    from compliance.sweep.remedies.binding_physics import explain
 
     cfg = load_plant("plant-a").replace(params={"controller.setpoint_opening_rate": 0.0312,
                                                 "controller.setpoint_closing_rate": 0.0315})

@@ -11,9 +11,9 @@ from compliance.cli import main
 from compliance.errors import InputError
 from compliance.model.config import load_plant
 from compliance.requirements.loading import load_requirements
-from compliance.sweep.duty import load_duty
-from compliance.sweep.sizing import size_cylinders, size_servo
-from compliance.sweep.sizing_tune import tune_throttles
+from compliance.sweep.sizing.duty_file import load_duty
+from compliance.sweep.sizing.size_servo import size_cylinders, size_servo
+from compliance.sweep.sizing.throttle_tuning import tune_throttles
 
 from tests.sweep.conftest import SMALL_TC
 

@@ -3,7 +3,7 @@
 import pytest
 
 from compliance.cli import main
-from compliance.sweep.spec import load_sweep
+from compliance.sweep.candidates.spec import load_sweep
 
 from tests.sweep.conftest import sweep_text
 

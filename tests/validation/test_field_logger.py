@@ -8,7 +8,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from compliance.diagnosis.noise_floor import sensor_noise_std
+from compliance.diagnosis.evidence.noise_floor import sensor_noise_std
 from compliance.errors import InputError
 from compliance.validation.locate import noise_floor
 from compliance.validation.logger_model import LoggerModel, first_order_filter, logger_model

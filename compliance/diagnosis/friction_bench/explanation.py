@@ -1,0 +1,95 @@
+"""Words of a seal-friction diagnosis: the paragraph per seal and the console summary."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from compliance.diagnosis.friction_bench.fit import PRESSURE_EFFECT
+from compliance.diagnosis.friction_bench.position import POSITION_FRICTION
+from compliance.diagnosis.friction_bench.laws import core_equivalent
+from compliance.units.formatting import fmt_si
+
+
+def explain_friction(d) -> str:
+    """One paragraph for a plant engineer about a ``friction_bench.diagnose.SealDiagnosis``."""
+    base = d.fits["baseline"]
+    rb = base.rms_per_run()
+    runs = d.runs
+    lo, hi = int(np.argmin([r.pressure for r in runs])), int(np.argmax([r.pressure for r in runs]))
+    bp = base.params
+    text = (f"Seal {d.seal}: a pressure-independent Stribeck law (F_C {fmt_si(bp['coulomb'], 'N')}, F_S {fmt_si(bp['static'], 'N')}, "
+            f"b {fmt_si(bp['viscous'], 'N*s/m')}) leaves an RMS friction error of {fmt_si(np.mean(rb), 'N')} over the {len(runs)} runs "
+            f"({math.sqrt(base.chi2 / base.n):.0f} times the force noise of {fmt_si(d.noise_floor, 'N')}).")
+    loc = d.located
+    trend = loc.get("pressure_trend")
+    if trend:
+        text += (f" Where it fails: in steady sliding the seal rubs {fmt_si(abs(trend['slope']), 'N/Pa')} of pressure "
+                 f"{'harder' if trend['slope'] > 0 else 'less'} than the law says as the pressure rises "
+                 f"({'+' if trend['span'] >= 0 else ''}{fmt_si(trend['span'], 'N')} across the pressures)")
+    else:
+        text += " Where it fails:"
+    if loc.get("reversal_excess"):
+        text += (f"{';' if trend else ''} after each reversal the residual is {loc['reversal_excess']:.1f} times its sliding level "
+                 f"- the friction builds up over the first millimetres of travel instead of jumping.")
+    else:
+        text += "."
+    if d.verdict == "no_mismatch":
+        return text + " The law already fits within the force noise: nothing is missing."
+    if d.winner is None:
+        tested = "pressure-dependent friction, pre-sliding hysteresis" if PRESSURE_EFFECT in d.fits else (
+            "pre-sliding hysteresis; pressure dependence needs runs at two or more pressures")
+        return text + f" None of the candidate physics ({tested}) removes enough of it: unexplained."
+    w = d.fits[d.winner]
+    p = w.params
+    parts = []
+    if "pressure_coefficient" in p:
+        parts.append(f"seal friction that rises with the chamber pressure (k_p = {fmt_si(p['pressure_coefficient'], 'N/Pa')} "
+                     f"on F_C and F_S{core_equivalent(p)})")
+    if "bristle_stiffness" in p:
+        pm = float(np.mean([r.pressure for r in runs]))
+        fc = p["coulomb"] + p.get("pressure_coefficient", 0.0) * pm
+        parts.append(f"pre-sliding hysteresis at reversals (LuGre bristles, \u03c3\u2080 = {fmt_si(p['bristle_stiffness'], 'N/m')}: "
+                     f"the friction builds up over a pre-sliding distance F_C/\u03c3\u2080 of about "
+                     f"{fmt_si(fc / p['bristle_stiffness'], 'm')} at {fmt_si(pm, 'Pa')} gauge)")
+    if "position_gradient" in p:
+        parts.append(f"friction that changes along the stroke (levels \u00d7 (1 + a (x \u2212 x_r) + c (x \u2212 x_r)\u00b2), "
+                     f"a = {fmt_si(p['position_gradient'], '1/m')}, c = {fmt_si(p['position_curvature'], '1/m^2')}, "
+                     f"x_r = {fmt_si(p['reference_position'], 'm')}; the bench effect \u201c{POSITION_FRICTION.meaning}\u201d, "
+                     "kept because it predicts held-out runs better)")
+    ra = w.rms_per_run()
+    text += (f" The missing physics: {' and '.join(parts)}. Adding it cuts the RMS friction error from {fmt_si(np.mean(rb), 'N')} "
+             f"to {fmt_si(np.mean(ra), 'N')} ({fmt_si(rb[lo], 'N')} \u2192 {fmt_si(ra[lo], 'N')} at {fmt_si(runs[lo].pressure, 'Pa')} gauge, "
+             f"{fmt_si(rb[hi], 'N')} \u2192 {fmt_si(ra[hi], 'N')} at {fmt_si(runs[hi].pressure, 'Pa')} gauge).")
+    if d.verdict == "unexplained":
+        text += " It still leaves most of the error: the rest is physics outside these candidates (e.g. position-dependent friction)."
+    return text
+
+
+def format_friction(d: dict, quiet: bool = False) -> str:
+    """Console summary of a friction diagnosis."""
+    lines = []
+    for s in d["seals"]:
+        lines.append(f"seal {s['seal']}: verdict {s['verdict']}" + (f" ({s['winner']})" if s["winner"] else ""))
+        if quiet:
+            continue
+        lines.append("  " + s["explanation"])
+        lines.append(f"  {'candidate':50s} {'k':>2s} {'chi2/N':>9s} {'dBIC':>9s}")
+        for e in s["effects"]:
+            lines.append(f"  {e['name']:50s} {e['k']:2d} {e['chi2_per_residual']:9.2f} {e['delta_bic']:9.1f}")
+        lines.append(f"  {'run':28s} {'p [bar g]':>9s} {'RMS before [N]':>15s} {'RMS after [N]':>14s}")
+        for run, b in s["fit_before"].items():
+            a = (s["fit_after"] or {}).get(run)
+            lines.append(f"  {run:28s} {b['pressure_gauge']/1e5:9.2f} {b['rms']:15.3f} {a['rms'] if a else float('nan'):14.3f}")
+        if s.get("holdout"):
+            h = s["holdout"]
+            lines.append(f"  out of sample ({h['law']}): each pressure predicted by the law fitted on the others")
+            lines.append(f"  {'run':28s} {'p [bar g]':>9s} {'in-sample [N]':>14s} {'held-out [N]':>13s} {'ratio':>6s} "
+                         f"{'offset [N]':>11s} {'noise [N]':>10s}")
+            for r in h["runs"]:
+                lines.append(f"  {r['run']:28s} {r['pressure_gauge']/1e5:9.2f} {r['in_sample_rms']:14.3f} {r['held_out_rms']:13.3f} "
+                             f"{r['ratio']:6.2f} {r['held_out_offset']:+11.2f} {r['noise_floor']:10.3f}")
+            lines.append(f"  median held-out / in-sample: {h['median_ratio']:.2f} (target <= {h['ratio_target']:g})")
+    lines.append(f"{d['timing']['seconds']:.1f} s")
+    return "\n".join(lines)

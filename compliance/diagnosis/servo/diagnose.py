@@ -1,0 +1,389 @@
+"""The diagnosis of a servo recording: replay, locate, fit every candidate, select, explain.
+
+``diagnose(cfg, frame, meta)`` runs the whole chain on one closed-loop (or open-loop)
+recording of the servo and returns a ``Diagnosis`` whose ``to_dict()`` is the JSON of
+docs/diagnosis-schema.md. The friction bench has its own chain (``friction_bench.diagnose``).
+
+Stages:
+1. nominal replay (re-synchronised segments, matched noise) and noise floors;
+2. located windows of the nominal residual and their regimes (compliance.validation.locate);
+3. in parallel: the recalibration of base parameters (greedy forward selection) and one fit
+   per effect (coarse grid, then bounded least squares), likely effects first;
+4. if the best single explanation leaves a clear excess and the recalibration found
+   something, the best effects are refitted together with the recalibrated parameters;
+5. scores (BIC/AIC on normalised residuals), verdict, windows agreement, explanation;
+6. full closed-loop replays of the nominal and of the winner for the before/after figures.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field, replace as dc_replace
+
+import numpy as np
+
+from compliance.model.config import PlantConfig, plant_to_toml, _suggest as _suggest_name
+from compliance.effects import EFFECTS
+from compliance.errors import InputError, SimulationError
+from compliance.diagnosis.servo.candidates import Candidate, apply, base_params, effect_candidate, signature_order
+from compliance.diagnosis.servo.fit import FitContext, FitResult, chi2_parts
+from compliance.diagnosis.servo.fitted_model import fitted_plant, save_fitted
+from compliance.diagnosis.servo.effect_sets import CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_enough, contributions, set_effects, set_name
+from compliance.diagnosis.evidence.discriminating_test import design_test
+from compliance.diagnosis.evidence.empirical_force import empirical_term
+from compliance.diagnosis.servo.instrument_candidates import (PREFIX, VERDICT, instrument_candidates, instrument_verdict, instrumented,
+                                                       is_instrument)
+from compliance.diagnosis.servo.lag_split import adopted_fit, split_scan
+from compliance.diagnosis.servo.friction_form import OPTION as FORM_OPTION, RETRY_VERDICTS, form_after_effects, friction_form_check
+from compliance.diagnosis.evidence.replay_fit import ReplaySetup, prepare_replay, replay_config, run_replay
+from compliance.diagnosis.evidence.residuals import (UNITS, build_residual_model, null_recording, own_floor_objective, signal_fit,
+                                            with_fail_level)
+from compliance.diagnosis.servo.selection import (AMBIGUOUS_BIC, EXPLAINED_ENOUGH, NOISE_TOLERANCE, RESIDUAL_LIMIT, ambiguity_set, honest, same_physics,
+                                         score_all, signals_left, verdict)
+from compliance.diagnosis.servo.report_data import SCHEMA
+from compliance.diagnosis.servo.result import Diagnosis
+from compliance.diagnosis.evidence.locate_misfit import event_rms, locate_mismatch, mask_agreement, where_words
+from compliance.diagnosis.servo.parallel_fits import run_fits
+from compliance.processes import available_cores
+
+COMBINE_LEVEL = 3.0  # chi2/N of the best single explanation above which effects are refitted with the recalibration
+COMBINE_TOP = 1  # how many effects are refitted with the recalibration
+
+
+@dataclass
+class Stage:
+    """What every stage of one diagnosis shares (built once by ``prepare_recording``)."""
+
+    setup: ReplaySetup
+    rc: PlantConfig
+    nominal_sim: dict
+    model: object
+    events: list
+    event_mask: np.ndarray
+    nominal_rms: dict
+    nvec: np.ndarray
+    payload: tuple
+    jobs: int
+    fits: dict = field(default_factory=dict)
+    vecs: dict = field(default_factory=dict)
+    sims: int = 2
+    rebased: bool = False  # the friction law's other form is the base (servo/friction_form.py)
+
+
+def check_effects(cfg: PlantConfig, effects) -> list[str]:
+    """Stage 0: the effects to try (``None``: every declared effect the plant does not already have); a name
+    that is not declared is an ``InputError``."""
+    names = [e for e in EFFECTS if e not in cfg.effects] if effects is None else list(effects)
+    for e in names:
+        if e not in EFFECTS:
+            raise InputError(f"--effects: '{e}' is not a declared effect{_suggest_name(e, EFFECTS)} (known: {', '.join(EFFECTS)})")
+    return names
+
+
+def prepare_recording(cfg: PlantConfig, frame, meta: dict, stride: int, jobs: int, sims: int = 0) -> Stage:
+    """Stages 1-2: the nominal replay, floors, located windows (``sims``: replays already run for this diagnosis)."""
+    setup = prepare_replay(cfg, frame, meta)
+    rc = replay_config(cfg, setup)
+    nominal_sim = run_replay(rc, setup)
+    model = build_residual_model(rc, setup, stride=stride, nominal=nominal_sim)
+    model = with_fail_level(model, model.vector(nominal_sim))
+    events, event_mask, _ = locate_mismatch(rc, setup, model.signals, nominal_sim)
+    nominal_rms = {s: v["rms_normalised"] for s, v in signal_fit(model, nominal_sim).items()}
+    nvec = model.vector(nominal_sim)
+    st = Stage(setup, rc, nominal_sim, model, events, event_mask, nominal_rms, nvec, (plant_to_toml(rc), setup, model), jobs)
+    st.sims += sims
+    chi2, parts = chi2_parts(model, nvec)
+    st.fits["nominal"] = FitResult("nominal", (), [], [], chi2, parts, model.size, 0, 0.0, "nominal model")
+    return st
+
+
+def _based_search(cfg: PlantConfig, frame, meta: dict, stride: int, jobs: int, names, recalibrate: bool):
+    """Stages 1-5 on the friction law's form that fits (servo/friction_form.py): the other form is the base from the start
+    when it beats the nominal, or after an incomplete verdict when effects refitted under it beat the declared form."""
+    st = prepare_recording(cfg, frame, meta, stride, jobs)
+    form = friction_form_check(st.rc, st.setup, st.model, st.fits["nominal"])
+    if form and form["adopted"]:  # the other friction law is the base of the whole search
+        cfg = cfg.replace(options={FORM_OPTION: form["adopted"]})
+        st = prepare_recording(cfg, frame, meta, stride, jobs, st.sims)
+        st.rebased = True
+    _fit_singles(st, names, recalibrate)
+    dec = _decide(st)
+    if form and not form["adopted"] and dec["verdict"] in RETRY_VERDICTS:
+        form = form_after_effects(form, st.rc, st.setup, st.model, st.fits, jobs)
+        if form["adopted"]:  # ... and the whole search runs again on it
+            cfg = cfg.replace(options={FORM_OPTION: form["adopted"]})
+            st = prepare_recording(cfg, frame, meta, stride, jobs, st.sims)
+            st.rebased = True
+            _fit_singles(st, names, recalibrate)
+            dec = _decide(st)
+    st.sims += form["replays"] if form else 0
+    return cfg, st, form, dec
+
+
+def _run(st: Stage, tasks) -> None:
+    for res, v in run_fits(tasks, st.jobs, st.payload):
+        st.fits[res.name] = res
+        st.vecs[res.name] = v
+        st.sims += res.sims + 1
+
+
+def _fit_singles(st: Stage, names, recalibrate: bool) -> None:
+    """Stages 3-4: the recalibration, one fit per effect, and the best effect with the recalibration."""
+    n = st.model.size
+    chi2 = st.fits["nominal"].chi2
+    excess = {s: v * v - 1.0 for s, v in st.nominal_rms.items()}
+    tasks = []
+    bparams = base_params(st.rc) if recalibrate else ()
+    if bparams:
+        tasks.append(("base", bparams, 2.0 * math.log(n) * max(1.0, chi2 / n)))
+    tasks += [("effect", effect_candidate(e)) for e in signature_order(names, excess)]
+    tasks += [("effect", c) for c in instrument_candidates(st.model.signals, st.setup.closed_loop)]
+    _run(st, tasks)
+    base_fit = st.fits.get("base")
+    singles = [f for f in st.fits.values() if f.name != "nominal"]
+    best = min(singles, key=lambda f: f.chi2, default=None)
+    if base_fit is not None and base_fit.k > 0 and best is not None and best.chi2 / n > COMBINE_LEVEL:
+        top = sorted((f for f in singles if f.name in EFFECTS), key=lambda f: f.chi2)[:COMBINE_TOP]
+        _run(st, [("combo", Candidate(f"{f.name}+base"), f, base_fit) for f in top])
+
+
+def _search_sets(st: Stage, winner: str) -> list[dict]:
+    """Stage 5: greedy forward selection of further effects on what the winner leaves (servo/effect_sets.py)."""
+    n = st.model.size
+    log = []
+    current = st.fits[winner]
+    while len(set_effects(current.name)) < MAX_EFFECTS:
+        if not signals_left(_objective(st, current.name)):
+            break
+        have = set(set_effects(current.name))
+        singles = [f for f in st.fits.values() if f.name in EFFECTS and f.name not in have]
+        screened = [r for r, _ in run_fits([("screen", current, f) for f in singles], st.jobs, st.payload)]
+        screen = {name: (chi, start) for name, chi, start, _ in screened}
+        st.sims += sum(r[3] for r in screened)
+        order = sorted(singles, key=lambda f: screen[f.name][0])[:CANDIDATES_PER_ROUND]
+        tasks = [("extend", current, f, screen[f.name][1]) for f in order]
+        if not tasks:
+            break
+        _run(st, tasks)
+        c = max(1.0, min(f.chi2 / max(n - f.k, 1) for f in st.fits.values() if math.isfinite(f.chi2)))
+        tried = sorted((_extended(st, t[1], t[2]) for t in tasks), key=lambda f: f.chi2)
+        best = tried[0]
+        times = np.tile(st.setup.time[st.model.index], len(st.model.signals))  # residuals are signal blocks
+        vecs = (st.vecs[current.name], st.vecs[best.name], times) if current.name in st.vecs else None
+        ok, why = adds_enough(best, current, n, math.log(n), c, vecs)
+        log.append({"round": len(have) + 1, "tried": [f.name for f in tried], "best": best.name, "kept": ok, "why": why})
+        if not ok:
+            break
+        current = best
+    return log
+
+
+def _extended(st: Stage, current: FitResult, single: FitResult) -> FitResult:
+    effects = set_effects(current.name) + set_effects(single.name)
+    name = set_name(effects) + ("+base" if any(fp.kind == "base" for fp in current.params) else "")
+    return st.fits[name]
+
+
+def _objective(st: Stage, name: str) -> dict:
+    """Signal -> normalised RMS of the re-synchronised replay of candidate ``name``."""
+    m = st.model.index.size
+    return {s: math.sqrt(st.fits[name].chi2_signal[s] / m) for s in st.model.signals}
+
+
+def _decide(st: Stage) -> dict:
+    """Verdict, winner, ambiguity set, each effect's own contribution (stage 5-6)."""
+    n = st.model.size
+    scores = score_all(st.fits, n)
+    effect_like = [k for k in st.fits if k not in ("nominal", "base") and not is_instrument(k)]
+    # "within the floor" on the objective every other verdict is judged on (time-resolved floors,
+    # select.NOISE_TOLERANCE), not on the constant floor the JSON reports
+    verdict_name, winner, reason = verdict(scores, n, _objective(st, "nominal"), effect_like)
+    search = []
+    if winner is not None and winner != "base" and verdict_name != "no_mismatch":
+        search = _search_sets(st, winner)
+        scores = score_all(st.fits, n)  # the sets tried are candidates too
+        kept = [r for r in search if r["kept"]]
+        if kept:
+            winner = kept[-1]["best"]
+            reason = f"{' and '.join(set_effects(winner))} together explain {100*scores[winner].explained:.0f} % of the excess residual"
+            verdict_name = "missing_physics" if scores[winner].explained >= EXPLAINED_ENOUGH else "unexplained"
+    verdict_name, winner, reason = instrument_verdict(scores, n, (verdict_name, winner, reason),
+                                                      [k for k in st.fits if k.startswith(PREFIX)])
+    after = _own_floors(st, winner, verdict_name)
+    verdict_name, reason = honest(verdict_name, winner, reason, after)
+    objectives = {k: _objective(st, k) for k in st.fits if k != "nominal"}
+    plant_scores = {k: v for k, v in scores.items() if not is_instrument(k)}  # instruments were settled by beats()
+    ambiguous = ambiguity_set(plant_scores, winner, objectives) if verdict_name not in ("no_mismatch", VERDICT) else []
+    if ambiguous and verdict_name in ("missing_physics", "parameters_only"):
+        verdict_name = "ambiguous"
+        reason = (f"{' and '.join(ambiguous)} explain the recording equally well (every signal within "
+                  f"{RESIDUAL_LIMIT:g} x its floor, or BIC within {AMBIGUOUS_BIC:g}); another test tells them apart")
+    return {"scores": scores, "verdict": verdict_name, "winner": winner, "reason": reason, "search": search,
+            "ambiguous": ambiguous, "after": after, "left": signals_left(after if winner else _objective(st, "nominal"))}
+
+
+def _own_floors(st: Stage, winner: str | None, verdict_name: str) -> dict | None:
+    """What the winner leaves, x floor; a complete verdict's leftovers are judged against its own null floors too,
+    unless the base is already another friction form (one relaxation of the yardstick at a time: on the pairs
+    benchmark, floors from a substitute friction law plus its winner's own passed wrong pairs as complete)."""
+    after = _objective(st, winner) if winner else None
+    if verdict_name in ("missing_physics", "parameters_only") and signals_left(after) and winner in st.vecs \
+            and not st.rebased:
+        w = st.fits[winner]
+        try:
+            own = own_floor_objective(st.model, apply(st.rc, w.params, w.values), st.setup, st.vecs[winner])
+        except (SimulationError, InputError):
+            return after
+        st.sims += 4  # two null draws, each a recording and its replay
+        after = {s: min(v, own.get(s, v)) for s, v in after.items()}
+    return after
+
+
+def _suggest(st: Stage, ambiguous: list) -> dict | None:
+    """The discriminating test between the two best explanations of an ambiguous recording."""
+    if len(ambiguous) < 2:
+        return None
+    a, b = st.fits[ambiguous[0]], st.fits[ambiguous[1]]
+    load = st.setup.load if not isinstance(st.setup.load, str) else 0.0
+    return design_test(apply(st.rc, a.params, a.values), apply(st.rc, b.params, b.values), st.model.floors,
+                       x0=st.setup.initial_position, load=float(load), names=(a.name, b.name))
+
+
+def _window_rows(st: Stage, seg_win) -> list:
+    model = st.model
+    before_rows = event_rms(st.events, model.recorded, st.nominal_sim, model.floors, model.signals)
+    after_rows = event_rms(st.events, model.recorded, seg_win, model.floors, model.signals)
+    return [{"index": i, "start": e["start"], "end": e["end"], "duration": e["duration"], "signals": dict(e["signals"]),
+             "regimes": list(e["dominant"]), "before": b, "after": a}
+            for i, (e, b, a) in enumerate(zip(st.events, before_rows, after_rows))]
+
+
+def _empirical(st: Stage, dec: dict) -> dict | None:
+    """Stage 7: outside the library, the missing force the recording implies (evidence/empirical_force.py)."""
+    if dec["verdict"] not in ("unexplained", "partially_explained"):
+        return None
+    w = dec["winner"]
+    cfg = apply(st.rc, st.fits[w].params, st.fits[w].values) if w else st.rc
+    try:
+        null = null_recording(cfg, st.setup, st.model.sensor_noise)
+        return empirical_term(cfg, st.setup, null)
+    except (SimulationError, InputError) as exc:
+        return {"label": "empirical suggestion, not a declared effect", "words": f"not estimated: {exc}", "terms": []}
+
+
+def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | None = None, stride: int = 5,
+             recalibrate: bool = True, suggest_test: bool = False) -> Diagnosis:
+    """Diagnose one recording of the servo against a plant configuration.
+
+    Parameters
+    ----------
+    cfg : PlantConfig
+        The nominal plant (effects already switched on in it stay on and are not candidates).
+    frame : pandas.DataFrame
+        Canonical recording (``compliance.recordings.reader.read_recording``).
+    meta : dict
+        Its metadata.
+    effects : iterable of str, optional
+        Candidate effects (default: every declared effect not already on).
+    jobs : int, optional
+        Worker processes (default: the available cores).
+    stride : int
+        Residual subsampling (every ``stride``-th sample).
+    recalibrate : bool
+        Also consider recalibrating base parameters.
+    suggest_test : bool
+        Design a discriminating test between the winner and the runner-up even when the
+        recording tells them apart (an ambiguous recording always gets one).
+
+    Returns
+    -------
+    Diagnosis
+
+    Raises
+    ------
+    InputError
+        Unknown effect names, a recording the replay cannot use.
+    """
+    t0 = time.perf_counter()
+    jobs = available_cores() if jobs is None else max(1, int(jobs))
+    names = check_effects(cfg, effects)
+    cfg, st, form, dec = _based_search(cfg, frame, meta, stride, jobs, names, recalibrate)
+    winner, verdict_name = dec["winner"], dec["verdict"]
+    split = _split(st, winner, verdict_name, dec)
+    agreement = {k: mask_agreement(st.model, st.nvec, st.vecs[k], st.event_mask) for k in st.fits if k in st.vecs}
+    ranked = sorted((k for k in st.fits if k != "nominal"), key=lambda k: (dec["scores"][k].bic, -agreement.get(k, 0.0)))
+    runner = (ranked[0] if ranked else None) if winner is None else next(
+        (k for k in ranked if k != winner and not same_physics(k, winner)), None)
+    # full closed-loop replays for the figures a test engineer reproduces
+    full = dc_replace(st.setup, resets=np.array([0]))
+    full_nom = run_replay(st.rc, full)
+    notes = list(st.setup.notes)
+    fitted_cfg = full_win = seg_win = None
+    if winner is not None:
+        w = st.fits[winner]
+        wcfg = apply(st.rc, w.params, w.values)
+        if verdict_name in ("missing_physics", "parameters_only", "partially_explained", "ambiguous", VERDICT):
+            full_win = _safe_replay(wcfg, instrumented(full, w.params, w.values), notes, "full closed-loop replay of the winner")
+            fitted_cfg = None if is_instrument(winner) else fitted_plant(cfg, w, meta)
+        seg_win = _safe_replay(wcfg, instrumented(st.setup, w.params, w.values), notes, "replay of the winner")
+    st.sims += 1 + (full_win is not None) + (seg_win is not None)
+    diag = Diagnosis(
+        verdict=verdict_name, reason=dec["reason"], winner=winner, runner_up=runner, fits=st.fits, scores=dec["scores"],
+        fit_before=signal_fit(st.model, full_nom), fit_after=signal_fit(st.model, full_win) if full_win is not None else None,
+        objective_before=_objective(st, "nominal"), objective_after=dec["after"] if winner else None,
+        windows=_window_rows(st, seg_win), floors=dict(st.model.floors), explanation="", cfg=cfg, fitted_cfg=fitted_cfg,
+        recording=st.setup.source, seconds=0.0, simulations=st.sims, jobs=jobs, notes=notes,
+        traces={"time": st.setup.time, "recorded": st.model.recorded, "before": full_nom, "after": full_win,
+                "objective_before": st.nominal_sim, "objective_after": seg_win},
+    )
+    diag.agreement, diag.friction_form = agreement, form
+    diag.located_regimes = where_words(st.events)
+    diag.ambiguous, diag.signals_left, diag.search = dec["ambiguous"], dec["left"], dec["search"]
+    diag.contributions = _contributions(st, winner)
+    pair = dec["ambiguous"] or ([winner, runner] if suggest_test and winner and runner else [])
+    diag.suggested_test, diag.empirical, diag.split = _suggest(st, pair), _empirical(st, dec), split
+    diag.simulations += split["replays"] if split else 0
+    from compliance.diagnosis.servo.explanation import explain
+    diag.explanation = explain(diag)
+    diag.seconds = time.perf_counter() - t0
+    return diag
+
+
+def _split(st: Stage, winner: str | None, verdict_name: str, dec: dict) -> dict | None:
+    """Does the recording pin the split of the winner's lag, or its total only (``servo.lag_split.split_scan``)?
+    An undetermined split moves to the segments' estimate (the winner's fit, scores and what is left follow)."""
+    lag = next((e for e in (winner or "").split("+") if e in EFFECTS and EFFECTS[e].lumped is not None), None)
+    if lag is None or verdict_name == "unexplained":
+        return None
+    ctx = FitContext(st.rc, st.setup, st.model)
+    sp = split_scan(ctx, st.fits[winner], lag, st.vecs.get(winner))
+    moved = adopted_fit(ctx, st.fits[winner], sp["estimate"]) if sp and sp["estimate"] else None
+    if moved is not None:
+        st.fits[winner], st.vecs[winner] = moved
+        after = _own_floors(st, winner, verdict_name)
+        dec.update(scores=score_all(st.fits, st.model.size), after=after, left=signals_left(after))
+    return sp and {**sp, "replays": ctx.sims}
+
+
+def _contributions(st: Stage, winner: str | None) -> dict:
+    """Effect -> its own share of the nominal excess in the winning set (switched off alone)."""
+    if winner is None or not set_effects(winner):
+        return {}
+    ctx = FitContext(st.rc, st.setup, st.model)
+    raw = contributions(ctx, st.fits[winner])
+    st.sims += ctx.sims
+    excess = max(st.fits["nominal"].chi2 - st.model.size, 1e-12)
+    return {e: {"chi2_increase_when_removed": v, "share_of_excess": v / excess} for e, v in raw.items()}
+
+
+def _safe_replay(cfg: PlantConfig, setup: ReplaySetup, notes: list, what: str):
+    """A replay for the figures; a candidate that diverges there is noted, not fatal."""
+    try:
+        return run_replay(cfg, setup)
+    except SimulationError as exc:
+        notes.append(f"{what} failed: {exc}")
+        return None
+
+
+__all__ = ["Diagnosis", "Stage", "diagnose", "prepare_recording", "check_effects", "save_fitted", "SCHEMA", "UNITS", "NOISE_TOLERANCE"]

@@ -1,0 +1,342 @@
+"""Bounded least-squares fits of candidate explanations to a recording's replay residuals.
+
+One fit: a coarse scan of the candidate's starting grid (cheap, finds the basin), a
+Nelder-Mead simplex (Nelder & Mead 1965) from the best grid point with steps of 5 % of each
+parameter's range, then ``scipy.optimize.least_squares`` (trust-region reflective, bounds)
+to polish and to give the Jacobian. All of it runs in the unit cube of
+``servo.candidates.FitParam`` on the stacked residuals of every measured signal divided by its
+noise floor, plus prior residuals holding recalibrated base parameters near their
+data-sheet values.
+
+Why the simplex: even re-synchronised, a closed loop with a dead zone and stiction leaves
+fine-grained roughness on the residual surface (a stall point moves by one quantum), on
+which forward-difference Gauss-Newton steps stall at the first wrinkle (on the practice
+valve-dynamics recording least squares alone stops at chi2/N = 14.5, the simplex reaches 4.1).
+The simplex' 5 % steps see the bowl, not the wrinkles.
+
+Standard errors come from the final Jacobian J and the residuals r themselves: the
+heteroscedasticity-and-autocorrelation-consistent sandwich of Newey & West (1987),
+cov = (J^T J)^-1 S (J^T J)^-1 with S = sum over lags |l| <= L of (1 - |l|/(L+1)) sum_t g_t g_(t-l)^T,
+g_t = J_t r_t, L = ``HAC_SECONDS`` of residuals. A replay's misfit is not white noise: one
+breakaway the replay makes and the bench did not leaves a burst correlated over a second, and
+such bursts carry far less information than as many independent samples. S is never taken
+below J^T J (the floors' own noise level).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from compliance.model.config import PlantConfig
+from compliance.effects import EFFECTS
+from compliance.errors import InputError
+from compliance.diagnosis.servo.candidates import Candidate, FitParam, apply
+from compliance.diagnosis.servo.instrument_candidates import instrumented
+from compliance.diagnosis.evidence.replay_fit import ReplaySetup
+from compliance.diagnosis.evidence.residuals import ResidualModel, evaluate
+
+DIFF_STEP = 0.01  # forward-difference step, 1 % of each parameter's (log) range
+MAX_NFEV = 6  # least-squares polishing evaluations (besides the Jacobian's)
+SIMPLEX_FEV = 16  # simplex evaluations per fitted parameter
+SECOND_START = 2.0  # a second local fit starts from a grid point within this chi-square ratio of the best
+HAC_SECONDS = 1.0  # s; Newey-West bandwidth: residual correlation of about one stick-slip episode
+
+
+@dataclass
+class FitContext:
+    """What every fit of one recording shares.
+
+    Attributes
+    ----------
+    cfg : PlantConfig
+        Parent configuration (recording overrides applied).
+    setup : ReplaySetup
+    model : ResidualModel
+    """
+
+    cfg: PlantConfig
+    setup: ReplaySetup
+    model: ResidualModel
+    sims: int = 0
+
+    def residual(self, params, values) -> tuple[np.ndarray, dict | None]:
+        """Normalised data residuals of a parameter set, and the replay (None if it failed).
+
+        Instrumentation parameters (``servo.instrument_candidates``) act on the logger model and on the
+        states the re-synchronisations read (the plant's, not the instrument's).
+        """
+        setup = instrumented(self.setup, params, values)
+        self.sims += 1
+        try:
+            cfg = apply(self.cfg, params, values)
+        except InputError:
+            return self.model.vector(None), None
+        return evaluate(self.model, cfg, setup)
+
+
+@dataclass
+class FitResult:
+    """Outcome of fitting one candidate.
+
+    Attributes
+    ----------
+    name : str
+        Effect name, ``base`` (recalibration alone) or ``nominal``.
+    params : tuple of FitParam
+    values, stderr : list of float
+        Fitted values and standard errors [SI].
+    chi2 : float
+        Sum of squared normalised data residuals (priors excluded).
+    chi2_signal : dict
+        Signal -> its part of chi2.
+    n : int
+        Number of residuals.
+    sims : int
+        Replays run.
+    seconds : float
+    message : str
+    """
+
+    name: str
+    params: tuple = ()
+    values: list = field(default_factory=list)
+    stderr: list = field(default_factory=list)
+    chi2: float = math.inf
+    chi2_signal: dict = field(default_factory=dict)
+    n: int = 0
+    sims: int = 0
+    seconds: float = 0.0
+    message: str = ""
+    scan: list = field(default_factory=list)
+    cov: np.ndarray | None = None  # covariance of the fitted values [SI], from the final Jacobian
+
+    @property
+    def k(self) -> int:
+        """Number of fitted parameters."""
+        return len(self.params)
+
+    def lumped(self, effect: str) -> tuple[float, float] | None:
+        """(value, standard error) of ``effect``'s declared lumped combination, or None.
+
+        The error propagates the full covariance (delta method): parameters that trade along a
+        valley are strongly anti-correlated, so their sum is much sharper than either.
+        """
+        decl = EFFECTS.get(effect)
+        if decl is None or decl.lumped is None:
+            return None
+        idx = [i for i, fp in enumerate(self.params) if fp.kind == "effect" and fp.effect == effect]
+        vals = {self.params[i].name: self.values[i] for i in idx}
+        if len(vals) != len(decl.params):
+            return None
+        f0 = float(decl.lumped.of(vals))
+        if self.cov is None or not np.all(np.isfinite(self.cov)):
+            return f0, float("nan")
+        grad = np.zeros(len(self.params))
+        for i in idx:
+            h = 1e-6 * max(abs(self.values[i]), 1e-9)
+            bumped = dict(vals)
+            bumped[self.params[i].name] += h
+            grad[i] = (float(decl.lumped.of(bumped)) - f0) / h
+        return f0, float(math.sqrt(max(float(grad @ self.cov @ grad), 0.0)))
+
+    def value(self, key: str) -> float:
+        """Fitted value of parameter ``key``."""
+        for fp, v in zip(self.params, self.values):
+            if fp.key == key:
+                return v
+        raise KeyError(key)
+
+
+def chi2_parts(model: ResidualModel, vec: np.ndarray) -> tuple[float, dict]:
+    """Total chi-square and its split per signal."""
+    parts = {s: float(np.dot(r, r)) for s, r in model.split(vec).items()}
+    return float(sum(parts.values())), parts
+
+
+def _objective(ctx: FitContext, params, cache: dict):
+    prior_idx = [i for i, fp in enumerate(params) if fp.prior]
+
+    def fun(u):
+        key = tuple(np.round(u, 12))
+        if key in cache:
+            return cache[key]
+        values = [fp.from_unit(x) for fp, x in zip(params, u)]
+        vec, _ = ctx.residual(params, values)
+        if prior_idx:
+            vec = np.concatenate([vec, [params[i].prior_residual(values[i]) for i in prior_idx]])
+        cache[key] = vec
+        return vec
+
+    return fun
+
+
+def _nelder_mead(fun, u0: np.ndarray, maxfev: int, step: float = 0.05) -> np.ndarray:
+    """Simplex search of sum(fun(u)^2) in the unit cube (points outside are clipped and penalised)."""
+    from scipy.optimize import minimize
+
+    k = u0.size
+
+    def f(u):
+        uc = np.clip(u, 0.0, 1.0)
+        out = float(np.dot(r := fun(uc), r))
+        return out * (1.0 + 10.0 * float(np.sum((u - uc) ** 2)))
+
+    simplex = [u0]
+    for i in range(k):
+        v = u0.copy()
+        v[i] = u0[i] + step if u0[i] + step <= 1.0 else u0[i] - step
+        simplex.append(v)
+    f0 = f(u0)
+    # stop when the simplex spans < 0.2 % of the range and its values differ by < 0.1 % (the roughness level)
+    res = minimize(f, u0, method="Nelder-Mead",
+                   options={"initial_simplex": np.array(simplex), "maxfev": maxfev, "xatol": 2e-3, "fatol": 1e-3 * f0})
+    return np.clip(res.x, 0.0, 1.0)
+
+
+def least_squares_fit(ctx: FitContext, name: str, params: tuple[FitParam, ...], start: list[float], *,
+                      max_nfev: int = MAX_NFEV, diff_step: float = DIFF_STEP, simplex_fev: int = SIMPLEX_FEV) -> FitResult:
+    """Fit ``params`` from ``start`` (SI values): simplex search, then bounded least squares.
+
+    Returns
+    -------
+    FitResult
+        With standard errors from the Jacobian at the solution.
+    """
+    t0 = time.perf_counter()
+    sims0 = ctx.sims
+    n = ctx.model.size
+    if not params:
+        vec, _ = ctx.residual((), [])
+        chi2, parts = chi2_parts(ctx.model, vec)
+        return FitResult(name, (), [], [], chi2, parts, n, ctx.sims - sims0, time.perf_counter() - t0, "nothing to fit")
+    cache: dict = {}
+    fun = _objective(ctx, params, cache)
+    u0 = np.array([min(max(fp.to_unit(v), 1e-6), 1.0 - 1e-6) for fp, v in zip(params, start)])
+    if simplex_fev > 0:
+        u0 = np.clip(_nelder_mead(fun, u0, maxfev=simplex_fev * len(params) + 10), 1e-6, 1.0 - 1e-6)
+    res = least_squares(fun, u0, bounds=(np.zeros(len(params)), np.ones(len(params))), method="trf",
+                        diff_step=diff_step, max_nfev=max_nfev, xtol=1e-4, ftol=1e-4, x_scale=1.0)
+    u = res.x
+    if float(np.dot(fun(u0), fun(u0))) < float(np.dot(fun(u), fun(u))):
+        u = u0  # never return worse than the simplex found
+    values = [fp.from_unit(x) for fp, x in zip(params, u)]
+    vec = fun(u)[:n]
+    chi2, parts = chi2_parts(ctx.model, vec)
+    t_res = ctx.setup.time[ctx.model.index]
+    dt_res = float(np.median(np.diff(t_res))) if t_res.size > 1 else 1.0
+    stderr, cov = _stderr(params, values, res.jac, n, ctx.model, vec, max(1, int(round(HAC_SECONDS / dt_res))))
+    out = FitResult(name, tuple(params), values, stderr, chi2, parts, n, ctx.sims - sims0,
+                    time.perf_counter() - t0, str(res.message))
+    out.cov = cov
+    return out
+
+
+def hac_information(jac_data: np.ndarray, vec: np.ndarray, model: ResidualModel, lag: int) -> np.ndarray:
+    """Newey-West (1987) estimate of the residual scores' covariance S, per signal block.
+
+    Parameters
+    ----------
+    jac_data : ndarray (n, k)
+        Jacobian rows of the data residuals.
+    vec : ndarray (n,)
+        Data residuals (normalised).
+    model : ResidualModel
+        Gives the per-signal blocks (each a time series).
+    lag : int
+        Bandwidth L in residual samples (Bartlett weights 1 - l/(L + 1)).
+    """
+    k = jac_data.shape[1]
+    s = np.zeros((k, k))
+    # one block per signal; a joint model of several recordings (servo/joint_recordings.py) has blocks of its own lengths
+    sizes = getattr(model, "block_sizes", None) or [model.index.size] * len(model.signals)
+    start = 0
+    for m in sizes:
+        g = jac_data[start:start + m] * vec[start:start + m, None]
+        start += m
+        s += g.T @ g
+        for lg in range(1, min(lag, m - 1) + 1):
+            c = g[lg:].T @ g[:-lg]
+            s += (1.0 - lg / (lag + 1.0)) * (c + c.T)
+    return s
+
+
+def _stderr(params, values, jac, n, model, vec, lag: int) -> tuple[list[float], np.ndarray]:
+    """Standard errors [SI] and the covariance [SI] of the fitted values (Newey-West sandwich)."""
+    k = len(params)
+    jd, jp = jac[:n], jac[n:]  # data rows, prior rows (independent, unit variance)
+    try:
+        a_inv = np.linalg.pinv(jac.T @ jac)
+        s = hac_information(jd, vec, model, lag)
+        plain = jd.T @ jd
+        if np.trace(s) < np.trace(plain):
+            s = s * (np.trace(plain) / max(np.trace(s), 1e-300))  # never below the floors' noise
+        cov = a_inv @ (s + jp.T @ jp) @ a_inv
+    except np.linalg.LinAlgError:
+        cov = np.full((k, k), np.inf)
+    su = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    d = np.array([fp.stderr(v, 1.0) for fp, v in zip(params, values)])  # dvalue/du (linear in sigma_u)
+    return [fp.stderr(v, float(x)) for fp, v, x in zip(params, values, su)], cov * np.outer(d, d)
+
+
+def scan_points(ctx: FitContext, params, points: list[list[float]]) -> list[float]:
+    """Chi-square (data + prior) at each point of a scan (SI values per point)."""
+    out = []
+    for values in points:
+        vec, _ = ctx.residual(params, values)
+        prior = sum(fp.prior_residual(v) ** 2 for fp, v in zip(params, values))
+        out.append(float(np.dot(vec, vec)) + prior)
+    return out
+
+
+def fit_candidate(ctx: FitContext, cand: Candidate, base_fit: FitResult | None, *, max_nfev: int = MAX_NFEV,
+                  screen: float | None = None) -> FitResult:
+    """Fit one effect on top of the recalibrated base, co-fitting the recalibrated base parameters.
+
+    The effect's grid is scanned with the base parameters at their recalibrated values; the
+    local fit starts from the best grid point. Effects with several parameters often trade
+    them along a valley (a spool delay against a slower spool, a sensor delay against its lag),
+    so a second local fit starts from the best grid point with another main-parameter value
+    when it is within ``SECOND_START`` of the best, and the better result is kept.
+
+    ``screen`` (a chi-square): when no grid point gets below it, the candidate is not refined and
+    its result is the best grid point (``message`` says so; no standard errors).
+    """
+    t0 = time.perf_counter()
+    sims0 = ctx.sims
+    bparams = tuple(base_fit.params) if base_fit is not None else ()
+    bvalues = list(base_fit.values) if base_fit is not None else []
+    eparams = cand.params
+    defaults = [fp.nominal for fp in eparams]
+    grid = cand.grid or ({},)
+    points = []
+    for g in grid:
+        points.append([g.get(fp.name, d) for fp, d in zip(eparams, defaults)] + bvalues)
+    all_params = tuple(eparams) + bparams
+    chis = scan_points(ctx, all_params, points)
+    best = int(np.argmin(chis))
+    if screen is not None and chis[best] > screen:
+        vec, _ = ctx.residual(all_params, points[best])
+        chi2, parts = chi2_parts(ctx.model, vec)
+        return FitResult(cand.name, tuple(all_params), list(points[best]), [math.nan] * len(all_params), chi2, parts,
+                         ctx.model.size, ctx.sims - sims0, time.perf_counter() - t0,
+                         "screened: no point of its grid removes enough to be refined",
+                         [(dict(zip([fp.key for fp in all_params], p)), c) for p, c in zip(points, chis)])
+    res = least_squares_fit(ctx, cand.name, all_params, points[best], max_nfev=max_nfev)
+    if len(eparams) > 1:
+        others = [i for i in np.argsort(chis) if points[i][0] != points[best][0]]
+        if others and chis[others[0]] <= SECOND_START * chis[best]:
+            alt = least_squares_fit(ctx, cand.name, all_params, points[others[0]], max_nfev=max_nfev)
+            if alt.chi2 < res.chi2:
+                res = alt
+    res.sims = ctx.sims - sims0
+    res.seconds = time.perf_counter() - t0
+    res.scan = [(dict(zip([fp.key for fp in all_params], p)), c) for p, c in zip(points, chis)]
+    return res
+
+
+__all__ = ["FitContext", "FitResult", "fit_candidate", "least_squares_fit", "scan_points", "chi2_parts"]

@@ -1,0 +1,1 @@
+"""What would make it pass: the smallest combined change, the staged search over settings, rate limiter and hardware, the finish."""
