@@ -37,7 +37,7 @@ from compliance.diagnosis.friction_bench.position import POSITION_FRICTION
 from compliance.diagnosis.friction_bench.explanation import explain_friction, format_friction  # noqa: F401 (re-exported)
 from compliance.diagnosis.friction_bench.holdout import holdout_words, position_words, prove_out_of_sample
 from compliance.diagnosis.friction_bench.runs import Run
-from compliance.diagnosis.evidence.noise_floor import sensor_noise_std
+from compliance.validation.recorded_noise import sensor_noise_std
 from compliance.diagnosis.servo.report_data import SCHEMA
 from compliance.diagnosis.friction_bench.residual_structure import friction_structure
 from compliance.diagnosis.servo.selection import EXPLAINED_ENOUGH, NOISE_TOLERANCE, score_all
