@@ -220,6 +220,8 @@ def _run_dask(client, fn, context, items, sink: _Sink):
             raise
         except Exception as exc:  # task error or KilledWorker: submit again, counted
             if sink.failed(i, exc):
+                if ctx.status != "finished":  # every worker holding the context died: send it again
+                    ctx = client.scatter(context, broadcast=True, hash=False)
                 again = client.submit(fn, ctx, items[i], pure=False)
                 futures[again] = i
                 stream.add(again)
