@@ -36,7 +36,8 @@ def main(argv=None) -> int:
 
     t0 = time.perf_counter()
     from compliance.model.config import load_plant
-    from compliance.campaign.executor import available_cores, warm_up
+    from compliance.campaign.executor import warm_up
+    from compliance.processes import available_cores
     from compliance.campaign.run import run_campaign
     from compliance.requirements.loading import load_requirements
 

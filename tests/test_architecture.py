@@ -17,7 +17,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "compliance"
 
 # bottom first: a package may import from itself and from packages before it in this list
 LAYERS = ["errors", "processes", "units", "files", "physics", "effects", "model", "simulation", "metrics", "linear",
-          "tracking", "procedures", "requirements", "campaign", "sweep", "recordings", "validation",
+          "tracking", "procedures", "requirements", "presentation", "campaign", "sweep", "recordings", "validation",
           "characterise", "diagnosis", "report", "papers", "cli", "__main__"]
 
 
@@ -247,3 +247,25 @@ def test_the_rule_sees_globals_and_setattr_on_a_module():
     tree = ast.parse(src)
     hits = [n.lineno for n in ast.walk(tree) if _makes_names(n, _module_names(tree))]
     assert sorted(hits) == [3, 4, 5]  # setattr on an object is not a module name
+
+
+# the one executor (compliance/processes/): nothing else starts processes, counts cores or maps tasks
+_POOL_NAMES = ("ProcessPoolExecutor", "multiprocessing", "worker_pool", "sched_getaffinity", "cpu_count")
+
+
+def test_one_process_pool_implementation():
+    found = []
+    for name, path in _modules().items():
+        if name.startswith("compliance.processes"):
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) and node.name == "map_tasks":
+                found.append(f"{name}: defines map_tasks")
+            elif isinstance(node, ast.Import):
+                found += [f"{name}: imports {a.name}" for a in node.names if a.name.split(".")[0] == "multiprocessing"]
+            elif isinstance(node, ast.ImportFrom) and node.module:
+                found += [f"{name}: imports {node.module}.{a.name}" for a in node.names
+                          if node.module.split(".")[0] == "multiprocessing" or a.name in _POOL_NAMES]
+            elif isinstance(node, ast.Attribute) and node.attr in _POOL_NAMES:
+                found.append(f"{name}: uses .{node.attr}")
+    assert not found, "process pools outside compliance/processes (use compliance.processes.map_tasks):\n" + "\n".join(found)

@@ -10,35 +10,24 @@ from __future__ import annotations
 
 from compliance.campaign.basis import limit_assumed, requirement_basis, row_basis
 from compliance.campaign.plan import Job
-from compliance.units.formatting import fmt_margin_pct, fmt_value
 from compliance.requirements.tightening import check_tightening
 from compliance.linear.requirement_values import linear_value
 from compliance.metrics.catalogue import METRICS
+from compliance.presentation.values import metric_text, resolved_limit, row_texts
 from compliance.requirements.requirement_set import RequirementSet
 from compliance.procedures.outcomes import Sample, request_key
 from compliance.requirements.verdict import Basis, Status, Verdict, evaluate, requirement_status, worst_index
 
-__all__ = ["fmt", "judge", "judge_row", "sample_dict"]
+__all__ = ["judge", "judge_row", "sample_dict"]
 
 # keys of the worst row copied into a requirement's entry
 _WORST_KEYS = ("run", "procedure", "operating_point", "value", "margin", "margin_pct", "status", "which", "display",
                "basis", "basis_reason", "non_responding")
 
 
-def fmt(value, metric: str, digits: int = 3) -> str:
-    """Display a SI value of ``metric`` in its display unit (``0.0016`` m -> ``'1.60 mm'``; the one formatter)."""
-    if value is None:
-        return "-"
-    info = METRICS[metric]
-    v = value * info.display_scale
-    if abs(v) < 1e-9:  # numerical zero (a body at rest in stiction), not a measurement
-        v = 0.0
-    return fmt_value(v, info.display_unit, digits)
-
-
 def sample_dict(s: Sample, metric: str) -> dict:
     """Plain-JSON form of one candidate value, with its display text."""
-    return {"label": s.label, "value": s.value, "display": fmt(s.value, metric), "eligible": s.eligible,
+    return {"label": s.label, "value": s.value, "display": metric_text(s.value, metric, unicode=False), "eligible": s.eligible,
             "reason": s.reason, "detail": s.detail}
 
 
@@ -98,15 +87,6 @@ def _why(samples) -> str:
     return "; ".join(reasons) if reasons else "no sample of this metric in the run"
 
 
-def _display_row(row: dict, metric: str) -> dict:
-    return {
-        "value": fmt(row.get("value"), metric),
-        "limit": None if not row.get("limit") else " .. ".join(fmt(v, metric) for v in row["limit"]),
-        "margin": fmt(row.get("margin"), metric),
-        "margin_pct": fmt_margin_pct(row.get("margin_pct"), unicode=False),
-    }
-
-
 def _row_verdict(req, r: dict) -> Verdict:
     return Verdict(r["value"], req.comparator, tuple(r["limit"] or ()), r["margin"], r["margin_pct"], r["status"], r["reason"])
 
@@ -164,7 +144,7 @@ def judge(cfg, reqset: RequirementSet, jobs: list[Job], outcomes) -> tuple[list[
         limit = req.resolved_limit(stroke) if req.limit is not None else None
         rows = _rows(cfg, reqset, req, limit, by_key) if req.enabled else []
         for r in rows:
-            r["display"] = _display_row(r, req.metric)
+            r["display"] = row_texts(r, req.metric, unicode=False)
         verdicts = [_row_verdict(req, r) for r in rows] if req.limit is not None else []
         if not req.enabled:
             status = Status.DISABLED
@@ -195,8 +175,7 @@ def judge(cfg, reqset: RequirementSet, jobs: list[Job], outcomes) -> tuple[list[
             "comparator": req.comparator,
             "limit": list(limit) if limit is not None else None,
             "limit_text": req.limit_text,
-            "limit_display": None if limit is None else (
-                ("within " if req.comparator == "within" else req.comparator + " ") + " .. ".join(fmt(v, req.metric) for v in limit)),
+            "limit_display": None if limit is None else resolved_limit(req.comparator, limit, req.metric),
             "severity": req.severity,
             "source": req.source,
             "status": status,

@@ -15,6 +15,7 @@ from compliance.errors import InputError
 from compliance.files.atomic import write_text_atomic
 from compliance.files.jsonable import json_text, read_json
 from compliance.requirements.verdict import Basis, Status
+from compliance.presentation.values import limit_as_written
 from compliance.units.formatting import STATUS_WORD as _STATUS_WORD  # the one status-word table
 
 RESULTS_SCHEMA = "govcheck-results/1"
@@ -122,9 +123,7 @@ def _table_row(e: dict) -> tuple:
     where = w.get("run") or "-"
     if w.get("which"):
         where += f" ({w['which']})"
-    limit = e["limit_text"]
-    if "stroke" in limit and e.get("limit_display"):
-        limit += f" ({e['limit_display'].split(' ', 1)[1]})"
+    limit = limit_as_written(e, unicode=False)
     cov = e.get("coverage") or {}
     cases = f"{cov['evaluated']}/{cov['rows']}" if cov.get("rows") and e.get("limit") is not None else "-"
     value = "no response" if w.get("non_responding") else d.get("value", "-")

@@ -23,8 +23,9 @@ from compliance.files.display import display_path
 from compliance.model.identity import identity_dict
 from compliance import __version__
 from compliance.campaign.plan import Job, plan
-from compliance.campaign.executor import available_cores, execute
-from compliance.campaign.judge import fmt, judge, sample_dict
+from compliance.campaign.executor import execute
+from compliance.processes import available_cores
+from compliance.campaign.judge import judge, sample_dict
 from compliance.errors import InputError
 from compliance.requirements.consistency import consistency_findings
 from compliance.requirements.tightening import check_tightening
@@ -39,7 +40,6 @@ __all__ = [
     "Job",
     "available_cores",
     "execute",
-    "fmt",
     "judge",
     "plan",
     "plant_section",

@@ -17,7 +17,7 @@ largest swings towards the limit, in order, until they cover the margin. ``govch
 
 from __future__ import annotations
 
-from compliance.campaign.executor import map_tasks
+from compliance.processes import map_tasks
 from compliance.campaign.judge import judge_row
 from compliance.procedures.outcomes import traces_off
 from compliance.procedures.registry import run as run_procedure

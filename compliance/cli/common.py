@@ -4,7 +4,7 @@
   ``--plant`` is still read for old scripts, but giving both is an error, never a silent choice.
 - The same output options everywhere: ``--json FILE.json``, ``--junit FILE.xml``,
   ``--report FILE.html``, ``--pdf FILE.pdf``; the same ``--quiet/-q``, ``--jobs/-j`` and
-  ``--reproducible``.
+  ``--reproducible``; ``--scheduler ADDR`` wherever work runs in parallel.
 - Every output path is checked (folder, writability, suffix) before any work starts
   (:func:`compliance.files.outputs.check_outputs`).
 """
@@ -114,6 +114,22 @@ def add_recording_inputs(parser, recordings: str) -> None:
 def add_jobs(parser, what: str = "worker processes") -> None:
     """``--jobs/-j N``."""
     parser.add_argument("--jobs", "-j", type=int, default=None, metavar="N", help=f"{what} (default: the available cores)")
+
+
+def add_scheduler(parser, what: str = "the parallel work") -> None:
+    """``--scheduler ADDR``: run ``what`` on Dask instead of the local process pool (the one spelling, every command)."""
+    parser.add_argument("--scheduler", metavar="ADDR",
+                        help=f"run {what} on Dask: tcp://host:8786 for a running cluster, local:N to start a "
+                             "LocalCluster of N workers; default: the local process pool (--jobs)")
+
+
+def check_scheduler(args) -> str | None:
+    """The ``--scheduler`` given, checked before any work (a bad address is exit 2); None for the local pool."""
+    from compliance.processes import parse_scheduler
+
+    value = getattr(args, "scheduler", None)
+    parse_scheduler(value)
+    return value
 
 
 def add_quiet(parser, what: str = "no progress; print only the verdict line") -> None:

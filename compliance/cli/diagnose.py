@@ -17,7 +17,7 @@ from pathlib import Path
 
 from compliance.cli.common import (add_recording_inputs, add_parser, add_jobs, add_outputs, add_quiet, add_reproducible, check_args_outputs,
                                    check_sidecar_conditions, sidecar_plant, split_config, add_document_options,
-                                   document_options)
+                                   document_options, add_scheduler, check_scheduler)
 from compliance.errors import InputError
 from compliance.files.atomic import write_json_atomic
 
@@ -50,8 +50,7 @@ def register(sub):
     p.add_argument("--effects", help="comma-separated candidate effects (default: every declared effect)")
     p.add_argument("--no-recalibration", action="store_true", help="do not consider recalibrating base parameters")
     add_jobs(p)
-    p.add_argument("--scheduler", metavar="ADDR", help="several recordings: run the joint fits on Dask (local:N or "
-                                                        "tcp://host:8786); default the local process pool")
+    add_scheduler(p, "the fits of several recordings (a joint diagnosis)")
     p.add_argument("--friction-bore", help='friction bench: piston bore, e.g. "25.7 mm" (else the column map\'s metadata)')
     add_outputs(p, "json", "report", "pdf", help={"json": "write the diagnosis (docs/diagnosis-schema.md) to FILE.json",
                                                   "report": "write an HTML report with the before/after figures to FILE.html",
@@ -157,31 +156,11 @@ def _print_servo(d: dict, quiet: bool) -> None:
 
 
 def _render_servo_report(cfg, frame, meta, diag, data: dict, args) -> None:
-    from compliance.report.render import render_validation_report
-    from compliance.validation.validate import ValidationSettings, validate
-
-    settings = ValidationSettings(modes=("closed_loop",)) if "reference" in frame.columns else ValidationSettings(modes=("plant_only",))
-    result = validate(cfg, frame, meta, settings)
-    diag_entry = {"explanation": data["explanation"], "verdict": data["verdict"], "added": [], "effects_ranked": data["effects"]}
-    if diag.fitted_cfg is not None:
-        diag_entry["after"] = validate(diag.fitted_cfg, frame, meta, settings)
-        from compliance.diagnosis.servo.explanation import explain_with_table
-
-        mode = settings.modes[0]  # the explanation quotes the fits of the table printed beside it
-        diag_entry["explanation"] = explain_with_table(diag, result["modes"][mode]["fits"], diag_entry["after"]["modes"][mode]["fits"])
-        winner = next(e for e in data["effects"] if e["name"] == data["winner"])
-        groups: dict[str, list] = {}
-        for p in winner["parameters"]:
-            group = p["name"].split(".")[0] if p["kind"] == "effect" else "base parameters (recalibrated)"
-            groups.setdefault(group, []).append({"name": p["name"].split(".", 1)[1] if p["kind"] == "effect" else p["name"],
-                                                 "value": p["value"], "unit": p["unit"]})
-        from compliance.effects import EFFECTS
-
-        for g, params in groups.items():
-            diag_entry["added"].append({"name": g, "meaning": EFFECTS[g].meaning if g in EFFECTS else "", "params": params})
-    result["diagnosis"] = diag_entry
     from compliance.model.identity import identity_dict
+    from compliance.diagnosis.servo.report_data import validation_with_diagnosis
+    from compliance.report.render import render_validation_report
 
+    result = validation_with_diagnosis(cfg, frame, meta, diag, data)
     document = {**document_options(args), "identity": identity_dict(cfg.identity)}
     render_validation_report(result, args.report, args.pdf, document=document)
 
@@ -220,7 +199,6 @@ def _run_friction(args, first, meta) -> int:
 
 def _run_joint(args, plant_arg, effects) -> int:
     """Several closed-loop recordings of one plant: one diagnosis with shared physics (diagnosis.servo.joint_recordings)."""
-    from compliance.campaign.executor import parse_scheduler
     from compliance.cli.progress import progress
     from compliance.diagnosis.servo.joint_recordings import diagnose_joint, format_joint
     from compliance.model.config import load_plant
@@ -229,9 +207,7 @@ def _run_joint(args, plant_arg, effects) -> int:
     for flag, value in (("--save-model", args.save_model), ("--report", args.report), ("--suggest-test", args.suggest_test)):
         if value:
             raise InputError(f"{flag}: not available for a joint diagnosis of several recordings (use --json)")
-    from compliance.cli.sweep import _check_scheme
-
-    _check_scheme(*parse_scheduler(args.scheduler))  # a bad address is exit 2 before any work (the sweep's check)
+    check_scheduler(args)  # a bad address is exit 2 before any work
     seen = set()
     for path in args.recordings:
         key = Path(path).resolve()

@@ -1,6 +1,6 @@
 """``govcheck diagnose-benchmark``: prove the diagnosis on generated concealed-effect recordings.
 
-    govcheck diagnose-benchmark [CONFIG] [--cases N] [--seed S] [--effects a,b] [--library a,b] [--jobs N]
+    govcheck diagnose-benchmark [CONFIG] [--cases N] [--seed S] [--effects a,b] [--library a,b] [--jobs N] [--scheduler ADDR]
                                 [--no-null] [--no-miscalibrations] [--practice DIR] [--json out.json]
                                 [--markdown results.md]
 
@@ -17,8 +17,8 @@ from __future__ import annotations
 
 import argparse
 
-from compliance.cli.common import (add_jobs, add_outputs, add_plant_argument, add_quiet, add_reproducible,
-                                   check_args_outputs, plant_from_args)
+from compliance.cli.common import (add_jobs, add_outputs, add_plant_argument, add_quiet, add_reproducible, add_scheduler,
+                                   check_args_outputs, check_scheduler, plant_from_args)
 from compliance.errors import InputError
 
 TOP1_TARGET = 0.9
@@ -39,6 +39,7 @@ def register(sub):
             "examples:\n"
             "  govcheck diagnose-benchmark --cases 3 --seed 1 --json bench.json\n"
             "  govcheck diagnose-benchmark --effects heat_transfer,internal_leakage --cases 2 --jobs 2\n"
+            "  govcheck diagnose-benchmark --cases 3 --scheduler local:2\n"
             "  govcheck diagnose-benchmark models/plant-a.toml --practice tests/data/practice\n"
             "  govcheck diagnose-benchmark --practice tests/data/practice --reproducible --markdown practice.md"
         ),
@@ -50,6 +51,7 @@ def register(sub):
     p.add_argument("--effects", help="effects to generate cases of (default: all declared)")
     p.add_argument("--library", help="candidate effects the diagnosis chooses from (default: all declared)")
     add_jobs(p, "cases diagnosed in parallel")
+    add_scheduler(p, "the cases (with --practice: the recordings)")
     p.add_argument("--no-null", action="store_true", help="no null cases")
     p.add_argument("--no-miscalibrations", action="store_true", help="no miscalibrated-parameter cases")
     p.add_argument("--practice", help="diagnose the recordings of this directory and score them against its ANSWERS.json")
@@ -91,14 +93,15 @@ def _write(args, data: dict, markdown) -> None:
 def run(args) -> int:
     """Run the benchmark; 0 when the targets are met, 1 when not."""
     from compliance.diagnosis.scoring.benchmark import format_summary, run_benchmark, run_practice
-    from compliance.diagnosis.servo.diagnose import default_jobs
+    from compliance.processes import available_cores
 
     check_args_outputs(args, (args.markdown, *MARKDOWN_OUTPUT))
+    scheduler = check_scheduler(args)
     if args.cases < 1:
         raise InputError(f"--cases {args.cases}: expected at least 1")
     if not 0 <= args.seed < 2**32:
         raise InputError(f"--seed {args.seed}: expected a whole number from 0 to {2**32 - 1} (a random generator seed)")
-    jobs = default_jobs() if args.jobs is None else args.jobs
+    jobs = available_cores() if args.jobs is None else args.jobs
     if jobs < 1:
         raise InputError(f"--jobs {jobs}: expected a positive number of worker processes")
     cfg = plant_from_args(args, fallback="plant-a")
@@ -109,7 +112,7 @@ def run(args) -> int:
             print(f"{mark} {row['name']:32s} truth {row['truth']:18s} -> {row['verdict']:16s} {row['winner'] or '-':28s} "
                   f"{row['seconds']:5.1f} s  {row['parameters']}", flush=True)
 
-        rep = run_practice(args.practice, cfg, library=library, jobs=jobs, progress=row_done)
+        rep = run_practice(args.practice, cfg, library=library, jobs=jobs, progress=row_done, scheduler=scheduler)
         amb = sum(bool(r.get("ambiguous_with_truth")) for r in rep["recordings"])
         print(f"\n{rep['correct']}/{len(rep['recordings'])} practice recordings diagnosed correctly"
               + (f"; {amb} more called ambiguous with the truth among the explanations named" if amb else ""))
@@ -133,7 +136,8 @@ def run(args) -> int:
             bar.update(1)
 
         rep = run_benchmark(cfg, effects=_names(args.effects, "--effects"), cases=args.cases, seed=args.seed, library=library,
-                            jobs=jobs, null=not args.no_null, miscalibrations=not args.no_miscalibrations, progress=progress)
+                            jobs=jobs, null=not args.no_null, miscalibrations=not args.no_miscalibrations, progress=progress,
+                            scheduler=scheduler)
     print()
     print(format_summary(rep))
     from compliance.diagnosis.scoring.practice_score import benchmark_markdown

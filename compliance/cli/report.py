@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from compliance.cli.common import add_document_options, add_jobs, add_parser, check_args_outputs, document_options
+from compliance.cli.common import (add_document_options, add_jobs, add_parser, add_scheduler, check_args_outputs,
+                                   check_scheduler, document_options)
 from compliance.errors import InputError
 from compliance.files.jsonable import read_json
 
@@ -36,6 +37,7 @@ def register(subparsers):
                    help="add a model validation written by 'govcheck validate --json'")
     add_document_options(p)
     add_jobs(p, "processes drawing figures")
+    add_scheduler(p, "the figures")
     p.add_argument("--appendix", choices=("none", "summary", "full"), default="summary",
                    help="compliance report appendix: none, summary (configuration, requirement file, versions; default) "
                         "or full (+ every run with its figures)")
@@ -66,6 +68,7 @@ def run(args) -> int:
     if not html and not args.pdf:
         html = str(Path(args.results).with_suffix(".html"))
     check_args_outputs(args, (None if args.report else html, "--report (default, beside the results)", (".html",)))
+    scheduler = check_scheduler(args)
     data = read_json(args.results, "results")
     if data.get("schema") == VALIDATION_SCHEMA:
         if args.linear or args.validation:
@@ -73,7 +76,7 @@ def run(args) -> int:
         check_validation(data, str(args.results))
         if not html:
             raise InputError("a validation report needs --report (the PDF is made from it)")
-        render_validation_report(data, html, args.pdf, workers=args.jobs)
+        render_validation_report(data, html, args.pdf, workers=args.jobs, scheduler=scheduler)
     else:
         check_results(data, str(args.results))
         if args.linear:
@@ -83,7 +86,7 @@ def run(args) -> int:
             check_validation(val, str(args.validation))
             data["validation"] = val
         render_report(data, html, args.pdf, workers=args.jobs, appendix=args.appendix,
-                      document=document_options(args, args.results))
+                      document=document_options(args, args.results), scheduler=scheduler)
     written = [p for p in (html, args.pdf) if p]
     print("report: " + ", ".join(written))
     return 0

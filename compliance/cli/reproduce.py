@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from compliance.cli.common import add_outputs, add_parser, add_plant_argument, check_args_outputs, plant_from_args
+from compliance.cli.common import (add_outputs, add_parser, add_plant_argument, add_scheduler, check_args_outputs,
+                                   check_scheduler, plant_from_args)
 from compliance.errors import InputError
 
 
@@ -25,6 +26,7 @@ def register(sub):
     p.add_argument("--calibrate", nargs="?", const="models/plant-a-calibrated.toml", metavar="OUT.toml",
                    help="fit the parameters the paper leaves unstated to its figures, print before/after and save "
                         "the calibrated configuration (default models/plant-a-calibrated.toml; docs/calibration.md)")
+    add_scheduler(p, "the --calibrate search")
     return p
 
 
@@ -33,6 +35,9 @@ def run(args) -> int:
     from compliance.papers.plant_a import compare, format_table
 
     check_args_outputs(args, (args.calibrate, "--calibrate", (".toml",)))
+    scheduler = check_scheduler(args)
+    if scheduler is not None and not args.calibrate:
+        raise InputError(f"--scheduler {scheduler}: only the --calibrate search runs in parallel; add --calibrate")
     cfg = plant_from_args(args)
     if cfg.options["cylinder.arrangement"] != "tandem":
         from compliance.files.display import display_path
@@ -41,7 +46,7 @@ def run(args) -> int:
     if args.calibrate:
         from compliance.papers.calibration_run import run_calibration
 
-        return run_calibration(cfg, args.calibrate, json_path=args.json)
+        return run_calibration(cfg, args.calibrate, json_path=args.json, scheduler=scheduler)
     comp = compare(cfg, explain=not args.no_explain)
     print(format_table(comp))
     if args.json:

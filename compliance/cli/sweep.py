@@ -10,7 +10,7 @@ import shlex
 import sys
 from pathlib import Path
 
-from compliance.cli.common import add_jobs, add_parser, add_quiet
+from compliance.cli.common import add_jobs, add_parser, add_quiet, add_scheduler, check_scheduler
 from compliance.errors import InputError
 
 
@@ -34,9 +34,7 @@ def register(subparsers):
     )
     p.add_argument("sweep", help="sweep file (TOML, schema govcheck-sweep/1)")
     p.add_argument("--out", metavar="DIR", help="output folder (default: reports/sweeps/NAME)")
-    p.add_argument("--scheduler", metavar="ADDR",
-                   help="Dask scheduler: tcp://host:8786 for a running cluster, local:N to start a LocalCluster of N "
-                        "workers; default: the local process pool")
+    add_scheduler(p, "the candidates")
     add_jobs(p, "local worker processes")
     p.add_argument("--samples", type=int, default=None, help="override the sweep file's latin-hypercube sample count")
     p.add_argument("--yield", dest="yield_of", metavar="CANDIDATE",
@@ -45,16 +43,6 @@ def register(subparsers):
     p.add_argument("--units", type=int, default=None, help="override the number of Monte Carlo units of --yield")
     add_quiet(p, "no progress; print only the result line")
     return p
-
-
-DASK_SCHEMES = ("tcp", "tls", "inproc", "ucx", "ws", "wss")  # what distributed.comm knows
-
-
-def _check_scheme(kind: str, address) -> None:
-    """A Dask address must name a scheme Dask can connect with (checked before any work or folder)."""
-    if kind == "dask" and str(address).split("://", 1)[0] not in DASK_SCHEMES:
-        raise InputError(f"--scheduler {address}: unknown address scheme; expected one of "
-                         f"{', '.join(s + '://' for s in DASK_SCHEMES)} (e.g. tcp://host:8786) or local:N")
 
 
 def _out_dir(args, spec) -> Path:
@@ -120,7 +108,6 @@ def run(args) -> int:
     """Run the sweep (or yield run), print the summary, exit 0 / 1 / 2."""
     from dataclasses import replace
 
-    from compliance.campaign.executor import parse_scheduler
     from compliance.sweep.run import run_sweep, run_yield_file
     from compliance.requirements.verdict import Overall
     from compliance.sweep.candidates.spec import load_sweep
@@ -129,8 +116,7 @@ def run(args) -> int:
         v = getattr(args, flag)
         if v is not None and v < 1:
             raise InputError(f"--{flag} {v}: expected a positive number")
-    kind, address = parse_scheduler(args.scheduler)  # a bad address is exit 2 before any work
-    _check_scheme(kind, address)
+    check_scheduler(args)  # a bad address is exit 2 before any work
     spec = load_sweep(args.sweep)
     if args.samples:
         spec = replace(spec, samples=args.samples)
@@ -168,23 +154,19 @@ def add_remedies_options(p) -> None:
     p.add_argument("--yield-units", type=int, default=None, metavar="N",
                    help="with --remedies: Monte Carlo units of the remedy's tolerance yield (default 59: 59/59 passing shows "
                         ">= 95 %% at 95 %% confidence; 0 skips it)")
-    p.add_argument("--scheduler", metavar="ADDR",
-                   help="with --remedies: Dask scheduler (tcp://host:8786, or local:N for a LocalCluster of N workers); "
-                        "default: the local process pool")
+    add_scheduler(p, "the --remedies search (needs --remedies)")
     p.add_argument("--remedies-state", metavar="DIR",
                    help="with --remedies: keep every judged candidate in DIR so an interrupted search resumes there")
 
 
 def check_remedies_options(args) -> None:
     """Refuse inconsistent or bad remedies options before any work (exit 2)."""
-    from compliance.campaign.executor import parse_scheduler
-
     used = [f for f in ("save_remedy", "yield_units", "scheduler", "remedies_state") if getattr(args, f, None) is not None]
     if used and not args.remedies:
         raise InputError(f"--{used[0].replace('_', '-')} needs --remedies")
     if args.yield_units is not None and args.yield_units < 0:
         raise InputError(f"--yield-units {args.yield_units}: expected 0 or a positive number of units")
-    parse_scheduler(args.scheduler)
+    check_scheduler(args)
     if args.remedies and args.catalogue not in ("default", "none"):
         from compliance.sweep.sizing.hardware_catalogue import load_catalogue
 

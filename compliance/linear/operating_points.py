@@ -119,29 +119,12 @@ def _assemble_map(positions, loads, cells) -> dict:
     return OperatingMap(positions, loads, values, notes).to_dict()
 
 
-_CTX: dict = {}  # set before the pool forks: workers read the configuration and tasks without pickling them
-
-
-def _work(i: int):
-    return i, _task(_CTX["cfg"], _CTX["tasks"][i])
-
-
 def _run_tasks(cfg: PlantConfig, tasks: list, workers: int | None) -> list:
-    """Results of ``tasks`` in order; on ``workers`` forked processes (default: the available cores)."""
-    import multiprocessing as mp
-    import os
+    """Results of ``tasks`` in order, on the one executor (``workers`` processes, default the available cores)."""
+    from compliance.processes import map_tasks
 
-    workers = len(os.sched_getaffinity(0)) if workers is None else workers
-    if workers <= 1 or len(tasks) < 4 or "fork" not in mp.get_all_start_methods():
-        return [_task(cfg, t) for t in tasks]
-    from compliance.processes import worker_pool
-
-    out: list = [None] * len(tasks)
-    _CTX.update(cfg=cfg, tasks=tasks)
-    try:
-        with worker_pool(workers) as pool:
-            for i, res in pool.map(_work, range(len(tasks))):
-                out[i] = res
-    finally:
-        _CTX.clear()
+    if len(tasks) < 4 or (workers is not None and workers <= 1):  # fork and import cost more than a few linearisations
+        workers = 1
+    out, stats = map_tasks(_task, cfg, list(tasks), workers=workers, progress=False, label="operating points", retries=0)
+    stats.raise_if_failed()
     return out

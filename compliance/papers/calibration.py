@@ -29,11 +29,13 @@ from __future__ import annotations
 
 import itertools
 import math
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from compliance.campaign.executor import available_cores, warm_up
+from compliance.campaign.executor import warm_up
+from compliance.processes import available_cores, dask_session, map_tasks
 from compliance.errors import InputError
 from compliance.model.config import PlantConfig
 from compliance.papers.calibration_objective import best_conditions, cost, rows_of
@@ -50,7 +52,7 @@ PROFILE_OFFSETS = (-0.3, -0.1, -0.03, 0.03, 0.1, 0.3)  # unit-cube offsets of th
 POLISH_ROUNDS = 2  # restarts of the compass from a profile point that beat it
 PIN_DELTA = 1.0  # one scatter^2: a value that moves one figure by its whole scatter is excluded
 
-_CTX: dict = {}  # set before the pool forks (nothing large is pickled)
+_CTX: dict = {}  # the search's state: configuration, parameters, conditions (the executor's context) and Dask client
 
 
 @dataclass
@@ -101,20 +103,20 @@ class Calibration:
     workers: int = 1
 
 
-def _point_cost(task):
+def _point_cost(ctx: dict, task):
     """Worker: a unit-cube point (or ("cfg", index) into a list of configurations) -> (cost, condition index,
-    cost under each condition set)."""
+    cost under each condition set); ``ctx`` is the search's state when the task was sent."""
     if isinstance(task, tuple):
-        cfg = _CTX["cfgs"][task[1]]
+        cfg = ctx["cfgs"][task[1]]
     else:
-        cfg = _configure(_CTX["cfg"], _CTX["params"], task)
+        cfg = _configure(ctx["cfg"], ctx["params"], task)
     try:
-        if "score" in _CTX:  # another objective of the same search (calibration_reach: one figure alone)
-            c = _CTX["score"](cfg)
+        if "score" in ctx:  # another objective of the same search (calibration_reach: one figure alone)
+            c = ctx["score"](cfg)
             return c, 0, (c,)
-        return best_conditions(cfg, _CTX["conds"], _CTX.get("targets"))
+        return best_conditions(cfg, ctx["conds"], ctx.get("targets"))
     except InputError:  # a point the loader's cross-checks refuse is outside the plant
-        return math.inf, 0, (math.inf,) * len(_CTX["conds"])
+        return math.inf, 0, (math.inf,) * len(ctx["conds"])
 
 
 def _configure(cfg: PlantConfig, params, u) -> PlantConfig:
@@ -122,13 +124,29 @@ def _configure(cfg: PlantConfig, params, u) -> PlantConfig:
 
 
 def _map(tasks: list, workers: int) -> list[tuple[float, int, tuple[float, ...]]]:
-    """Score tasks on a forked pool (workers read the configuration from ``_CTX``, nothing large pickled)."""
-    if workers <= 1 or len(tasks) < 4:
-        return [_point_cost(t) for t in tasks]
-    from compliance.processes import worker_pool
+    """Score tasks on the one executor: ``workers`` local processes, or the Dask client of :func:`search_session`."""
+    ctx = {k: v for k, v in _CTX.items() if k != "client"}
+    client = _CTX.get("client")
+    if workers <= 1 or len(tasks) < 4:  # a few points: fork and scatter cost more than they save
+        workers, client = 1, None
+    results, stats = map_tasks(_point_cost, ctx, list(tasks), workers=workers, client=client, progress=False,
+                               label="calibration points", retries=0)
+    stats.raise_if_failed()
+    return results
 
-    with worker_pool(workers) as pool:
-        return list(pool.map(_point_cost, tasks, chunksize=max(1, len(tasks) // (4 * workers))))
+
+@contextmanager
+def search_session(scheduler: str | None):
+    """Every search inside runs on one Dask client for ``scheduler`` (``local:N`` or ``tcp://host:port``); None: local."""
+    if scheduler is None or _CTX.get("client") is not None:
+        yield
+        return
+    with dask_session(scheduler) as client:
+        _CTX["client"] = client
+        try:
+            yield
+        finally:
+            _CTX.pop("client", None)
 
 
 def map_configs(cfgs: list[PlantConfig], conds: list[dict], workers: int) -> list[tuple[float, int, tuple]]:
@@ -185,7 +203,7 @@ def _condition_restarts(u_best: np.ndarray, best: tuple, workers: int, iteration
             continue
         _CTX["conds"] = [cond]  # the forked workers read it
         try:
-            r0 = _point_cost(u_start)
+            r0 = _point_cost(_CTX, u_start)
             u, b, n = _compass(np.asarray(u_start), r0, workers, iterations)
         finally:
             _CTX["conds"] = conds
@@ -229,7 +247,7 @@ def calibrate(cfg: PlantConfig, *, workers: int | None = None, sobol_points: int
               table: tuple[ParamHandle, ...] | None = None, conditions: dict | None = None,
               profiles: bool = True, targets: dict | None = None,
               compass_iterations: int = COMPASS_ITERATIONS, seeds: tuple[PlantConfig, ...] = (),
-              starts: int = STARTS, restarts: bool = True) -> Calibration:
+              starts: int = STARTS, restarts: bool = True, scheduler: str | None = None) -> Calibration:
     """Fit the unstated parameters and test conditions of ``cfg`` to the paper's figures.
 
     Parameters
@@ -256,7 +274,16 @@ def calibrate(cfg: PlantConfig, *, workers: int | None = None, sobol_points: int
         Compass searches from that many best points of the sample.
     restarts : bool
         Condition-set restarts: the compass again from the optimum under each other set of test conditions.
+    scheduler : str, optional
+        Evaluate the points on Dask (:func:`search_session`) instead of ``workers`` local processes.
     """
+    with search_session(scheduler):
+        return _calibrate(cfg, workers, sobol_points, table, conditions, profiles, targets, compass_iterations, seeds,
+                          starts, restarts)
+
+
+def _calibrate(cfg, workers, sobol_points, table, conditions, profiles, targets, compass_iterations, seeds, starts,
+               restarts) -> Calibration:
     workers = max(1, workers or available_cores())
     table = table if table is not None else unstated_for(cfg)
     params = list(table)

@@ -164,7 +164,7 @@ def _stage(name: str, cfg0: PlantConfig, table: tuple[ParamHandle, ...], workers
     params = list(table)
     cal_search._CTX.update(cfg=cfg0, params=params)
     u0 = np.array([fp.to_unit(fp.value_in(cfg0)) for fp in params])
-    b0 = cal_search._point_cost(u0)
+    b0 = cal_search._point_cost(cal_search._CTX, u0)
     u, b, n = cal_search._compass(u0, b0, workers, REACH_ITERATIONS, good_enough=INSIDE)
     n += 1
     reached = b[0] <= INSIDE

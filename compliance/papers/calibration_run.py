@@ -26,8 +26,10 @@ def _cpu_seconds() -> float:
     return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
 
 
-def calibrate_in_stages(cfg: PlantConfig, workers: int | None = None):
+def calibrate_in_stages(cfg: PlantConfig, workers: int | None = None, scheduler: str | None = None):
     """Parameters first; then the effect search; then parameters again with the named valve effect.
+
+    ``scheduler``: every stage's points on one Dask client (``local:N`` or ``tcp://host:port``).
 
     Returns
     -------
@@ -36,11 +38,19 @@ def calibrate_in_stages(cfg: PlantConfig, workers: int | None = None):
         effect-search results or [])
     """
     from compliance.effects import EFFECTS
+    from compliance.papers.calibration import search_session
+    from compliance.papers.calibration_table import NULL_FLOW_EFFECT
+
+    with_effect = NULL_FLOW_EFFECT in EFFECTS and NULL_FLOW_EFFECT not in cfg.effects
+    with search_session(scheduler):
+        return _stages(cfg, workers, with_effect)
+
+
+def _stages(cfg: PlantConfig, workers, with_effect: bool):
     from compliance.papers.calibration import calibrate
     from compliance.papers.calibration_effects import effect_search
     from compliance.papers.calibration_table import NULL_FLOW_EFFECT
 
-    with_effect = NULL_FLOW_EFFECT in EFFECTS and NULL_FLOW_EFFECT not in cfg.effects
     first = calibrate(cfg, workers=workers, profiles=not with_effect,
                       **({"sobol_points": FIRST_STAGE_SOBOL, "compass_iterations": FIRST_STAGE_COMPASS} if with_effect else {}))
     if not with_effect:
@@ -57,8 +67,8 @@ def calibrate_in_stages(cfg: PlantConfig, workers: int | None = None):
     return final, first, found
 
 
-def run_calibration(cfg: PlantConfig, out: str, json_path: str | None = None) -> int:
-    """Calibrate ``cfg`` to the paper's figures, print the stages, save to ``out``.
+def run_calibration(cfg: PlantConfig, out: str, json_path: str | None = None, scheduler: str | None = None) -> int:
+    """Calibrate ``cfg`` to the paper's figures, print the stages, save to ``out`` (``scheduler``: Dask, else local).
 
     Returns
     -------
@@ -75,7 +85,7 @@ def run_calibration(cfg: PlantConfig, out: str, json_path: str | None = None) ->
     if json_path:
         _check_writable(json_path)
     t0, c0 = time.perf_counter(), _cpu_seconds()
-    final, first, found = calibrate_in_stages(cfg)
+    final, first, found = calibrate_in_stages(cfg, scheduler=scheduler)
     wall, cpu = time.perf_counter() - t0, _cpu_seconds() - c0
     # serial: one figure's test is a few ms, less than a process pool costs per poll
     reach = reach_search(final.best, final.conditions, final.rows_after, workers=1)

@@ -79,6 +79,35 @@ def lugre_force(velocity, bristle, bristle_rate, stiffness, damping, viscous):
     return stiffness * bristle + damping * bristle_rate + viscous * velocity
 
 
+@njit(cache=True)
+def lugre_sampled_force(v, g, dt, sigma0, n_sub):
+    """LuGre bristle force sigma0*z [N] over a sampled velocity ``v`` [m/s] (Canudas de Wit et al. 1995).
+
+    The same bristle law as :func:`lugre_bristle_rate`, integrated along a measured motion (the
+    friction bench): for a velocity held over a substep h (``n_sub`` per sample step ``dt`` [s]),
+    dz/dt = v - (sigma0 |v| / g) z relaxes z towards g sign(v)/sigma0 with rate sigma0 |v| / g;
+    the update is exact for any h (no stiffness limit). ``g`` [N] is the Stribeck level per sample,
+    ``sigma0`` [N/m] the bristle stiffness.
+    """
+    n = v.size
+    out = np.empty(n)
+    z = g[0] * np.sign(v[0]) / sigma0 if v[0] != 0.0 else 0.0
+    out[0] = sigma0 * z
+    for k in range(1, n):
+        h = dt[k] / n_sub
+        for j in range(n_sub):
+            w = (j + 0.5) / n_sub
+            vv = v[k - 1] * (1.0 - w) + v[k] * w
+            gg = g[k - 1] * (1.0 - w) + g[k] * w
+            if vv == 0.0 or gg <= 0.0:
+                continue
+            zs = gg / sigma0 * (1.0 if vv > 0.0 else -1.0)
+            rate = sigma0 * abs(vv) / gg
+            z = zs + (z - zs) * math.exp(-rate * h)
+        out[k] = sigma0 * z
+    return out
+
+
 @njit(cache=True, error_model="numpy", inline="always")
 def piecewise_stribeck_friction(velocity, applied_force, breakaway_force, low_speed_coefficient, critical_velocity,
                                 high_speed_coefficient, limit_velocity):

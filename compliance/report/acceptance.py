@@ -13,7 +13,7 @@ from __future__ import annotations
 from compliance.errors import InputError
 from compliance.metrics import METRICS
 from compliance.metrics.catalogue import STEP_OPTION_DEFAULTS
-from compliance.report.requirement_pages import limit_text, metric_text
+from compliance.presentation.values import limit_as_written, metric_text
 from compliance.requirements.verdict import Status
 from compliance.units.amounts import parse_amount
 from compliance.units.formatting import fmt_value, unit_text
@@ -242,7 +242,7 @@ def conclusions(results: dict) -> list[dict]:
         elif e["status"] == Status.NOT_EVALUATED:
             finding = "not evaluated (see its page)"
         else:
-            finding = f"{value} against {limit_text(e)}" + (f" at {w.get('operating_point')}" if w.get("operating_point") else "")
+            finding = f"{value} against {limit_as_written(e)}" + (f" at {w.get('operating_point')}" if w.get("operating_point") else "")
         out.append({"id": e["id"], "status": e["status"], "severity": e["severity"], "finding": finding})
     return out
 

@@ -12,7 +12,8 @@ import hashlib
 import shlex
 
 from compliance.errors import InputError
-from compliance.report.requirement_pages import TOLERANCE_METRICS, limit_text, metric_text, reader_text
+from compliance.presentation.values import limit_as_written, metric_text, row_texts
+from compliance.report.requirement_pages import TOLERANCE_METRICS, reader_text
 from compliance.requirements.verdict import Basis, Overall, Status
 from compliance.units.formatting import fmt_margin_pct, fmt_num, unit_text
 
@@ -74,11 +75,6 @@ def check_results(results, where: str = "results") -> None:
 # --------------------------------------------------------------------------- formatting
 # the one formatter and status-word table live in compliance/units/formatting.py
 
-def fmt_metric(value, metric: str) -> str:
-    """A SI value of ``metric`` in its display unit (``0.0016`` m -> ``1.60 mm``)."""
-    return metric_text(value, metric)
-
-
 def setting_text(v) -> str:
     """A procedure setting as a reader reads it: units typeset, yes/no, lists joined."""
     if isinstance(v, bool):
@@ -111,23 +107,13 @@ def status_class(status: str | None) -> str:
 
 
 # --------------------------------------------------------------------------- sections
-def _display(row: dict, metric: str) -> dict:
-    """Value, limit and margin of a verdict row, formatted from the SI numbers (one source per figure)."""
-    d = {"value": fmt_metric(row.get("value"), metric)}
-    if row.get("limit"):
-        d["limit"] = " .. ".join(fmt_metric(v, metric) for v in row["limit"])
-    d["margin"] = fmt_metric(row.get("margin"), metric)
-    d["margin_pct"] = fmt_margin_pct(row.get("margin_pct"))
-    return d
-
-
 def summary_rows(results: dict) -> list[dict]:
     """One row per requirement: worst value, limit, margin, status, where the worst case was."""
     out = []
     run_ids = {r.get("id") for r in results.get("runs") or []}
     for e in results["requirements"]:
         w = e.get("worst") or {}
-        d = _display(w, e["metric"]) if w else {}
+        d = row_texts(w, e["metric"]) if w else {}
         reason = None
         if e["status"] == Status.NOT_EVALUATED:
             reason = "; ".join(sorted({r.get("reason") for r in e["rows"] if r.get("reason")})) or "not evaluated"
@@ -138,7 +124,7 @@ def summary_rows(results: dict) -> list[dict]:
             "id": e["id"], "title": e["title"], "metric": e["metric"], "severity": e["severity"],
             "source": e.get("source", "simulation"), "standard": e.get("standard"), "clause": e.get("clause"),
             "limit_text": e["limit_text"],
-            "limit": limit_text(e),
+            "limit": limit_as_written(e),
             "value": d.get("value", "\u2013"), "margin": d.get("margin", "\u2013") if w.get("margin") is not None else "\u2013",
             "margin_pct": d.get("margin_pct"), "status": e["status"], "where": where, "which": w.get("which"),
             "procedure": w.get("procedure"), "operating_point": w.get("operating_point"), "reason": reason,
@@ -162,7 +148,7 @@ def band_text(band, metric: str) -> str | None:
     """A verdict's value band under the declared parameter uncertainty (``{"low", "high"}``, SI) as text."""
     if not isinstance(band, dict) or band.get("low") is None or band.get("high") is None:
         return None
-    lo, hi = fmt_metric(band["low"], metric), fmt_metric(band["high"], metric)
+    lo, hi = metric_text(band["low"], metric), metric_text(band["high"], metric)
     return f"band {lo} to {hi}"
 
 
@@ -173,10 +159,10 @@ def _run_evidence(results: dict, run_id: str) -> list[dict]:
         for r in e["rows"]:
             if r.get("run") != run_id:
                 continue
-            d = _display(r, e["metric"])
+            d = row_texts(r, e["metric"])
             samples = []
             for s in r.get("samples") or []:
-                samples.append({"label": s.get("label"), "value": s.get("display") or fmt_metric(s.get("value"), e["metric"]),
+                samples.append({"label": s.get("label"), "value": s.get("display") or metric_text(s.get("value"), e["metric"]),
                                 "excluded": not s.get("eligible", True) or s.get("value") is None, "reason": s.get("reason")})
             rows.append({"id": e["id"], "metric": e["metric"], "value": d.get("value"), "which": r.get("which"),
                          "limit": d.get("limit") or ("open" if e.get("limit") is None else e["limit_text"]), "margin": d.get("margin") if r.get("margin") is not None else "\u2013",

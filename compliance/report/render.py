@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import base64
 import datetime as _dt
-import os
 import platform
+import threading
 import time
 from importlib import resources
 from pathlib import Path
@@ -37,7 +37,7 @@ from compliance.units.formatting import fmt_date, fmt_margin_pct, fmt_num, fmt_s
 
 TEMPLATES = resources.files("compliance.report") / "templates"
 VALIDATION_SCHEMA = "govcheck.validation/1"
-_FIG_CTX: dict = {}  # figure specs, set before worker processes fork (no pickling of traces)
+_DRAW_LOCK = threading.Lock()
 
 
 # --------------------------------------------------------------------------- figures
@@ -74,39 +74,24 @@ def _draw(spec: dict, valve: dict | None = None) -> str:
     raise ValueError(f"unknown figure kind {k!r}")
 
 
-def _draw_chunk(indices):
-    specs, valve = _FIG_CTX["specs"], _FIG_CTX["valve"]
-    return [(i, _draw(specs[i], valve)) for i in indices]
+def _draw_chunk(context, indices):
+    specs, valve = context
+    with _DRAW_LOCK:  # matplotlib is not thread-safe: a Dask worker with several threads draws one figure at a time
+        return [(i, _draw(specs[i], valve)) for i in indices]
 
 
-def draw_figures(specs: list[dict], valve: dict | None = None, workers: int | None = None) -> dict:
-    """Draw every figure spec -> ``{id: svg}``; in parallel (forked workers) when it pays."""
+def draw_figures(specs: list[dict], valve: dict | None = None, workers: int | None = None,
+                 scheduler: str | None = None) -> dict:
+    """Draw every figure spec -> ``{id: svg}``; in parallel on the one executor when it pays (or on Dask)."""
+    from compliance.processes import available_cores, map_tasks
+
     n = len(specs)
-    if workers is None:
-        try:
-            workers = len(os.sched_getaffinity(0))
-        except AttributeError:  # pragma: no cover - not Linux
-            workers = os.cpu_count() or 1
-    import multiprocessing as mp
-
-    workers = max(1, min(workers, n // 4))  # a worker pays off from ~4 figures (fork + import ~0.2 s)
-    out = {}
-    if workers == 1 or "fork" not in mp.get_all_start_methods():
-        for s in specs:
-            out[s["id"]] = _draw(s, valve)
-        return out
-    from compliance.processes import worker_pool
-
-    _FIG_CTX.update(specs=specs, valve=valve)
-    try:
-        chunks = [list(range(w, n, workers)) for w in range(workers)]  # interleaved: similar costs per worker
-        with worker_pool(workers) as pool:
-            for part in pool.map(_draw_chunk, chunks):
-                for i, svg in part:
-                    out[specs[i]["id"]] = svg
-    finally:
-        _FIG_CTX.clear()
-    return out
+    workers = max(1, min(available_cores() if workers is None else workers, n // 4))  # a worker pays off from ~4 figures (fork + import ~0.2 s)
+    chunks = [list(range(w, n, workers)) for w in range(workers)] if n else []  # interleaved: similar costs per worker
+    parts, stats = map_tasks(_draw_chunk, (specs, valve), chunks, workers=workers, scheduler=scheduler, progress=False,
+                             label="figures", retries=0)
+    stats.raise_if_failed()
+    return {specs[i]["id"]: svg for part in parts for i, svg in part}
 
 
 def _svg_data_uri(svg: str) -> str:
@@ -216,7 +201,7 @@ APPENDIX_LEVELS = ("none", "summary", "full")
 
 
 def build_report(results: dict, workers: int | None = None, appendix: str = "summary",
-                 document: dict | None = None) -> tuple[dict, dict]:
+                 document: dict | None = None, scheduler: str | None = None) -> tuple[dict, dict]:
     """Check the results and build the template context and the figures (no file written).
 
     ``appendix``: ``none`` (sign-off page, requirement pages, linear and validation sections),
@@ -231,7 +216,7 @@ def build_report(results: dict, workers: int | None = None, appendix: str = "sum
     specs += run_specs
     lin_ctx, lin_specs = linear_section(results.get("linear"), len(specs) + 1, results)
     val_ctx, val_specs = validation_section(results.get("validation"), len(specs) + len(lin_specs) + 1)
-    svgs = draw_figures(specs + lin_specs + val_specs, C.valve_marks(results), workers)
+    svgs = draw_figures(specs + lin_specs + val_specs, C.valve_marks(results), workers, scheduler)
     plant, rs, summary = results["plant"], results["requirement_set"], results["summary"]
     ctx = {
         **_common(results),
@@ -273,7 +258,7 @@ def build_report(results: dict, workers: int | None = None, appendix: str = "sum
 
 
 def render_report(results: dict, html_path=None, pdf_path=None, *, workers: int | None = None,
-                  appendix: str = "summary", document: dict | None = None) -> None:
+                  appendix: str = "summary", document: dict | None = None, scheduler: str | None = None) -> None:
     """Render the compliance report of a ``govcheck check`` results dict.
 
     Parameters
@@ -286,6 +271,8 @@ def render_report(results: dict, html_path=None, pdf_path=None, *, workers: int 
         Where to write the HTML and the PDF; at least one.
     workers : int, optional
         Processes drawing figures (default: the available cores).
+    scheduler : str, optional
+        Draw the figures on Dask instead (``local:N`` or ``tcp://host:port``).
     appendix : {"none", "summary", "full"}
         What follows the body: nothing; the configuration, requirement file, command and
         versions; or also every run with its figures.
@@ -304,7 +291,7 @@ def render_report(results: dict, html_path=None, pdf_path=None, *, workers: int 
         _check_target(html_path, "--report")
     if pdf_path:
         _check_target(pdf_path, "--pdf")
-    ctx, svgs = build_report(results, workers, appendix, document)
+    ctx, svgs = build_report(results, workers, appendix, document, scheduler)
     _emit("report.html.j2", ctx, svgs, html_path, pdf_path)
 
 
@@ -335,7 +322,7 @@ def check_validation(result, where: str = "validation results") -> None:
 
 
 def render_validation_report(result: dict, html_path, pdf_path=None, *, workers: int | None = None,
-                             document: dict | None = None) -> None:
+                             document: dict | None = None, scheduler: str | None = None) -> None:
     """Render the model-validation report of ``govcheck validate`` / ``govcheck diagnose``.
 
     Parameters
@@ -346,6 +333,8 @@ def render_validation_report(result: dict, html_path, pdf_path=None, *, workers:
         ``added``: effects with fitted parameters; ``explanation``: text).
     html_path : path
     pdf_path : path, optional
+    workers, scheduler
+        Processes drawing figures, or the Dask scheduler that draws them (as :func:`render_report`).
     document : dict, optional
         ``number``, ``revision`` and ``identity`` (the configuration's ``[identity]``) for the
         document control; without identity and number the report is a DRAFT.
@@ -358,7 +347,7 @@ def render_validation_report(result: dict, html_path, pdf_path=None, *, workers:
         _check_target(pdf_path, "--pdf")
     check_validation(result)
     ctx, specs = validation_section(result, 1)
-    svgs = draw_figures(specs, None, workers)
+    svgs = draw_figures(specs, None, workers, scheduler)
     plant = dict(result.get("plant") or {})
     plant["path"] = display_path(plant.get("path"))  # never an installation's absolute path
     ctx["recording"] = dict(ctx["recording"], path=display_path(ctx["recording"].get("path")))

@@ -12,6 +12,7 @@ from __future__ import annotations
 import re
 
 from compliance.metrics import METRICS
+from compliance.presentation.values import limit_as_written, metric_text
 from compliance.requirements.verdict import Status
 from compliance.units.formatting import fmt_margin_pct, fmt_value, unit_text
 
@@ -39,25 +40,6 @@ def reader_text(text) -> str:
     text = _DOC_REF_RE.sub("", text)
     text = _PAPER_SECTION_RE.sub(r"\1in the paper's section \2", text)  # never read as a section of this report
     return _MODULE_REF_RE.sub(lambda m: f"govcheck's {m.group(1).replace('_', ' ')} analysis", text)
-
-
-def metric_text(value, metric: str) -> str:
-    """A SI value of ``metric`` in its display unit, digits by metric (the one formatter)."""
-    info = METRICS.get(metric)
-    if info is None:
-        return fmt_value(value, "", 3, unicode=True)
-    return fmt_value(None if value is None else value * info.display_scale, info.display_unit, 3, unicode=True)
-
-
-def limit_text(e: dict) -> str:
-    """The limit of a requirement entry as a reader writes it (``≤ 1 % stroke (1.60 mm)``)."""
-    if e.get("limit") is None:
-        return "open (purchaser's data sheet)"
-    shown = (e.get("limit_display") or "").replace("<=", "\u2264").replace(">=", "\u2265")
-    written = (e.get("limit_text") or "").replace("<=", "\u2264").replace(">=", "\u2265").replace(" .. ", " \u2013 ")
-    if "stroke" in written and shown and shown != written:
-        return unit_text(f"{written} ({shown.split(' ', 1)[-1]})")
-    return unit_text(written or shown)
 
 
 def _step_facts(sample: dict, limit_si, metric: str) -> dict:
@@ -245,7 +227,7 @@ def requirement_pages(results: dict, start: int = 1) -> tuple[list[dict], list[d
             reqs.append({"id": e["id"], "title": e["title"], "status": e["status"], "severity": e["severity"],
                          "metric": e["metric"], "meaning": (METRICS.get(e["metric"]).meaning if METRICS.get(e["metric"]) else ""),
                          "standard": e.get("standard"), "clause": reader_text(e.get("clause")), "note": reader_text(e.get("note")),
-                         "limit": limit_text(e), "value": metric_text(w.get("value"), e["metric"]) if w else "\u2013",
+                         "limit": limit_as_written(e), "value": metric_text(w.get("value"), e["metric"]) if w else "\u2013",
                          "margin_pct": fmt_margin_pct(w.get("margin_pct")), "cases": cases,
                          "cannot_fail": sum(1 for c in cases if c["cannot_fail"]),
                          "not_evaluated": sum(len(c["ops"]) for c in cases if c["status"] == Status.NOT_EVALUATED)})

@@ -14,7 +14,7 @@ from collections import Counter
 from compliance.campaign.coverage import case_coverage, case_coverage_text
 from compliance.campaign.basis import verdict_qualifier
 from compliance.model.parameters import used_by_model
-from compliance.report.requirement_pages import limit_text, metric_text
+from compliance.presentation.values import limit_as_written, metric_text
 from compliance.requirements.verdict import Overall, Status
 from compliance.units.formatting import fmt_margin_pct, fmt_si
 
@@ -140,7 +140,7 @@ def failures(results: dict) -> list[dict]:
             continue
         w = e.get("worst") or {}
         out.append({"id": e["id"], "title": e["title"], "severity": e["severity"], "value": metric_text(w.get("value"), e["metric"]),
-                    "limit": limit_text(e), "margin_pct": fmt_margin_pct(w.get("margin_pct")),
+                    "limit": limit_as_written(e), "margin_pct": fmt_margin_pct(w.get("margin_pct")),
                     "where": f"{w.get('procedure')} at {w.get('operating_point')}" if w.get("procedure") else None,
                     "remedy": remedies.get(e["id"]), "anchor": "req-" + e["id"]})
     return out

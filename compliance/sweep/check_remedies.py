@@ -100,7 +100,7 @@ def remedies_for_check(cfg, reqset, sweep_file: str | None, *, workers=None, pro
     store : str or None
         Folder keeping every judged candidate, so an interrupted search resumes (``candidates.candidate_store``).
     """
-    from compliance.campaign.executor import dask_session
+    from compliance.processes import dask_session
     from compliance.sweep.sizing.hardware_catalogue import load_catalogue
     from compliance.sweep.remedies.finish import as_given, finish
     from compliance.sweep.remedies.staged_search import staged_search

@@ -81,7 +81,7 @@ def run_sweep(spec, out_dir, *, scheduler=None, workers=None, progress=True, cli
     cfg, reqset = load_inputs(spec)
     ctx = make_context(cfg, reqset, spec.paths, spec.linear)
     base = nominal_values(cfg, spec.paths)
-    from compliance.campaign.executor import dask_session
+    from compliance.processes import dask_session
     from compliance.sweep.candidates.runner import run_candidates
 
     cands = _candidates(spec)
@@ -141,7 +141,7 @@ def run_yield_file(spec, out_dir, candidate: dict, label: str, *, scheduler=None
     out = Path(out_dir)  # created at the end, with every result in hand
     cfg, reqset = load_inputs(spec)
     ctx = make_context(cfg, reqset, spec.paths, spec.linear)
-    from compliance.campaign.executor import dask_session
+    from compliance.processes import dask_session
 
     with dask_session(scheduler, client) as session:
         run_kw = {"scheduler": scheduler, "workers": workers, "progress": progress, "client": session}

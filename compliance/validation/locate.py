@@ -5,10 +5,9 @@ own noise floor, estimated from the recording (not from the model):
 
     floor = 1.4826 * MAD(diff(y)) / sqrt(2)
 
-over the samples at rest (all samples when the recording rests for less than
-``MIN_REST_SAMPLES``). For white sensor noise of standard deviation sigma, successive
-differences have standard deviation sigma*sqrt(2), and the MAD ignores the few large
-differences of fast transients. A minimum floor (a fraction of the signal's per-unit base)
+over the samples at rest (``recorded_noise.noise_floor``, the one noise-floor module). For
+white sensor noise of standard deviation sigma, successive differences have standard deviation
+sigma*sqrt(2), and the MAD ignores the few large differences of fast transients. A minimum floor (a fraction of the signal's per-unit base)
 keeps noise-free recordings from flagging round-off.
 
 The smoothed |r| (centred moving average over ``smoothing`` seconds) must rise above
@@ -26,11 +25,10 @@ import numpy as np
 import pandas as pd
 
 from compliance.errors import InputError
-from compliance.validation.recorded_noise import quantisation_std
+from compliance.validation.recorded_noise import noise_floor
 from compliance.validation.regimes import Regimes, attribute
 
 SIGNALS = ("position", "valve_command", "pressure_a", "pressure_b", "supply_pressure")
-MIN_REST_SAMPLES = 200
 MIN_FLOOR_PU = 1e-5  # minimum noise floor, per unit of the signal's base (1.6 um, 0.1 mV, 8 Pa on plant A)
 ONSET_SPAN = 0.2  # s; the regimes at a window's onset say more than its whole length when a misfit then persists
 
@@ -146,34 +144,6 @@ def residuals(recording: pd.DataFrame, simulated: pd.DataFrame, signals=SIGNALS,
             continue
         out[s] = recording[s].to_numpy(dtype=float) - simulated[s].to_numpy(dtype=float)
     return out
-
-
-def noise_floor(values: np.ndarray, rest: np.ndarray | None = None, minimum: float = 0.0, resolution: float = 0.0) -> float:
-    """Noise standard deviation of a recorded signal from its first differences (see module doc).
-
-    Parameters
-    ----------
-    values : ndarray
-        Recorded signal (SI).
-    rest : ndarray of bool, optional
-        Samples at rest; used when there are at least ``MIN_REST_SAMPLES`` consecutive pairs.
-    minimum : float
-        Lower bound of the result (SI).
-    resolution : float
-        Declared quantisation step (SI); 0: the lattice of the values, if any. The floor is never
-        below its q / sqrt(12) (``recorded_noise.quantisation_std``).
-    """
-    y = np.asarray(values, dtype=float)
-    d = np.diff(y)
-    if rest is not None:
-        pair = np.asarray(rest[1:], dtype=bool) & np.asarray(rest[:-1], dtype=bool)
-        if np.count_nonzero(pair) >= MIN_REST_SAMPLES:
-            d = d[pair]
-    q_std = quantisation_std(y, resolution)
-    if d.size == 0:
-        return max(float(minimum), q_std)
-    sigma = 1.4826 * float(np.median(np.abs(d - np.median(d)))) / math.sqrt(2.0)
-    return max(sigma, float(minimum), q_std)
 
 
 def smoothed_abs(time: np.ndarray, values: np.ndarray, window: float) -> np.ndarray:

@@ -14,6 +14,7 @@ import pandas as pd
 
 from compliance import __version__
 from compliance.errors import InputError
+from compliance.files.jsonable import jsonable
 from compliance.model.config import PlantConfig
 from compliance.validation.fit_metrics import SIGNAL_UNITS, derive_windows, per_unit_bases, signal_fit, window_metrics
 from compliance.validation.locate import locate, merge_across_signals
@@ -49,24 +50,6 @@ def decimation_indices(values: np.ndarray, max_points: int) -> np.ndarray:
         idx.append(np.array([full + int(np.argmin(tail)), full + int(np.argmax(tail))]))
     out = np.unique(np.concatenate(idx + [np.array([0, n - 1])]))
     return out[:max_points] if out.size > max_points else out
-
-
-def _clean(obj):
-    """Make a results tree JSON-ready: numpy scalars to Python, non-finite floats to None."""
-    if isinstance(obj, dict):
-        return {str(k): _clean(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_clean(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return [_clean(v) for v in obj.tolist()]
-    if isinstance(obj, (np.bool_, bool)):
-        return bool(obj)
-    if isinstance(obj, (np.integer,)):
-        return int(obj)
-    if isinstance(obj, (float, np.floating)):
-        f = float(obj)
-        return f if math.isfinite(f) else None
-    return obj
 
 
 def _round_list(a: np.ndarray, digits: int = 9) -> list:
@@ -155,10 +138,10 @@ def validate(cfg: PlantConfig, recording: pd.DataFrame, metadata: dict | None = 
         },
         "warnings": warnings,
     }
-    result = _clean(result)
+    result = jsonable(result)
     for mode, (overlays, resid) in traces.items():  # already JSON-ready (rounded lists)
         result["modes"][mode]["overlays"] = overlays
-        result["modes"][mode]["residuals"] = {s: {k: (_clean(v) if not isinstance(v, list) else v) for k, v in d.items()} for s, d in resid.items()}
+        result["modes"][mode]["residuals"] = {s: {k: (jsonable(v) if not isinstance(v, list) else v) for k, v in d.items()} for s, d in resid.items()}
     return result
 
 

@@ -371,6 +371,10 @@ case("report-missing", "report out/none.json", "not found")
 case("linear-at-text", "linear plant.toml --at middle", "--at")
 case("linear-load-unit", "linear plant.toml --load 5m", "--load")
 case("reproduce-plant-b", "reproduce plant-b", "tandem")
+# --scheduler: one spelling and one check on every command with parallel work
+case("bench-bad-scheduler", "diagnose-benchmark --scheduler local:0", "expected local:N with N >= 1")
+case("report-bad-scheduler", "report out/good.json --report out/r.html --scheduler ftp://x", "unknown address scheme")
+case("reproduce-scheduler-without-calibrate", "reproduce plant.toml --scheduler local:2", "add --calibrate")
 
 # ------------------------------------------------------------------------------------- output paths
 for cid, argv, frag in [

@@ -338,7 +338,7 @@ def test_noise_estimate_keeps_the_low_band_while_holding_and_follows_steps():
     holds, and across the step the estimate stays the short smoother's (no motion leaks in)."""
     from scipy.signal import savgol_filter
 
-    from compliance.diagnosis.evidence.noise_floor import HOLD_WINDOW, position_noise_estimate
+    from compliance.validation.recorded_noise import HOLD_WINDOW, position_noise_estimate
 
     rng = np.random.default_rng(5)
     t = np.arange(0.0, 6.0, 1e-3)

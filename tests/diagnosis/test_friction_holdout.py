@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from compliance.characterise.friction_map import piston_area, synthetic_friction_run
-from compliance.diagnosis.friction_bench.diagnose import FRICTION_RESIDUAL_LIMIT, diagnose_friction, prepare_runs
+from compliance.diagnosis.friction_bench.diagnose import FRICTION_RESIDUAL_LIMIT, diagnose_friction
+from compliance.diagnosis.friction_bench.runs import prepare_runs
 from compliance.diagnosis.friction_bench.fit import fit_law
 from compliance.diagnosis.friction_bench.holdout import earns, prove_out_of_sample
 from compliance.diagnosis.friction_bench.laws import position_factor

@@ -8,11 +8,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from compliance.diagnosis.evidence.noise_floor import sensor_noise_std
 from compliance.errors import InputError
-from compliance.validation.locate import noise_floor
 from compliance.validation.logger_model import LoggerModel, first_order_filter, logger_model
-from compliance.validation.recorded_noise import quantisation_std
+from compliance.validation.recorded_noise import noise_floor, quantisation_std, sensor_noise_std
 from compliance.validation.resampling import logged_indices, on_controller_clock
 
 

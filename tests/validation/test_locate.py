@@ -14,9 +14,9 @@ from compliance.validation.locate import (
     hysteresis_windows,
     locate,
     merge_across_signals,
-    noise_floor,
     smoothed_abs,
 )
+from compliance.validation.recorded_noise import noise_floor
 from compliance.simulation.profiles import Profile
 from compliance.recordings.synth import PRACTICE_NOISE, synthesise
 from compliance.validation.regimes import REVERSAL_SPAN, compute_regimes

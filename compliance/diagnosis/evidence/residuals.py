@@ -1,7 +1,7 @@
 """Replay residuals: normalised by each signal's noise floor, subsampled, summarised per signal and window.
 
 The fitted residual vector stacks, for every measured signal s, (recorded - model)/floor_s(t) at
-every ``stride``-th sample. A correct model leaves values of about one (evidence/noise_floor.py). The
+every ``stride``-th sample. A correct model leaves values of about one (validation/recorded_noise.py). The
 floor varies along the test: where a correct model's replay cannot follow the recording (slow
 stick-slip, where noise decides when the servo breaks away) it is as large as that replay's
 local error, so such stretches weigh in the fit by what they can tell (weighted least squares
@@ -18,7 +18,7 @@ import numpy as np
 
 from compliance.model.config import PlantConfig
 from compliance.errors import InputError, SimulationError
-from compliance.diagnosis.evidence.noise_floor import QUANTISED_SHARE, sensor_noise_std
+from compliance.validation.recorded_noise import QUANTISED_SHARE, sensor_noise_std
 from compliance.diagnosis.evidence.operating_point import load_at_start
 from compliance.diagnosis.evidence.replay_fit import ReplaySetup, run_replay
 from compliance.validation.fit_metrics import nrmse

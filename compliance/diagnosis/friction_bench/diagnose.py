@@ -9,7 +9,7 @@ once:
    bias c0 + c1 p_g) fitted by bounded least squares to every sample, residuals normalised by
    the force sensor's noise floor;
 2. locate: the baseline residual split into *after-reversal* stretches (the first
-   ``REVERSAL_TRAVEL`` of travel after each change of direction) and *steady sliding*; the
+   ``runs.REVERSAL_TRAVEL`` of travel after each change of direction) and *steady sliding*; the
    friction-magnitude error sign(v)*r in steady sliding is regressed on the pressure
    (a slope says the law misses a pressure dependence) and the after-reversal RMS is compared
    with the sliding RMS (an excess says the friction does not jump at reversals: pre-sliding);
@@ -22,31 +22,22 @@ once:
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
-from scipy.signal import savgol_filter
 
-from compliance.errors import InputError
 from compliance.files.jsonable import json_number
-from compliance.units import ATMOSPHERE_PA
 from compliance.diagnosis.friction_bench.fit import LAWS, PRESLIDING, PRESSURE_EFFECT, LawFit, fit_law
 from compliance.diagnosis.friction_bench.position import POSITION_FRICTION
 from compliance.diagnosis.friction_bench.explanation import explain_friction, format_friction  # noqa: F401 (re-exported)
 from compliance.diagnosis.friction_bench.holdout import holdout_words, position_words, prove_out_of_sample
-from compliance.diagnosis.friction_bench.runs import Run
-from compliance.diagnosis.evidence.noise_floor import sensor_noise_std
+from compliance.diagnosis.friction_bench.runs import Run, prepare_runs
 from compliance.diagnosis.servo.report_data import SCHEMA
 from compliance.diagnosis.friction_bench.residual_structure import friction_structure
 from compliance.diagnosis.servo.selection import EXPLAINED_ENOUGH, NOISE_TOLERANCE, score_all
 from compliance.diagnosis.verdicts.candidate_set import CandidateSet
 from compliance.diagnosis.verdicts.verdict import DiagnosisVerdict
 
-REVERSAL_TRAVEL = 2e-3  # m of travel after a change of direction counted as "after reversal"
-VELOCITY_WINDOW = 0.05  # s; Savitzky-Golay (quadratic) derivative window of the position
-MIN_SLIDING_SPEED = 1e-3  # m/s; slower samples are not "steady sliding"
 # a friction law is complete when its residual is within 3 x the force noise (our target for the real
 # seals): the floor here is the force sensor alone, while the law is evaluated on a velocity
 # differentiated from a noisy position, whose error adds ~1-2 x the force noise near the Stribeck hump
@@ -66,81 +57,6 @@ MEANING = {
     "reference_position": "x_r, centre of the position-dependent friction (median position of the runs; not fitted)",
     **{q.name: q.meaning for q in POSITION_FRICTION.params},
 }
-
-
-def seal_name(path: str) -> str:
-    """Seal label from a file name: ``O-ring257_3bar.csv`` -> ``O-ring257`` (text before the pressure)."""
-    stem = Path(path).name
-    for suf in (".gz", ".csv", ".txt", ".tsv", ".dat", ".parquet", ".mat"):
-        if stem.lower().endswith(suf):
-            stem = stem[: -len(suf)]
-    m = re.match(r"(.*?)[_\- ]?\d+(\.\d+)?\s*bar.*$", stem, flags=re.IGNORECASE)
-    return (m.group(1) if m and m.group(1) else stem) or stem
-
-
-def _reversal_masks(position: np.ndarray, velocity: np.ndarray, travel: float) -> tuple[np.ndarray, np.ndarray]:
-    n = velocity.size
-    after = np.zeros(n, dtype=bool)
-    moving = np.abs(velocity) > MIN_SLIDING_SPEED
-    sign = np.sign(velocity)
-    last_sign = 0.0
-    start_x = None
-    for k in range(n):
-        if moving[k] and sign[k] != last_sign:
-            if last_sign != 0.0:
-                start_x = position[k]
-            last_sign = sign[k]
-        if start_x is not None:
-            if abs(position[k] - start_x) <= travel:
-                after[k] = True
-            else:
-                start_x = None
-    # the slow approach to a reversal belongs to it too
-    after |= ~moving
-    return after, moving & ~after
-
-
-def prepare_runs(runs, bore: float | None) -> list[Run]:
-    """Friction samples of each run: velocity, gauge pressure, measured friction, reversal masks.
-
-    Parameters
-    ----------
-    runs : sequence of (DataFrame, metadata)
-        ``read_recording`` output with ``time``, ``position``, ``pressure_a``, ``force``.
-    bore : float or None
-        Piston bore [m] (else the metadata's ``bore``).
-    """
-    out = []
-    for frame, meta in runs:
-        src = str(meta.get("source_path", "<recording>"))
-        for col in ("time", "position", "pressure_a", "force"):
-            if col not in frame.columns:
-                raise InputError(f"{src}: a friction-bench run needs column '{col}' (has {', '.join(frame.columns)})")
-        d = bore if bore is not None else meta.get("bore")
-        if not isinstance(d, (int, float)) or not d > 0:
-            raise InputError(f"{src}: no piston bore: pass --friction-bore \"25.7 mm\" or give 'bore' in the column map's [metadata]")
-        area = math.pi * float(d) ** 2 / 4.0
-        t = frame["time"].to_numpy(dtype=float)
-        x = frame["position"].to_numpy(dtype=float)
-        dt = float(np.median(np.diff(t)))
-        w = max(5, int(round(VELOCITY_WINDOW / dt)) | 1)
-        if t.size < 4 * w:
-            raise InputError(f"{src}: {t.size} samples are too few for a friction diagnosis (need >= {4 * w})")
-        v = savgol_filter(x, w, 2, deriv=1, delta=dt)
-        pg = frame["pressure_a"].to_numpy(dtype=float) - ATMOSPHERE_PA
-        f = frame["force"].to_numpy(dtype=float) - pg * area  # Zillen et al. eq. (3)
-        after, sliding = _reversal_masks(x, v, REVERSAL_TRAVEL)
-        if not np.any(sliding):
-            raise InputError(f"{src}: the piston never slides faster than {MIN_SLIDING_SPEED*1e3:g} mm/s: no friction law to fit")
-        floor = max(sensor_noise_std(frame["force"].to_numpy(dtype=float)), 1e-3)
-        # the derivative window smears a reversal over +/- w/2 samples: there the estimated speed is not
-        # the piston's and no friction law can be judged on it (all laws lose the same samples)
-        valid = np.ones(t.size, dtype=bool)
-        sgn = np.sign(v)
-        for k in np.flatnonzero(sgn[1:] * sgn[:-1] < 0):
-            valid[max(k - w // 2, 0):k + w // 2 + 2] = False
-        out.append(Run(Path(src).name, seal_name(src), t - t[0], x, v, pg, f, after, sliding, floor, valid))
-    return out
 
 
 # ----------------------------------------------------------------------------- locate

@@ -19,7 +19,7 @@ sample. Per run the table gives
 that only describes the runs it saw degrades far more out of sample. An added effect is kept
 only when it *earns its parameters on held-out runs* (``earns``): it lowers the held-out error
 of at least ``EARN_FOLDS`` of the runs and the median held-out error by ``EARN_GAIN``.
-The folds run on the shared executor (``campaign.executor.map_tasks``).
+The folds run on the shared executor (``processes.map_tasks``).
 """
 
 from __future__ import annotations
@@ -51,7 +51,7 @@ def held_out_residuals(runs, full: LawFit, *, jobs: int | None = None, scheduler
     """Each run's residual [N] under the law ``full.name`` refitted without it (None: fewer than ``MIN_RUNS`` runs)."""
     if len(runs) < MIN_RUNS:
         return None
-    from compliance.campaign.executor import map_tasks
+    from compliance.processes import map_tasks
 
     res, stats = map_tasks(_fold, (runs, full.name, start_from(full.params)), list(range(len(runs))), workers=jobs,
                            scheduler=scheduler, progress=False, label="held-out fits", retries=0)

@@ -18,39 +18,11 @@ F_f the seal friction. Three friction laws, nested:
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numba import njit
 
-from compliance.physics.friction import stribeck_magnitude
+from compliance.physics.friction import lugre_sampled_force, stribeck_magnitude
 from compliance.diagnosis.friction_bench.position import MIN_FACTOR
-
-
-@njit(cache=True)
-def _lugre_force(v, g, dt, sigma0, n_sub):
-    """LuGre bristle force sigma0*z over a sampled velocity (exact exponential update per substep).
-
-    For a velocity held over a substep h, dz/dt = v - (sigma0 |v| / g) z relaxes z towards
-    g sign(v)/sigma0 with rate sigma0 |v| / g; the update is exact for any h (no stiffness limit).
-    """
-    n = v.size
-    out = np.empty(n)
-    z = g[0] * np.sign(v[0]) / sigma0 if v[0] != 0.0 else 0.0
-    out[0] = sigma0 * z
-    for k in range(1, n):
-        h = dt[k] / n_sub
-        for j in range(n_sub):
-            w = (j + 0.5) / n_sub
-            vv = v[k - 1] * (1.0 - w) + v[k] * w
-            gg = g[k - 1] * (1.0 - w) + g[k] * w
-            if vv == 0.0 or gg <= 0.0:
-                continue
-            zs = gg / sigma0 * (1.0 if vv > 0.0 else -1.0)
-            rate = sigma0 * abs(vv) / gg
-            z = zs + (z - zs) * math.exp(-rate * h)
-        out[k] = sigma0 * z
-    return out
 
 
 @njit(cache=True)
@@ -112,7 +84,7 @@ def friction_force(velocity, pressure_gauge, time, params: dict, *, presliding: 
                        params.get("pressure_coefficient", 0.0)) * position_factor(position, params)
     if presliding:
         dt = np.concatenate(([0.0], np.diff(np.asarray(time, dtype=float))))
-        return _lugre_force(np.ascontiguousarray(v), np.ascontiguousarray(g), dt, float(params["bristle_stiffness"]), n_sub) \
+        return lugre_sampled_force(np.ascontiguousarray(v), np.ascontiguousarray(g), dt, float(params["bristle_stiffness"]), n_sub) \
             + params["viscous"] * v
     return np.sign(v) * g + params["viscous"] * v
 

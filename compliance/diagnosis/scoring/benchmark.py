@@ -169,29 +169,26 @@ def make_case(cfg: PlantConfig, kind: str, truth: str, seed: int) -> Case:
     return miscalibration_case(cfg, truth, seed)
 
 
-_BENCH: dict = {}
-
-
-def _init(cfg_text: str, library, diag_jobs: int) -> None:
+def _bench_context(cfg_text: str, library, diag_jobs: int) -> dict:
+    """What every case of a worker shares: the plant (built once per worker process), the library, the fit processes."""
     import tomllib
 
     from compliance.model.config import plant_from_dict
 
-    _BENCH["cfg"] = plant_from_dict(tomllib.loads(cfg_text), "<benchmark plant>")
-    _BENCH["library"] = library
-    _BENCH["jobs"] = diag_jobs
+    return {"cfg": plant_from_dict(tomllib.loads(cfg_text), "<benchmark plant>"), "library": library, "jobs": diag_jobs}
 
 
-def _run_one(item) -> CaseResult:
+def _run_one(context, item) -> CaseResult:
     from compliance.diagnosis.servo.diagnose import diagnose
 
     from compliance.errors import GovcheckError
 
     kind, truth, seed = item
-    cfg = _BENCH["cfg"]
+    bench = context.get()
+    cfg = bench["cfg"]
     try:
         case = make_case(cfg, kind, truth, seed)
-        diag = diagnose(cfg, case.frame, case.meta, effects=_BENCH["library"], jobs=_BENCH["jobs"])
+        diag = diagnose(cfg, case.frame, case.meta, effects=bench["library"], jobs=bench["jobs"])
     except GovcheckError as exc:  # a case that cannot be generated or diagnosed counts as a failure, with its reason
         return CaseResult(kind=kind, truth=truth, predicted="error", verdict=f"error: {exc}", correct=False, seed=seed,
                           operating_point={}, true_params={})
@@ -199,7 +196,7 @@ def _run_one(item) -> CaseResult:
 
 
 def run_benchmark(cfg: PlantConfig, *, effects=None, cases: int = 3, seed: int = 1, library=None, jobs: int = 1,
-                  null: bool = True, miscalibrations: bool = True, progress=None) -> dict:
+                  null: bool = True, miscalibrations: bool = True, progress=None, scheduler: str | None = None) -> dict:
     """Generate and diagnose the benchmark cases; return per-case rows and the summary.
 
     Parameters
@@ -215,33 +212,24 @@ def run_benchmark(cfg: PlantConfig, *, effects=None, cases: int = 3, seed: int =
         Candidate effects the diagnosis may choose from (default: all).
     jobs : int
         Cases diagnosed in parallel (each diagnosis runs serially).
+    scheduler : str, optional
+        Dask scheduler for the cases (``local:N`` or ``tcp://host:port``; ``processes.map_tasks``).
     null, miscalibrations : bool
         Include null / miscalibration cases.
     progress : callable, optional
         Called with each CaseResult as it completes.
     """
     from compliance.model.config import plant_to_toml
+    from compliance.processes import PerProcess, map_tasks
 
     effects = list(EFFECTS) if effects is None else list(effects)
     plan = case_plan(effects, cases, seed, null=null, miscalibrations=miscalibrations)
     t0 = time.perf_counter()
     payload = (plant_to_toml(cfg), None if library is None else list(library), 1)
-    results: list[CaseResult] = []
-    if jobs <= 1:
-        _init(*payload)
-        for item in plan:
-            r = _run_one(item)
-            results.append(r)
-            if progress:
-                progress(r)
-    else:
-        from compliance.processes import worker_pool
-
-        with worker_pool(jobs, initializer=_init, initargs=payload) as ex:
-            for r in ex.map(_run_one, plan):
-                results.append(r)
-                if progress:
-                    progress(r)
+    results, stats = map_tasks(_run_one, PerProcess(_bench_context, *payload), plan, workers=jobs, scheduler=scheduler,
+                               progress=False, label="cases", retries=0,
+                               on_result=(lambda i, r: progress(r)) if progress else None)
+    stats.raise_if_failed()
     return {"cases": [r.__dict__ for r in results], "summary": summarise(results, effects), "seconds": time.perf_counter() - t0,
             "seed": seed, "cases_per_effect": cases}
 
@@ -340,20 +328,52 @@ def format_summary(report: dict) -> str:
 ANSWER_ALIASES = {alias: f"{name}.{p.name}" for name, eff in EFFECTS.items() for p in eff.params for alias in p.aliases}
 
 
-def run_practice(directory, cfg: PlantConfig, *, library=None, jobs: int = 1, progress=None) -> dict:
+def _practice_row(context, item) -> dict:
+    """Diagnose one practice recording and score it against its answer."""
+    from compliance.diagnosis.scoring.practice_score import answer_in_si, main_parameter, practice_correct
+    from compliance.diagnosis.servo.diagnose import diagnose
+    from compliance.recordings.reader import read_recording
+
+    cfg, library, jobs = context
+    name, ans, path = item
+    frame, meta = read_recording(path)
+    d = diagnose(cfg, frame, meta, effects=library, jobs=jobs)
+    truth = list(ans.get("effects") or [])
+    correct, ambiguous_ok = practice_correct(d, truth, ans.get("accept"))
+    fitted = {}
+    if d.winner:
+        fit = d.fits[d.winner]
+        fitted = {fp.key: v for fp, v in zip(fit.params, fit.values)}
+    params = {}
+    for alias, value in (ans.get("parameters") or {}).items():
+        key = ANSWER_ALIASES.get(alias, alias)
+        got = fitted.get(key)
+        value = answer_in_si(alias, value)
+        params[alias] = {"true": value, "fitted": got, "error": None if got is None else abs(got - value) / abs(value)}
+    return {"name": name, "truth": ", ".join(truth) or "none", "verdict": d.verdict, "winner": d.winner,
+            "correct": bool(correct), "ambiguous_with_truth": ambiguous_ok, "ambiguity": list(d.ambiguous),
+            "signals_left": dict(d.signals_left), "parameters": params, "seconds": d.seconds,
+            "simulations": d.simulations, "explanation": d.explanation, "fit_before": d.fit_before, "fit_after": d.fit_after, "main": main_parameter(d, truth, params),
+            # the verdict's own yardstick (re-synchronised replay, x floor), every fitted value, the lag scan
+            "objective_before": d.objective_before, "objective_after": d.objective_after, "fitted": fitted,
+            "split": d.split}
+
+
+def run_practice(directory, cfg: PlantConfig, *, library=None, jobs: int = 1, progress=None,
+                 scheduler: str | None = None) -> dict:
     """Diagnose every recording of a directory and score it against the directory's ANSWERS.json.
 
     ANSWERS.json maps a recording name (file name without ``.csv``/``.csv.gz``) to
     ``{"effects": [...], "parameters": {name: value}}``; an empty effect list means "no effect"
     (the right verdict is ``no_mismatch``; ``parameters_only`` is also accepted as "no missing physics").
+    Locally the recordings are diagnosed one after the other, each on ``jobs`` processes; with a Dask
+    ``scheduler`` the recordings run side by side, each diagnosis in one process.
     """
     import json
     from pathlib import Path
 
     from compliance.errors import InputError
-    from compliance.recordings.reader import read_recording
-    from compliance.diagnosis.servo.diagnose import diagnose
-    from compliance.diagnosis.scoring.practice_score import answer_in_si, main_parameter, practice_correct
+    from compliance.processes import map_tasks
 
     folder = Path(directory)
     answers_path = folder / "ANSWERS.json"
@@ -363,35 +383,16 @@ def run_practice(directory, cfg: PlantConfig, *, library=None, jobs: int = 1, pr
         answers = json.loads(answers_path.read_text())
     except json.JSONDecodeError as exc:
         raise InputError(f"{answers_path}: not valid JSON ({exc})") from None
-    rows = []
+    items = []
     for name, ans in sorted(answers.items()):
         files = [p for p in (folder / f"{name}.csv.gz", folder / f"{name}.csv") if p.is_file()]
         if not files:
             raise InputError(f"{answers_path}: '{name}' has no {name}.csv(.gz) beside it")
-        frame, meta = read_recording(files[0])
-        d = diagnose(cfg, frame, meta, effects=library, jobs=jobs)
-        truth = list(ans.get("effects") or [])
-        correct, ambiguous_ok = practice_correct(d, truth, ans.get("accept"))
-        fitted = {}
-        if d.winner:
-            fit = d.fits[d.winner]
-            fitted = {fp.key: v for fp, v in zip(fit.params, fit.values)}
-        params = {}
-        for alias, value in (ans.get("parameters") or {}).items():
-            key = ANSWER_ALIASES.get(alias, alias)
-            got = fitted.get(key)
-            value = answer_in_si(alias, value)
-            params[alias] = {"true": value, "fitted": got, "error": None if got is None else abs(got - value) / abs(value)}
-        rows.append({"name": name, "truth": ", ".join(truth) or "none", "verdict": d.verdict, "winner": d.winner,
-                     "correct": bool(correct), "ambiguous_with_truth": ambiguous_ok, "ambiguity": list(d.ambiguous),
-                     "signals_left": dict(d.signals_left), "parameters": params, "seconds": d.seconds, "simulations": d.simulations,
-                     "explanation": d.explanation,
-                     "fit_before": d.fit_before, "fit_after": d.fit_after, "main": main_parameter(d, truth, params),
-                     # the verdict's own yardstick (re-synchronised replay, x floor), every fitted value, the lag scan
-                     "objective_before": d.objective_before, "objective_after": d.objective_after, "fitted": fitted,
-                     "split": d.split})
-        if progress is not None:
-            progress(rows[-1])
+        items.append((name, ans, files[0]))
+    rows, stats = map_tasks(_practice_row, (cfg, library, jobs if scheduler is None else 1), items, workers=1,
+                            scheduler=scheduler, progress=False, label="recordings", retries=0,
+                            on_result=(lambda i, row: progress(row)) if progress is not None else None)
+    stats.raise_if_failed()
     mains = [r["main"] for r in rows if r["main"]]
     return {"recordings": rows, "correct": sum(r["correct"] for r in rows), "main_scored": len(mains),
             "main_within_25": sum(m["within_25"] for m in mains),

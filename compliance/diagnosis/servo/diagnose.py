@@ -46,9 +46,10 @@ from compliance.diagnosis.servo.report_data import SCHEMA
 from compliance.diagnosis.servo.result import Diagnosis
 from compliance.diagnosis.evidence.locate_misfit import event_rms, locate_mismatch, mask_agreement, where_words
 from compliance.diagnosis.servo.parallel_fits import (ExtendSet, FitEffect, FitWithBase, RecalibrateBase, RefitSet, ScreenAddition,
-                                                     default_jobs, map_tasks)
+                                                     run_fits)
 from compliance.diagnosis.verdicts.candidate_set import BASE, CandidateSet
 from compliance.diagnosis.verdicts.verdict import EXPLAINED, INCOMPLETE, DiagnosisVerdict
+from compliance.processes import available_cores
 
 COMBINE_LEVEL = 3.0  # chi2/N of the best single explanation above which effects are refitted with the recalibration
 COMBINE_TOP = 1  # how many effects are refitted with the recalibration
@@ -125,7 +126,7 @@ def _based_search(cfg: PlantConfig, frame, meta: dict, stride: int, jobs: int, n
 
 
 def _run(st: Stage, tasks) -> None:
-    for res, v in map_tasks(tasks, st.jobs, st.payload):
+    for res, v in run_fits(tasks, st.jobs, st.payload):
         st.fits[res.name] = res
         st.vecs[res.name] = v
         st.sims += res.sims
@@ -164,7 +165,7 @@ def _search_sets(st: Stage, winner: str) -> list[dict]:
             break
         have = set(CandidateSet.parse(current.name).effects)
         singles = [f for f in st.fits.values() if f.name in EFFECTS and f.name not in have]
-        screened = [r for r, _ in map_tasks([ScreenAddition(current, f) for f in singles], st.jobs, st.payload)]
+        screened = [r for r, _ in run_fits([ScreenAddition(current, f) for f in singles], st.jobs, st.payload)]
         screen = {name: (chi, start) for name, chi, start, _ in screened}
         st.sims += sum(r[3] for r in screened)
         level = screen_level(current.chi2, n)  # an addition whose screen removes too little is not refitted
@@ -314,7 +315,7 @@ def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | N
         Unknown effect names, a recording the replay cannot use.
     """
     t0 = time.perf_counter()
-    jobs = default_jobs() if jobs is None else max(1, int(jobs))
+    jobs = available_cores() if jobs is None else max(1, int(jobs))
     names = check_effects(cfg, effects)
     cfg, st, form, dec = _based_search(cfg, frame, meta, stride, jobs, names, recalibrate)
     winner, verdict_name = dec["winner"], dec["verdict"]
@@ -391,4 +392,4 @@ def _safe_replay(cfg: PlantConfig, setup: ReplaySetup, notes: list, what: str):
         return None
 
 
-__all__ = ["Diagnosis", "Stage", "diagnose", "prepare_recording", "check_effects", "save_fitted", "default_jobs", "SCHEMA", "UNITS", "NOISE_TOLERANCE"]
+__all__ = ["Diagnosis", "Stage", "diagnose", "prepare_recording", "check_effects", "save_fitted", "SCHEMA", "UNITS", "NOISE_TOLERANCE"]

@@ -37,7 +37,7 @@ from compliance.diagnosis.servo.candidates import effect_candidate
 from compliance.diagnosis.servo.fit import chi2_parts
 from compliance.diagnosis.evidence.replay_fit import run_replay
 from compliance.diagnosis.servo.selection import MIN_GAIN, SIGNIFICANCE, beats, score_all
-from compliance.diagnosis.servo.parallel_fits import FitEffect, map_tasks
+from compliance.diagnosis.servo.parallel_fits import FitEffect, run_fits
 
 OPTION = "friction.model"
 # forms with one steady-state map (same parameters); the piecewise Stribeck law (seed 001 eq. 8)
@@ -130,7 +130,7 @@ def form_after_effects(check: dict, rc, setup, model, fits: dict, jobs: int) -> 
     order = sorted(screened, key=screened.get)[:FORM_REFITS]
     payload = (plant_to_toml(rc.replace(options={OPTION: other})), setup, model)
     tasks = [FitEffect(effect_candidate(e)) for e in order]
-    refits = {f"{r.name}@{other}": r for r, _ in map_tasks(tasks, jobs, payload)} if tasks else {}
+    refits = {f"{r.name}@{other}": r for r, _ in run_fits(tasks, jobs, payload)} if tasks else {}
     replays += sum(r.sims + 1 for r in refits.values())
     out["replays"] = check["replays"] + replays
     scores = score_all({**fits, **refits}, model.size)

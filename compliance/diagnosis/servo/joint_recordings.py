@@ -19,7 +19,7 @@ supply they are not.
 
 An effect none of whose declared grid points removes ``SCREEN_SHARE`` (2 %) of the nominal
 excess chi-square is not refined (reported at its best grid point, marked ``screened``): each
-refinement costs one replay per recording per step. The candidate fits run on the shared executor (``campaign.executor.map_tasks``; a Dask
+refinement costs one replay per recording per step. The candidate fits run on the shared executor (``processes.map_tasks``; a Dask
 scheduler with ``scheduler``). Not done jointly (the single-recording diagnosis does them):
 the multi-effect search, the friction-form check, the empirical term and the lag split.
 """
@@ -43,7 +43,6 @@ from compliance.diagnosis.servo.selection import AMBIGUOUS_BIC, RESIDUAL_LIMIT, 
 from compliance.diagnosis.verdicts.verdict import EXPLAINED, DiagnosisVerdict
 from compliance.diagnosis.servo.parallel_fits import FitEffect, RecalibrateBase
 
-_WORKER: dict = {}  # token -> JointContext, built once per worker process
 
 
 @dataclass
@@ -116,18 +115,15 @@ class JointContext:
         return np.concatenate(vecs), (None if any(s is None for s in sims) else sims)
 
 
-def _worker_context(payload) -> JointContext:
-    token, labels, parts = payload
-    if token not in _WORKER:
-        ctxs = [FitContext(plant_from_dict(tomllib.loads(t), "<joint diagnosis>"), setup, model) for t, setup, model in parts]
-        _WORKER.clear()
-        _WORKER[token] = JointContext(ctxs, list(labels))
-    return _WORKER[token]
+def _joint_context(labels, parts) -> JointContext:
+    """The fit context of every recording, built once per worker process (``PerProcess``)."""
+    ctxs = [FitContext(plant_from_dict(tomllib.loads(t), "<joint diagnosis>"), setup, model) for t, setup, model in parts]
+    return JointContext(ctxs, list(labels))
 
 
-def _task(payload, task) -> FitResult:
+def _task(context, task) -> FitResult:
     """One joint fit on a worker: a ``RecalibrateBase`` or a ``FitEffect`` (``servo.parallel_fits``)."""
-    return task.fit(_worker_context(payload))
+    return task.fit(context.get())
 
 
 def _prepare_task(context, item):
@@ -204,7 +200,8 @@ def _conditions(stage) -> dict:
 
 def _stages(cfg: PlantConfig, recordings, stride: int, jobs, scheduler) -> tuple[list, list]:
     """Stages 1-2 of the single-recording engine on each recording, in parallel; labels R1, R2, ... in order."""
-    from compliance.campaign.executor import map_tasks, warm_up
+    from compliance.campaign.executor import warm_up
+    from compliance.processes import map_tasks
 
     for i, (frame, meta) in enumerate(recordings, 1):
         if "reference" not in frame.columns:
@@ -221,7 +218,7 @@ def _stages(cfg: PlantConfig, recordings, stride: int, jobs, scheduler) -> tuple
 def _fit_all(stages, labels, names, recalibrate, jobs, scheduler) -> tuple[dict, object]:
     """Stage 3, joint: the recalibration and one fit per effect, each with one parameter set for every recording."""
     from compliance.model.config import plant_to_toml
-    from compliance.campaign.executor import map_tasks
+    from compliance.processes import PerProcess, map_tasks
 
     n = sum(s.model.size for s in stages)
     chi2_nom = sum(s.fits["nominal"].chi2 for s in stages)
@@ -236,8 +233,7 @@ def _fit_all(stages, labels, names, recalibrate, jobs, scheduler) -> tuple[dict,
         tasks.append(RecalibrateBase(bparams, 2.0 * math.log(n) * max(1.0, chi2_nom / n)))
     screen = screen_level(chi2_nom, n)  # an effect none of whose grid points removes SCREEN_SHARE of the excess: not refined
     tasks += [FitEffect(effect_candidate(e), screen) for e in signature_order(names, excess)]
-    token = f"joint-{time.time_ns()}"
-    payload = (token, tuple(labels), [(plant_to_toml(s.rc), s.setup, s.model) for s in stages])
+    payload = PerProcess(_joint_context, tuple(labels), [(plant_to_toml(s.rc), s.setup, s.model) for s in stages])
     results, stats = map_tasks(_task, payload, tasks, workers=jobs, scheduler=scheduler, progress=False,
                                label="joint fits", retries=1)
     if stats.failed:

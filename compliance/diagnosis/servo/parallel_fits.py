@@ -1,14 +1,13 @@
-"""Parallel fits of one diagnosis: worker processes that each hold the recording's fit context.
+"""Parallel fits of one diagnosis on the one executor: each worker holds the recording's fit context.
 
-The recording's replay set-up and residual model are sent once per worker (initializer); each
-task is a small frozen record of what to fit (``RecalibrateBase``, ``FitEffect``, ``FitWithBase``,
-``ExtendSet``) or to screen (``ScreenAddition``), run by ``_run_task``. Processes are forked where the platform
-allows it (no re-import of the compiled core).
+The recording's replay set-up and residual model are the executor's context, built into a
+``FitContext`` once per worker process (:class:`~compliance.processes.PerProcess`); each task is a
+small frozen record of what to fit (``RecalibrateBase``, ``FitEffect``, ``FitWithBase``, ``ExtendSet``,
+``RefitSet``) or to screen (``ScreenAddition``), run by ``_run_task``.
 """
 
 from __future__ import annotations
 
-import os
 import tomllib
 from dataclasses import dataclass
 
@@ -19,8 +18,7 @@ from compliance.diagnosis.servo.fit import FitContext, FitResult, fit_candidate,
 from compliance.diagnosis.servo.recalibration import forward_select_base
 from compliance.diagnosis.servo.effect_sets import SET_SIMPLEX_FEV, extend_fit, screen_addition
 from compliance.diagnosis.evidence.replay_fit import ReplaySetup
-
-_WORKER: dict = {}
+from compliance.processes import PerProcess, map_tasks
 
 
 @dataclass(frozen=True)
@@ -94,15 +92,14 @@ class ScreenAddition:
     single: FitResult
 
 
-def _init_worker(toml_text: str, setup: ReplaySetup, model) -> None:
-    cfg = plant_from_dict(tomllib.loads(toml_text), "<diagnosis>")
-    _WORKER["ctx"] = FitContext(cfg, setup, model)
+def _fit_context(toml_text: str, setup: ReplaySetup, model) -> FitContext:
+    return FitContext(plant_from_dict(tomllib.loads(toml_text), "<diagnosis>"), setup, model)
 
 
-def _run_task(task):
+def _run_task(context: PerProcess, task):
     """One unit of parallel work: a fit -> (FitResult, residual vector); a screen -> ((effect, chi-square,
     start, replays) of ``effect_sets.screen_addition``, None): no fit, no residual."""
-    ctx: FitContext = _WORKER["ctx"]
+    ctx: FitContext = context.get()
     if isinstance(task, ScreenAddition):
         return screen_addition(ctx, task.current, task.single), None
     res = task.fit(ctx)
@@ -112,28 +109,15 @@ def _run_task(task):
     return res, vec
 
 
-def map_tasks(tasks, jobs: int, payload):
-    if jobs <= 1 or len(tasks) <= 1:
-        _init_worker(*payload)
-        return [_run_task(t) for t in tasks]
-    import multiprocessing as mp
+def run_fits(tasks, jobs: int, payload, scheduler: str | None = None) -> list:
+    """(result, residual vector) of every fit task, in task order, on ``jobs`` processes (or Dask).
 
-    try:
-        ctx = mp.get_context("fork")
-    except ValueError:  # pragma: no cover - platforms without fork
-        ctx = mp.get_context()
-    from compliance.processes import worker_pool
-
-    with worker_pool(min(jobs, len(tasks)), ctx, initializer=_init_worker, initargs=payload) as ex:
-        return list(ex.map(_run_task, tasks))
+    ``payload`` is (plant TOML text, replay set-up, residual model); a task that raises raises here.
+    """
+    results, stats = map_tasks(_run_task, PerProcess(_fit_context, *payload), list(tasks), workers=jobs,
+                               scheduler=scheduler, progress=False, label="fits", retries=0)
+    stats.raise_if_failed()
+    return results
 
 
-def default_jobs() -> int:
-    """Worker processes by default: the cores this process may use."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:  # pragma: no cover
-        return max(1, os.cpu_count() or 1)
-
-
-__all__ = ["map_tasks", "default_jobs"]
+__all__ = ["ExtendSet", "FitEffect", "FitWithBase", "RecalibrateBase", "RefitSet", "ScreenAddition", "run_fits"]

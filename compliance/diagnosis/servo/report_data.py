@@ -1,11 +1,16 @@
-"""The diagnosis as a JSON document (docs/diagnosis-schema.md): plain numbers, SI units named."""
+"""The diagnosis as a JSON document (docs/diagnosis-schema.md): plain numbers, SI units named.
+
+Also the validation report's ``diagnosis`` entry (``govcheck diagnose --report``,
+:func:`validation_with_diagnosis`): the recording validated before and after, the explanation
+quoting the fits of the table printed beside it, the winner's parameters grouped by effect.
+"""
 
 from __future__ import annotations
 
 
 from compliance.effects import EFFECTS
 from compliance.diagnosis.servo.instrument_candidates import finding_words, is_instrument
-from compliance.files.jsonable import json_number
+from compliance.files.jsonable import json_number, jsonable
 from compliance.model.parameters import BASE_BY_KEY
 from compliance.diagnosis.servo.candidates import FRICTION_LEVEL
 from compliance.diagnosis.evidence.residuals import UNITS
@@ -56,24 +61,13 @@ def _fit_table(fit: dict | None) -> dict | None:
                 "nrmse": json_number(v["nrmse"]), "fit_percent": json_number(v["fit_percent"])} for s, v in fit.items()}
 
 
-def _clean(obj):
-    """Plain JSON of nested dicts/lists (non-finite floats -> null)."""
-    if isinstance(obj, dict):
-        return {str(k): _clean(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_clean(v) for v in obj]
-    if isinstance(obj, (float, int)) and not isinstance(obj, bool):
-        return json_number(obj) if isinstance(obj, float) else obj
-    return obj
-
-
 def _ambiguity(d) -> dict | None:
     """The explanations the recording cannot tell apart and the test that would (docs/diagnosis-schema.md)."""
     if not d.ambiguous:
         return None
     return {"explanations": list(d.ambiguous),
             "delta_bic": {k: json_number(d.scores[k].bic - d.scores[d.ambiguous[0]].bic) for k in d.ambiguous},
-            "suggested_test": _clean(d.suggested_test)}
+            "suggested_test": jsonable(d.suggested_test)}
 
 
 def diagnosis_to_dict(d, saved_model: str | None = None) -> dict:
@@ -130,11 +124,51 @@ def diagnosis_to_dict(d, saved_model: str | None = None) -> dict:
         "signals_left": {s: json_number(v) for s, v in d.signals_left.items()},
         "residual_limit": RESIDUAL_LIMIT,
         "contributions": {e: {k: json_number(v) for k, v in c.items()} for e, c in d.contributions.items()},
-        "effect_search": _clean(d.search),
-        "empirical": _clean(d.empirical),
-        "split": _clean(getattr(d, "split", None)),
-        "friction_form": _clean(getattr(d, "friction_form", None)),
+        "effect_search": jsonable(d.search),
+        "empirical": jsonable(d.empirical),
+        "split": jsonable(getattr(d, "split", None)),
+        "friction_form": jsonable(getattr(d, "friction_form", None)),
         "saved_model": saved_model,
         "notes": list(d.notes),
         "timing": {"seconds": json_number(d.seconds), "simulations": d.simulations, "jobs": d.jobs},
     }
+
+
+# --------------------------------------------------------------------------- the validation report's entry
+def _added(winner: dict) -> list[dict]:
+    """The winner's fitted parameters grouped by effect (base parameters as one group), with each effect's meaning."""
+    groups: dict[str, list] = {}
+    for p in winner["parameters"]:
+        group = p["name"].split(".")[0] if p["kind"] == "effect" else "base parameters (recalibrated)"
+        groups.setdefault(group, []).append({"name": p["name"].split(".", 1)[1] if p["kind"] == "effect" else p["name"],
+                                             "value": p["value"], "unit": p["unit"]})
+    return [{"name": g, "meaning": EFFECTS[g].meaning if g in EFFECTS else "", "params": params} for g, params in groups.items()]
+
+
+def validation_with_diagnosis(cfg, frame, meta: dict, diag, data: dict) -> dict:
+    """The validation result of ``frame`` against ``cfg`` with the ``diagnosis`` entry of ``diag``.
+
+    Parameters
+    ----------
+    cfg : PlantConfig
+        The plant the recording was diagnosed against.
+    frame, meta
+        The recording (``recordings.reader.read_recording``).
+    diag : diagnosis.servo.result.Diagnosis
+        The diagnosis (its fitted configuration is validated too, when there is one).
+    data : dict
+        ``diag.to_dict()`` (explanation, verdict, ranked effects, winner).
+    """
+    from compliance.diagnosis.servo.explanation import explain_with_table
+    from compliance.validation.validate import ValidationSettings, validate
+
+    settings = ValidationSettings(modes=("closed_loop",) if "reference" in frame.columns else ("plant_only",))
+    result = validate(cfg, frame, meta, settings)
+    entry = {"explanation": data["explanation"], "verdict": data["verdict"], "added": [], "effects_ranked": data["effects"]}
+    if diag.fitted_cfg is not None:
+        entry["after"] = validate(diag.fitted_cfg, frame, meta, settings)
+        mode = settings.modes[0]  # the explanation quotes the fits of the table printed beside it
+        entry["explanation"] = explain_with_table(diag, result["modes"][mode]["fits"], entry["after"]["modes"][mode]["fits"])
+        entry["added"] = _added(next(e for e in data["effects"] if e["name"] == data["winner"]))
+    result["diagnosis"] = entry
+    return result

@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import math
 
-from compliance.campaign.executor import map_tasks, warm_up
+from compliance.campaign.executor import warm_up
+from compliance.processes import map_tasks
 from compliance.requirements.verdict import Status
 from compliance.sweep.candidates.evaluate import Context, Unjudged, evaluate_batch, judged
 
@@ -40,7 +41,7 @@ def run_candidates(ctx: Context, candidates: list[dict], *, scheduler=None, work
         for i, r in zip(todo, new):
             rows[i] = r
         return rows, stats
-    from compliance.campaign.executor import available_cores
+    from compliance.processes import available_cores
 
     if not candidates:
         return [], None

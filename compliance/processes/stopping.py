@@ -1,7 +1,7 @@
-"""The one way govcheck starts worker processes, and stops them all when the run is interrupted.
+"""Worker processes that stop with the run: the one process pool (`worker_pool`) and the signal handling.
 
-Every process pool (campaign and sweep executor, diagnosis fits, benchmark, calibration, operating
-maps, report figures) is a :func:`worker_pool`. Its workers ignore SIGINT and SIGTERM's Python
+The executor (:mod:`compliance.processes.executor`) runs every local parallel stage on a
+:func:`worker_pool`. Its workers ignore SIGINT and SIGTERM's Python
 handler (a Ctrl-C on a terminal reaches the whole process group; only the parent decides), and
 when the parent leaves the pool through an exception - KeyboardInterrupt from SIGINT, or
 :class:`Terminated` from SIGTERM (see :func:`stop_on_signals`) - every worker is killed at once
