@@ -45,7 +45,7 @@ from compliance.model.rest_state import initial_state, set_rest_internal_states
 from compliance.diagnosis.evidence.operating_point import load_at_start
 from compliance.simulation.rk4 import N_OUT, OUTPUT_COLUMNS
 from compliance.simulation.pid_loop import simulate_core
-from compliance.diagnosis.evidence.noise_floor import position_noise_estimate, sensor_noise_std
+from compliance.validation.recorded_noise import position_noise_estimate, sensor_noise_std
 from compliance.validation.logger_model import logger_model
 from compliance.validation.recorded_noise import position_quantum
 
