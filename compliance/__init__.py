@@ -29,4 +29,11 @@ if "NUMBA_CACHE_DIR" not in _os.environ:
     except OSError:  # read-only install: numba falls back to its own default
         pass
 
+# govcheck runs in parallel over processes (compliance.processes); inside each, OpenBLAS's own threads
+# only spin-wait on the small least-squares matrices of a fit, doubling CPU time for no gain and
+# stealing the other worker's core. One BLAS thread per process unless the user chose otherwise
+# (read when numpy loads, so it must be set before the first numpy import).
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    _os.environ.setdefault(_var, "1")
+
 __all__ = ["__version__"]
