@@ -10,7 +10,6 @@ from compliance.errors import InputError
 from compliance.model.config import PlantConfig
 from compliance.simulation.pid_loop import simulate_pid
 from compliance.simulation.scenario import Scenario
-from compliance.simulation.state_feedback_loop import simulate_state_feedback
 
 
 def simulate(cfg: PlantConfig, scenario: Scenario) -> pd.DataFrame:
@@ -39,5 +38,8 @@ def simulate(cfg: PlantConfig, scenario: Scenario) -> pd.DataFrame:
     if not (scenario.duration > 0 and math.isfinite(scenario.duration)):
         raise InputError(f"duration must be a positive number of seconds, got {scenario.duration}")
     if scenario.command is None and cfg.options["controller.type"] != "pid":
+        # imported here: its design step loads python-control (~1 s), which PID runs never need
+        from compliance.simulation.state_feedback_loop import simulate_state_feedback
+
         return simulate_state_feedback(cfg, scenario)
     return simulate_pid(cfg, scenario)
