@@ -220,7 +220,7 @@ def _run_joint(args, plant_arg, effects) -> int:
         raise InputError(f"{args.recordings[0]}: no CONFIG given and the sidecar names no 'plant'")
     cfg = load_plant(plant)
     for path, (frame, meta) in zip(args.recordings, recs):
-        check_sidecar_conditions(cfg, meta, path)
+        check_sidecar_conditions(cfg, frame, meta, path)
         if "reference" not in frame.columns:
             raise InputError(f"{path}: no 'reference' column; a joint diagnosis needs closed-loop recordings")
     with progress(1, "diagnose", quiet=args.quiet, unit="stage", first=f"{len(recs)} recordings, shared physics") as bar:

@@ -93,3 +93,20 @@ def test_joint_cli_refuses_report_before_work(tmp_path, recordings, capsys):
     out = tmp_path / "j.html"
     assert main(["diagnose", "plant-a", *paths, "--report", str(out)]) == 2
     assert "not available for a joint diagnosis" in capsys.readouterr().err and not out.exists()
+
+
+def test_joint_cli_end_to_end_names_the_pressure_law(tmp_path, recordings):
+    """``govcheck diagnose CONFIG R1 R2 --json``: each recording is checked against the plant, then diagnosed jointly."""
+    import json
+
+    _, recs = recordings
+    paths = []
+    for i, (frame, meta) in enumerate(recs):
+        path, _ = write_recording(frame, meta, tmp_path / f"r{i}.csv")
+        paths.append(str(path))
+    out = tmp_path / "j.json"
+    assert main(["diagnose", "plant-a", *paths, "--effects", "pressure_dependent_friction", "--json", str(out),
+                 "--jobs", "2", "-q"]) == 0
+    data = json.loads(out.read_text())
+    assert data["verdict"] == "missing_physics" and data["winner"] == "pressure_dependent_friction"
+    assert [r["n_residuals"] > 0 for r in data["recordings"]] == [True, True]
