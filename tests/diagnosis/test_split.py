@@ -10,7 +10,7 @@ import pytest
 from compliance.diagnosis.servo.candidates import effect_params
 from compliance.diagnosis.servo.fit import FitResult
 from compliance.diagnosis.scoring.practice_score import answer_in_si, main_parameter
-from compliance.diagnosis.servo.lag_split import split_scan
+from compliance.diagnosis.servo.lag_split import valley_point, split_scan
 
 M = 100  # residuals per signal
 SIGNALS = ("position", "pressure_a")
@@ -22,6 +22,7 @@ class _Valley:
     def __init__(self, chi2_of):
         self.chi2_of = chi2_of
         self.calls = []
+        self.sims = 0  # replays run (FitContext.sims)
         self.model = SimpleNamespace(index=np.arange(M), size=M * len(SIGNALS), split=self._split)
 
     def _split(self, vec):
@@ -30,6 +31,7 @@ class _Valley:
     def residual(self, params, values):
         p = {fp.name: v for fp, v in zip(params, values)}
         self.calls.append(p)
+        self.sims += 1
         per = self.chi2_of(p["time_constant"], p["delay"]) / len(SIGNALS)
         return np.full(M * len(SIGNALS), np.sqrt(per / M)), object()
 
@@ -54,6 +56,11 @@ def test_flat_valley_leaves_the_split_open_and_holds_the_total():
     assert not sp["pinned"]
     assert sp["interval"][0] <= 0.015 <= sp["interval"][1]  # a split of 15 + 9 ms is not told apart
     assert sp["lumped"] == pytest.approx(0.024)
+    assert sp["replays"] == len(ctx.calls) - 1  # every replay of the scan counted (the fit's own was before it)
+    # the scan's points are independent: run by a caller's workers (here: in reverse order), the same scan
+    again = split_scan(ctx, fit, "sensor_lag", along=lambda vs, lim: [valley_point(ctx, fit, "sensor_lag", v, lim)
+                                                                      for v in vs[::-1]][::-1])
+    assert again == sp
 
 
 def test_sharp_valley_pins_the_split():

@@ -46,7 +46,7 @@ from compliance.diagnosis.servo.report_data import SCHEMA
 from compliance.diagnosis.servo.result import Diagnosis
 from compliance.diagnosis.evidence.locate_misfit import event_rms, locate_mismatch, mask_agreement, where_words
 from compliance.diagnosis.servo.parallel_fits import (ExtendSet, FitEffect, FitWithBase, RecalibrateBase, RefitSet, ScreenAddition,
-                                                     run_fits)
+                                                     ValleyPoint, run_fits)
 from compliance.diagnosis.verdicts.candidate_set import BASE, CandidateSet
 from compliance.diagnosis.verdicts.verdict import EXPLAINED, INCOMPLETE, DiagnosisVerdict
 from compliance.processes import available_cores
@@ -363,13 +363,18 @@ def _split(st: Stage, winner: str | None, verdict_name: str, dec: dict) -> dict 
     if lag is None or verdict_name == DiagnosisVerdict.UNEXPLAINED:
         return None
     ctx = FitContext(st.rc, st.setup, st.model)
-    sp = split_scan(ctx, st.fits[winner], lag, st.vecs.get(winner))
-    moved = adopted_fit(ctx, st.fits[winner], sp["estimate"]) if sp and sp["estimate"] else None
+    fit = st.fits[winner]
+
+    def along(values, limit):  # the scan's points are independent: one task each on the workers
+        return [r for r, _ in run_fits([ValleyPoint(fit, lag, v, limit) for v in values], st.jobs, st.payload)]
+
+    sp = split_scan(ctx, fit, lag, st.vecs.get(winner), along)
+    moved = adopted_fit(ctx, fit, sp["estimate"]) if sp and sp["estimate"] else None
     if moved is not None:
         st.fits[winner], st.vecs[winner] = moved
         after = _own_floors(st, winner, verdict_name)
         dec.update(scores=score_all(st.fits, st.model.size), after=after, left=signals_left(after))
-    return sp and {**sp, "replays": ctx.sims}
+    return sp and {**sp, "replays": sp["replays"] + (moved is not None)}
 
 
 def _contributions(st: Stage, winner: str | None) -> dict:

@@ -165,9 +165,37 @@ def _connected(points: list, fitted: float, ok) -> list[float]:
     return [values[lo], values[hi]]
 
 
-def split_scan(ctx, fit, effect: str, vec: np.ndarray | None = None) -> dict | None:
+def _valley(fit, effect: str):
+    """(parameter index by name, fitted values by name, main, delay, lumped total) of ``effect`` in ``fit``,
+    or None when the effect declares no lumped combination with a delay."""
+    decl = EFFECTS.get(effect)
+    delay = _delay_param(effect) if decl is not None else None
+    if decl is None or decl.lumped is None or delay is None:
+        return None
+    idx = {fp.name: i for i, fp in enumerate(fit.params) if fp.kind == "effect" and fp.effect == effect}
+    if len(idx) != len(decl.params):
+        return None
+    vals = {q: fit.values[i] for q, i in idx.items()}
+    return idx, vals, decl.params[0].name, delay, float(decl.lumped.of(vals))
+
+
+def valley_point(ctx, fit, effect: str, value: float, limit: float) -> tuple[tuple | None, int]:
+    """One point of the scan (``split_scan``): the best replay with the main parameter of ``effect`` at
+    ``value`` [SI] and the nuisance parameters profiled, or None outside the bounds; and the replays it ran.
+
+    ``limit``: chi-square per residual deciding whether the coarse profile is refined."""
+    idx, vals, main, delay, total = _valley(fit, effect)
+    fm = fit.params[idx[main]]
+    sims = ctx.sims
+    got = (_best_on_valley(ctx, fit, effect, idx, vals, main, delay, value, total, limit, _segments(ctx))
+           if fm.low <= value <= fm.high else None)
+    return got, ctx.sims - sims
+
+
+def split_scan(ctx, fit, effect: str, vec: np.ndarray | None = None, along=None) -> dict | None:
     """Scan the lumped valley of ``effect`` in the fitted candidate ``fit`` (``servo.fit.FitContext`` ``ctx``);
-    ``vec``: the fit's own residual vector when the caller has it (else it is replayed once).
+    ``vec``: the fit's own residual vector when the caller has it (else it is replayed once); ``along``:
+    runs ``valley_point`` for a list of main-parameter values and limit (the caller's workers; default here).
 
     Returns
     -------
@@ -177,20 +205,14 @@ def split_scan(ctx, fit, effect: str, vec: np.ndarray | None = None) -> dict | N
         the fit, ``bracket`` (the nearest values tried outside it, None at the scan's end), ``pinned``
         (interval narrower than ``PINNED_SPAN``), ``lumped`` (total held), ``estimate`` (the interval's
         point with the lowest trimmed chi2: ``value``, ``values`` of all the fit's parameters, ``trimmed``
-        and the fit's ``trimmed_fit``; None when it is the fit itself or the split is pinned) - or None
-        when the effect declares no lumped combination with a delay.
+        and the fit's ``trimmed_fit``; None when it is the fit itself or the split is pinned), ``replays``
+        (the scan's own) - or None when the effect declares no lumped combination with a delay.
     """
-    decl = EFFECTS.get(effect)
-    delay = _delay_param(effect) if decl is not None else None
-    if decl is None or decl.lumped is None or delay is None:
+    valley = _valley(fit, effect)
+    if valley is None:
         return None
-    idx = {fp.name: i for i, fp in enumerate(fit.params) if fp.kind == "effect" and fp.effect == effect}
-    if len(idx) != len(decl.params):
-        return None
-    main = decl.params[0].name
-    vals = {q: fit.values[i] for q, i in idx.items()}
-    total = float(decl.lumped.of(vals))
-    fm = fit.params[idx[main]]
+    idx, vals, main, delay, total = valley
+    sims0 = ctx.sims
     m = ctx.model.index.size
     segments = _segments(ctx)
     fit_worst = max(math.sqrt(c / m) for c in fit.chi2_signal.values())
@@ -201,12 +223,11 @@ def split_scan(ctx, fit, effect: str, vec: np.ndarray | None = None) -> dict | N
         own_trimmed = own[2] if own else math.inf
     points = [(vals[main], fit.chi2 / ctx.model.size, fit_worst, own_trimmed, list(fit.values))]
     limit = AMBIGUOUS_RATIO * fit.chi2 / ctx.model.size
-    for f in SPLIT_FACTORS:
-        value = vals[main] * f
-        got = (_best_on_valley(ctx, fit, effect, idx, vals, main, delay, value, total, limit, segments)
-               if fm.low <= value <= fm.high else None)
-        if got is not None:
-            points.append((value, *got))
+    values = [vals[main] * f for f in SPLIT_FACTORS]
+    replays = ctx.sims - sims0  # the fit's own, when replayed here; each point counts its own below
+    scanned = (along or (lambda vs, lim: [valley_point(ctx, fit, effect, v, lim) for v in vs]))(values, limit)
+    replays += sum(n for _, n in scanned)
+    points += [(value, *got) for value, (got, _) in zip(values, scanned) if got is not None]
     points.sort(key=lambda p: p[0])
     # as good as the fit: chi-square within the ratio, no signal beyond the limit or (when the fit itself
     # sits near it) beyond the fit's own worst signal by the same ratio
@@ -224,7 +245,7 @@ def split_scan(ctx, fit, effect: str, vec: np.ndarray | None = None) -> dict | N
         "value": best[0], "values": best[4], "trimmed": best[3], "trimmed_fit": own_trimmed}
     return {"parameter": f"{effect}.{main}", "fitted": vals[main], "lumped": total, "delay": f"{effect}.{delay}",
             "points": [list(p[:4]) for p in points], "interval": interval, "bracket": bracket,
-            "pinned": pinned, "scanned": [points[0][0], points[-1][0]], "estimate": estimate}
+            "pinned": pinned, "scanned": [points[0][0], points[-1][0]], "estimate": estimate, "replays": replays}
 
 
 def adopted_fit(ctx, fit, estimate: dict):
@@ -240,4 +261,4 @@ def adopted_fit(ctx, fit, estimate: dict):
     return moved, vec
 
 
-__all__ = ["adopted_fit", "split_scan", "trimmed_chi2", "SPLIT_FACTORS", "PINNED_SPAN", "TRIM_SHARE", "ESTIMATE_GAIN"]
+__all__ = ["adopted_fit", "split_scan", "valley_point", "trimmed_chi2", "SPLIT_FACTORS", "PINNED_SPAN", "TRIM_SHARE", "ESTIMATE_GAIN"]

@@ -3,7 +3,8 @@
 The recording's replay set-up and residual model are the executor's context, built into a
 ``FitContext`` once per worker process (:class:`~compliance.processes.PerProcess`); each task is a
 small frozen record of what to fit (``RecalibrateBase``, ``FitEffect``, ``FitWithBase``, ``ExtendSet``,
-``RefitSet``) or to screen (``ScreenAddition``), run by ``_run_task``.
+``RefitSet``), to screen (``ScreenAddition``) or a point of a lag's valley to replay (``ValleyPoint``), run by
+``_run_task``.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from compliance.model.parameters import ParamHandle
 from compliance.diagnosis.servo.fit import FitContext, FitResult, fit_candidate, least_squares_fit
 from compliance.diagnosis.servo.recalibration import forward_select_base
 from compliance.diagnosis.servo.effect_sets import SET_SIMPLEX_FEV, extend_fit, screen_addition
+from compliance.diagnosis.servo.lag_split import valley_point
 from compliance.diagnosis.evidence.replay_fit import ReplaySetup
 from compliance.processes import PerProcess, map_tasks
 
@@ -91,17 +93,34 @@ class ScreenAddition:
     current: FitResult
     single: FitResult
 
+    def run(self, ctx: FitContext) -> tuple:
+        return screen_addition(ctx, self.current, self.single)
+
+
+@dataclass(frozen=True)
+class ValleyPoint:
+    """A point of the lag-split scan: ``effect``'s main parameter at ``value`` [SI] in ``fit``
+    (``lag_split.valley_point``: the best profiled replay there and the replays it ran)."""
+
+    fit: FitResult
+    effect: str
+    value: float
+    limit: float
+
+    def run(self, ctx: FitContext) -> tuple:
+        return valley_point(ctx, self.fit, self.effect, self.value, self.limit)
+
 
 def _fit_context(toml_text: str, setup: ReplaySetup, model) -> FitContext:
     return FitContext(plant_from_dict(tomllib.loads(toml_text), "<diagnosis>"), setup, model)
 
 
 def _run_task(context: PerProcess, task):
-    """One unit of parallel work: a fit -> (FitResult, residual vector); a screen -> ((effect, chi-square,
-    start, replays) of ``effect_sets.screen_addition``, None): no fit, no residual."""
+    """One unit of parallel work: a fit -> (FitResult, residual vector); a task that is not a fit (a screen,
+    a valley point) -> (what its ``run`` returns, None): no fit, no residual."""
     ctx: FitContext = context.get()
-    if isinstance(task, ScreenAddition):
-        return screen_addition(ctx, task.current, task.single), None
+    if hasattr(task, "run"):
+        return task.run(ctx), None
     res = task.fit(ctx)
     sims = ctx.sims
     vec, _ = ctx.residual(res.params, res.values)  # the fit's own last replay, remembered (FitContext.memo)
@@ -120,4 +139,4 @@ def run_fits(tasks, jobs: int, payload, scheduler: str | None = None) -> list:
     return results
 
 
-__all__ = ["ExtendSet", "FitEffect", "FitWithBase", "RecalibrateBase", "RefitSet", "ScreenAddition", "run_fits"]
+__all__ = ["ExtendSet", "FitEffect", "FitWithBase", "RecalibrateBase", "RefitSet", "ScreenAddition", "ValleyPoint", "run_fits"]
