@@ -3,15 +3,16 @@
 Budget (issue 24): <= 15 s per 30 s recording on 2 cores with the full effect library.
 Measured as a cold process (``python -m compliance diagnose REC --json OUT --jobs N``: imports,
 numba cache load, reading, replays, every candidate fit, JSON) on the four practice recordings
-when ``../shared`` is beside the repository (else on two synthetic practice recordings), and the
-number of simulations each diagnosis ran.
+when ``../shared`` is beside the repository (else on two synthetic practice recordings), or on every
+recording of ``--practice DIR`` (field logs of other lengths: the time is also given per 30 s of
+recording), and the number of simulations each diagnosis ran.
 
 The previous implementation is measured in the same run, on the same recordings, one after the
 other: ``--against REV`` (default ``main``) is checked out in a temporary git worktree and run
 the same way, and the ratio of the wall times is printed (``--against none`` skips it). Each
 side's numba cache is warmed by one untimed diagnosis first, so compilation is not counted.
 
-Run: .venv/bin/python benchmarks/diagnose_speed.py [--jobs 2] [--against main] [--recordings N]
+Run: .venv/bin/python benchmarks/diagnose_speed.py [--jobs 2] [--against main] [--recordings N] [--practice DIR]
 Not part of the timed test suite. The machine's other load counts: run it on a quiet machine.
 """
 
@@ -31,7 +32,12 @@ sys.path.insert(0, str(ROOT))
 BUDGET = 15.0  # s per 30 s recording on 2 cores (issue 24)
 
 
-def _recordings(tmp: Path) -> list[Path]:
+def _recordings(tmp: Path, practice: Path | None) -> list[Path]:
+    if practice is not None:
+        found = sorted(practice.glob("*.csv.gz")) + sorted(practice.glob("*.csv"))
+        if not found:
+            raise SystemExit(f"--practice {practice}: no recordings (*.csv, *.csv.gz)")
+        return found
     practice = ROOT.parent / "shared" / "practice-recordings"
     found = sorted(practice.glob("practice_*.csv.gz")) if practice.is_dir() else []
     if found:
@@ -65,6 +71,19 @@ def _diagnose(code: Path, rec: Path, out: Path, jobs: int) -> tuple[float, dict]
     return wall, json.loads(out.read_text())
 
 
+def _duration(rec: Path) -> float:
+    """Length of the recording [s] (its time column)."""
+    from compliance.recordings.reader import read_recording
+
+    t = read_recording(str(rec))[0]["time"].to_numpy()
+    return float(t[-1] - t[0])
+
+
+def _per30(wall: float, row: dict) -> float:
+    """Wall time per 30 s of recording [s]: the budget is per 30 s recording; a shorter log is not scaled up."""
+    return wall * 30.0 / max(row["seconds"], 30.0)
+
+
 def _previous(rev: str, tmp: Path) -> Path:
     """A temporary worktree of ``rev`` (the previous implementation)."""
     where = tmp / "previous"
@@ -77,10 +96,11 @@ def main() -> None:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--against", default="main", help="git revision of the previous implementation, or 'none'")
     ap.add_argument("--recordings", type=int, default=0, help="only the first N recordings (0: all)")
+    ap.add_argument("--practice", type=Path, default=None, help="time every recording of this folder instead")
     args = ap.parse_args()
     with tempfile.TemporaryDirectory() as d:
         tmp = Path(d)
-        recs = _recordings(tmp)[: args.recordings or None]
+        recs = _recordings(tmp, args.practice)[: args.recordings or None]
         sides = {"this": ROOT}
         if args.against != "none":
             sides["previous"] = _previous(args.against, tmp)
@@ -89,7 +109,7 @@ def main() -> None:
             for name, code in sides.items():
                 _diagnose(code, recs[0], tmp / "warm.json", args.jobs)  # numba cache of this side, untimed
             for rec in recs:
-                row = {"name": rec.name}
+                row = {"name": rec.name, "seconds": _duration(rec)}
                 for name, code in sides.items():
                     wall, data = _diagnose(code, rec, tmp / f"{name}.json", args.jobs)
                     row[name] = (wall, data["timing"]["simulations"], data["verdict"], data["winner"])
@@ -99,17 +119,20 @@ def main() -> None:
                 subprocess.run(["git", "worktree", "remove", "--force", str(sides["previous"])], cwd=ROOT, check=False)
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     print(f"govcheck diagnose, full library, --jobs {args.jobs} (load average at the end {load:.1f}):")
-    print(f"{'recording':34s} {'wall [s]':>9s} {'simulations':>12s} {'previous [s]':>13s} {'ratio':>6s}  verdict")
+    print(f"{'recording':52s} {'length [s]':>10s} {'wall [s]':>9s} {'per 30 s':>9s} {'simulations':>12s} "
+          f"{'previous [s]':>13s} {'ratio':>6s}  verdict")
     for r in rows:
         wall, sims, verdict, winner = r["this"]
         prev = r.get("previous")
         extra = f"{prev[0]:13.1f} {prev[0] / wall:6.2f}" if prev else f"{'-':>13s} {'-':>6s}"
-        print(f"{r['name']:34s} {wall:9.1f} {sims:12d} {extra}  {verdict} {winner or ''}")
-    worst = max(r["this"][0] for r in rows)
+        print(f"{r['name']:52s} {r['seconds']:10.1f} {wall:9.1f} {_per30(wall, r):9.1f} {sims:12d} {extra}  "
+              f"{verdict} {winner or ''}")
+    worst = max(_per30(r["this"][0], r) for r in rows)
     if "previous" in rows[0]:
         total = sum(r["previous"][0] for r in rows) / sum(r["this"][0] for r in rows)
         print(f"speed ratio against {args.against} (previous wall / this wall, same run): {total:.2f}")
-    print(f"worst {worst:.1f} s against the {BUDGET:.0f} s budget: {'within' if worst <= BUDGET else 'OVER'}")
+    print(f"worst {worst:.1f} s per 30 s of recording against the {BUDGET:.0f} s budget: "
+          f"{'within' if worst <= BUDGET else 'OVER'}")
 
 
 if __name__ == "__main__":
