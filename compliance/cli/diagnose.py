@@ -50,7 +50,7 @@ def register(sub):
     p.add_argument("--effects", help="comma-separated candidate effects (default: every declared effect)")
     p.add_argument("--no-recalibration", action="store_true", help="do not consider recalibrating base parameters")
     add_jobs(p)
-    add_scheduler(p, "the fits of several recordings (a joint diagnosis)")
+    add_scheduler(p, "the candidate fits (of one recording or of several jointly)")
     p.add_argument("--friction-bore", help='friction bench: piston bore, e.g. "25.7 mm" (else the column map\'s metadata)')
     add_outputs(p, "json", "report", "pdf", help={"json": "write the diagnosis (docs/diagnosis-schema.md) to FILE.json",
                                                   "report": "write an HTML report with the before/after figures to FILE.html",
@@ -96,11 +96,12 @@ def run(args) -> int:
         raise InputError(f"{args.recordings[0]}: no CONFIG given and the sidecar names no 'plant'")
     cfg = load_plant(plant)
     check_sidecar_conditions(cfg, frame, meta, args.recordings[0])
+    check_scheduler(args)  # a bad address is exit 2 before any work
     from compliance.cli.progress import progress
 
     with progress(1, "diagnose", quiet=args.quiet, unit="stage", first="replay, locate, fit every candidate") as bar:
         diag = diagnose(cfg, frame, meta, effects=effects, jobs=args.jobs, recalibrate=not args.no_recalibration,
-                        suggest_test=args.suggest_test)
+                        suggest_test=args.suggest_test, scheduler=args.scheduler)
         bar.update(1)
     unsaved = saved = None
     if args.save_model:
@@ -172,6 +173,8 @@ def _run_friction(args, first, meta) -> int:
 
     if args.save_model:
         raise InputError("--save-model: a friction-bench diagnosis fits a friction law, not a plant configuration; use --json")
+    if args.scheduler:
+        raise InputError("--scheduler: friction-bench runs are fitted on the local process pool (seconds per seal); use --jobs")
     runs = [(first, meta)]
     for path in args.recordings[1:]:
         f, m = read_recording(path, args.column_map, required=("time",))

@@ -7,7 +7,7 @@ import pytest
 
 from compliance.diagnosis.servo.candidates import effect_candidate
 from compliance.diagnosis.servo.parallel_fits import FitEffect, RecalibrateBase
-from compliance.diagnosis.servo.result import Diagnosis
+from compliance.diagnosis.servo.report_data import Diagnosis
 from compliance.diagnosis.verdicts.verdict import EXPLAINED, INCOMPLETE, DiagnosisVerdict
 
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import pytest
 
 from compliance.model.config import load_plant
-from compliance.diagnosis.servo.diagnose import prepare_recording
+from compliance.diagnosis.servo.stage import prepare_recording
 from compliance.diagnosis.servo.candidates import effect_params
 from compliance.model.parameters import apply
 from compliance.diagnosis.servo.fit import FitResult, chi2_parts

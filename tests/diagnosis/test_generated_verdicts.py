@@ -17,7 +17,8 @@ import pytest
 from compliance.model.config import load_plant
 from compliance.diagnosis.servo.candidates import base_params
 from compliance.diagnosis.scoring.concealed_cases import miscalibration_case, null_case
-from compliance.diagnosis.servo.diagnose import _decide, prepare_recording
+from compliance.diagnosis.servo.diagnose import _decide
+from compliance.diagnosis.servo.stage import prepare_recording
 from compliance.diagnosis.servo.fit import FitContext, scan_points
 from compliance.diagnosis.servo.recalibration import forward_select_base
 from compliance.diagnosis.servo.selection import NOISE_TOLERANCE

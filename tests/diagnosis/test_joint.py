@@ -110,3 +110,32 @@ def test_joint_cli_end_to_end_names_the_pressure_law(tmp_path, recordings):
     data = json.loads(out.read_text())
     assert data["verdict"] == "missing_physics" and data["winner"] == "pressure_dependent_friction"
     assert [r["n_residuals"] > 0 for r in data["recordings"]] == [True, True]
+
+
+def test_one_recording_on_a_dask_cluster_gives_the_local_pools_diagnosis(tmp_path, recordings):
+    """``--scheduler local:2`` runs every fit of a single-recording diagnosis on Dask: same verdict and values."""
+    import json
+
+    _, recs = recordings
+    path, _ = write_recording(*recs[1], tmp_path / "r.csv")
+    outs = {}
+    for label, extra in (("pool", ["--jobs", "2"]), ("dask", ["--scheduler", "local:2"])):
+        outs[label] = tmp_path / f"{label}.json"
+        assert main(["diagnose", "plant-a", str(path), "--effects", "pressure_dependent_friction",
+                     "--json", str(outs[label]), "-q", *extra]) == 0
+    pool, dask = (json.loads(outs[k].read_text()) for k in ("pool", "dask"))
+    assert dask["verdict"] == pool["verdict"] and dask["winner"] == pool["winner"]
+    assert [(e["name"], e["parameters"], e["chi2"]) for e in dask["effects"]] == \
+        [(e["name"], e["parameters"], e["chi2"]) for e in pool["effects"]]
+    assert dask["timing"]["simulations"] == pool["timing"]["simulations"]
+
+
+def test_scheduler_is_refused_for_friction_bench_runs_before_work(tmp_path, capsys):
+    from pathlib import Path
+
+    data = Path(__file__).resolve().parents[1] / "data" / "zillen"
+    runs = sorted(str(p) for p in data.glob("*.csv"))[:1]
+    assert runs, "fixture of the seal bench missing"
+    out = tmp_path / "f.json"
+    assert main(["diagnose", *runs, "--column-map", "zillen-friction", "--scheduler", "local:2", "--json", str(out)]) == 2
+    assert "--scheduler" in capsys.readouterr().err and not out.exists()

@@ -17,7 +17,7 @@ from compliance.diagnosis.evidence.discriminating_test import design_test
 from compliance.diagnosis.evidence.empirical_force import sparse_fit
 from compliance.diagnosis.servo.diagnose import diagnose
 from compliance.diagnosis.servo.candidates import effect_params
-from compliance.diagnosis.servo.diagnose import prepare_recording
+from compliance.diagnosis.servo.stage import prepare_recording
 from compliance.diagnosis.servo.effect_sets import ADD_GAIN, BURST_WINDOW, NO_WORSE, adds_enough, screen_addition
 from compliance.diagnosis.servo.fit import FitContext, FitResult, chi2_parts, scan_points
 from compliance.diagnosis.evidence.operating_point import load_at_start

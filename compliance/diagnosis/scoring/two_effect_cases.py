@@ -78,7 +78,7 @@ def truth_share(cfg, case: dict, stride: int = 5) -> float:
     ``unexplained``, not a named pair.
     """
     from compliance.diagnosis.servo.candidates import effect_params
-    from compliance.diagnosis.servo.diagnose import prepare_recording  # the diagnosis' own replay, floors and residual model
+    from compliance.diagnosis.servo.stage import prepare_recording  # the diagnosis' own replay, floors and residual model
     from compliance.diagnosis.servo.fit import FitContext
 
     st = prepare_recording(cfg, case["frame"], case["meta"], stride, 1)

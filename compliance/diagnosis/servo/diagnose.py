@@ -19,16 +19,16 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field, replace as dc_replace
+from dataclasses import replace as dc_replace
 
 import numpy as np
 
-from compliance.model.config import PlantConfig, plant_to_toml, _suggest as _suggest_name
+from compliance.model.config import PlantConfig
 from compliance.model.parameters import apply
 from compliance.effects import EFFECTS
 from compliance.errors import InputError, SimulationError
 from compliance.diagnosis.servo.candidates import Candidate, base_params, effect_candidate, signature_order
-from compliance.diagnosis.servo.fit import FitContext, FitResult, chi2_parts, replays_bound, screen_level
+from compliance.diagnosis.servo.fit import FitContext, FitResult, replays_bound, screen_level
 from compliance.diagnosis.servo.fitted_model import fitted_plant, save_fitted
 from compliance.diagnosis.servo.effect_sets import CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_enough, contributions, full_name, prune
 from compliance.diagnosis.evidence.discriminating_test import design_test
@@ -37,87 +37,39 @@ from compliance.diagnosis.servo.instrument_candidates import (PREFIX, instrument
                                                        is_instrument)
 from compliance.diagnosis.servo.lag_split import adopted_fit, split_scan
 from compliance.diagnosis.servo.friction_form import OPTION as FORM_OPTION, form_after_effects, friction_form_check
-from compliance.diagnosis.evidence.replay_fit import ReplaySetup, prepare_replay, replay_config, run_replay
-from compliance.diagnosis.evidence.residuals import (UNITS, build_residual_model, null_recording, own_floor_objective, signal_fit,
-                                            with_fail_level)
+from compliance.diagnosis.evidence.replay_fit import ReplaySetup, run_replay
+from compliance.diagnosis.evidence.residuals import UNITS, null_recording, own_floor_objective, signal_fit
 from compliance.diagnosis.servo.selection import (AMBIGUOUS_BIC, EXPLAINED_ENOUGH, NOISE_TOLERANCE, RESIDUAL_LIMIT, ambiguity_set, honest,
                                          score_all, signals_left, verdict)
-from compliance.diagnosis.servo.report_data import SCHEMA
-from compliance.diagnosis.servo.result import Diagnosis
-from compliance.diagnosis.evidence.locate_misfit import event_rms, locate_mismatch, mask_agreement, where_words
+from compliance.diagnosis.servo.report_data import SCHEMA, Diagnosis
+from compliance.diagnosis.evidence.locate_misfit import event_rms, mask_agreement, where_words
 from compliance.diagnosis.servo.parallel_fits import (ExtendSet, FitEffect, FitWithBase, RecalibrateBase, RefitSet, ScreenAddition,
-                                                     ValleyPoint, run_fits)
+                                                     ValleyPoint)
 from compliance.diagnosis.verdicts.candidate_set import BASE, CandidateSet
 from compliance.diagnosis.verdicts.verdict import EXPLAINED, INCOMPLETE, DiagnosisVerdict
-from compliance.processes import available_cores
+from compliance.diagnosis.servo.stage import Stage, check_effects, prepare_recording
+from compliance.processes import available_cores, dask_session
 
 COMBINE_LEVEL = 3.0  # chi2/N of the best single explanation above which effects are refitted with the recalibration
 COMBINE_TOP = 1  # how many effects are refitted with the recalibration
 
 
-@dataclass
-class Stage:
-    """What every stage of one diagnosis shares (built once by ``prepare_recording``)."""
-
-    setup: ReplaySetup
-    rc: PlantConfig
-    nominal_sim: dict
-    model: object
-    events: list
-    event_mask: np.ndarray
-    nominal_rms: dict
-    nvec: np.ndarray
-    payload: tuple
-    jobs: int
-    fits: dict = field(default_factory=dict)
-    vecs: dict = field(default_factory=dict)
-    sims: int = 2
-    rebased: bool = False  # the friction law's other form is the base (servo/friction_form.py)
-
-
-def check_effects(cfg: PlantConfig, effects) -> list[str]:
-    """Stage 0: the effects to try (``None``: every declared effect the plant does not already have); a name
-    that is not declared is an ``InputError``."""
-    names = [e for e in EFFECTS if e not in cfg.effects] if effects is None else list(effects)
-    for e in names:
-        if e not in EFFECTS:
-            raise InputError(f"--effects: '{e}' is not a declared effect{_suggest_name(e, EFFECTS)} (known: {', '.join(EFFECTS)})")
-    return names
-
-
-def prepare_recording(cfg: PlantConfig, frame, meta: dict, stride: int, jobs: int, sims: int = 0) -> Stage:
-    """Stages 1-2: the nominal replay, floors, located windows (``sims``: replays already run for this diagnosis)."""
-    setup = prepare_replay(cfg, frame, meta)
-    rc = replay_config(cfg, setup)
-    nominal_sim = run_replay(rc, setup)
-    model = build_residual_model(rc, setup, stride=stride, nominal=nominal_sim)
-    model = with_fail_level(model, model.vector(nominal_sim))
-    events, event_mask, _ = locate_mismatch(rc, setup, model.signals, nominal_sim)
-    nominal_rms = {s: v["rms_normalised"] for s, v in signal_fit(model, nominal_sim).items()}
-    nvec = model.vector(nominal_sim)
-    st = Stage(setup, rc, nominal_sim, model, events, event_mask, nominal_rms, nvec, (plant_to_toml(rc), setup, model), jobs)
-    st.sims += sims
-    chi2, parts = chi2_parts(model, nvec)
-    st.fits["nominal"] = FitResult("nominal", (), [], [], chi2, parts, model.size, 0, 0.0, "nominal model")
-    return st
-
-
-def _based_search(cfg: PlantConfig, frame, meta: dict, stride: int, jobs: int, names, recalibrate: bool):
+def _based_search(cfg: PlantConfig, frame, meta: dict, stride: int, jobs: int, names, recalibrate: bool, client=None):
     """Stages 1-5 on the friction law's form that fits (servo/friction_form.py): the other form is the base from the start
     when it beats the nominal, or after an incomplete verdict when effects refitted under it beat the declared form."""
-    st = prepare_recording(cfg, frame, meta, stride, jobs)
+    st = prepare_recording(cfg, frame, meta, stride, jobs, client=client)
     form = friction_form_check(st.rc, st.setup, st.model, st.fits["nominal"])
     if form and form["adopted"]:  # the other friction law is the base of the whole search
         cfg = cfg.replace(options={FORM_OPTION: form["adopted"]})
-        st = prepare_recording(cfg, frame, meta, stride, jobs, st.sims)
+        st = prepare_recording(cfg, frame, meta, stride, jobs, st.sims, client)
         st.rebased = True
     _fit_singles(st, names, recalibrate)
     dec = _decide(st)
     if form and not form["adopted"] and dec["verdict"] in INCOMPLETE:
-        form = form_after_effects(form, st.rc, st.setup, st.model, st.fits, jobs)
+        form = form_after_effects(form, st.rc, st.setup, st.model, st.fits, jobs, client)
         if form["adopted"]:  # ... and the whole search runs again on it
             cfg = cfg.replace(options={FORM_OPTION: form["adopted"]})
-            st = prepare_recording(cfg, frame, meta, stride, jobs, st.sims)
+            st = prepare_recording(cfg, frame, meta, stride, jobs, st.sims, client)
             st.rebased = True
             _fit_singles(st, names, recalibrate)
             dec = _decide(st)
@@ -126,7 +78,7 @@ def _based_search(cfg: PlantConfig, frame, meta: dict, stride: int, jobs: int, n
 
 
 def _run(st: Stage, tasks) -> None:
-    for res, v in run_fits(tasks, st.jobs, st.payload):
+    for res, v in st.run_fits(tasks):
         st.fits[res.name] = res
         st.vecs[res.name] = v
         st.sims += res.sims
@@ -165,7 +117,7 @@ def _search_sets(st: Stage, winner: str) -> list[dict]:
             break
         have = set(CandidateSet.parse(current.name).effects)
         singles = [f for f in st.fits.values() if f.name in EFFECTS and f.name not in have]
-        screened = [r for r, _ in run_fits([ScreenAddition(current, f) for f in singles], st.jobs, st.payload)]
+        screened = [r for r, _ in st.run_fits([ScreenAddition(current, f) for f in singles])]
         screen = {name: (chi, start) for name, chi, start, _ in screened}
         st.sims += sum(r[3] for r in screened)
         level = screen_level(current.chi2, n)  # an addition whose screen removes too little is not refitted
@@ -282,7 +234,7 @@ def _empirical(st: Stage, dec: dict) -> dict | None:
 
 
 def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | None = None, stride: int = 5,
-             recalibrate: bool = True, suggest_test: bool = False) -> Diagnosis:
+             recalibrate: bool = True, suggest_test: bool = False, scheduler: str | None = None) -> Diagnosis:
     """Diagnose one recording of the servo against a plant configuration.
 
     Parameters
@@ -304,6 +256,9 @@ def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | N
     suggest_test : bool
         Design a discriminating test between the winner and the runner-up even when the
         recording tells them apart (an ambiguous recording always gets one).
+    scheduler : str, optional
+        Dask scheduler (``local:N`` or ``tcp://host:port``) for every fit of the diagnosis, one session
+        for the whole run; None: the local pool of ``jobs`` processes.
 
     Returns
     -------
@@ -317,7 +272,13 @@ def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | N
     t0 = time.perf_counter()
     jobs = available_cores() if jobs is None else max(1, int(jobs))
     names = check_effects(cfg, effects)
-    cfg, st, form, dec = _based_search(cfg, frame, meta, stride, jobs, names, recalibrate)
+    with dask_session(scheduler) as client:
+        cfg, st, form, dec = _based_search(cfg, frame, meta, stride, jobs, names, recalibrate, client)
+        return _conclude(cfg, meta, st, form, dec, t0, jobs, suggest_test)
+
+
+def _conclude(cfg: PlantConfig, meta: dict, st: Stage, form, dec: dict, t0: float, jobs: int, suggest_test: bool) -> Diagnosis:
+    """Stages 6-7 after the search: the lag split, the figures' full replays, contributions, the suggested test."""
     winner, verdict_name = dec["winner"], dec["verdict"]
     split = _split(st, winner, verdict_name, dec)
     agreement = {k: mask_agreement(st.model, st.nvec, st.vecs[k], st.event_mask) for k in st.fits if k in st.vecs}
@@ -366,7 +327,7 @@ def _split(st: Stage, winner: str | None, verdict_name: str, dec: dict) -> dict 
     fit = st.fits[winner]
 
     def along(values, limit):  # the scan's points are independent: one task each on the workers
-        return [r for r, _ in run_fits([ValleyPoint(fit, lag, v, limit) for v in values], st.jobs, st.payload)]
+        return [r for r, _ in st.run_fits([ValleyPoint(fit, lag, v, limit) for v in values])]
 
     sp = split_scan(ctx, fit, lag, st.vecs.get(winner), along)
     moved = adopted_fit(ctx, fit, sp["estimate"]) if sp and sp["estimate"] else None
@@ -397,4 +358,4 @@ def _safe_replay(cfg: PlantConfig, setup: ReplaySetup, notes: list, what: str):
         return None
 
 
-__all__ = ["Diagnosis", "Stage", "diagnose", "prepare_recording", "check_effects", "save_fitted", "SCHEMA", "UNITS", "NOISE_TOLERANCE"]
+__all__ = ["Diagnosis", "diagnose", "save_fitted", "SCHEMA", "UNITS", "NOISE_TOLERANCE"]

@@ -94,7 +94,7 @@ def friction_form_check(rc, setup, model, nominal_fit) -> dict | None:
     return out
 
 
-def form_after_effects(check: dict, rc, setup, model, fits: dict, jobs: int) -> dict:
+def form_after_effects(check: dict, rc, setup, model, fits: dict, jobs: int, client=None) -> dict:
     """The other friction form tried again with the single effects on, after an incomplete verdict.
 
     Parameters
@@ -107,6 +107,8 @@ def form_after_effects(check: dict, rc, setup, model, fits: dict, jobs: int) -> 
         Every candidate the declared form's search fitted (name -> FitResult).
     jobs : int
         Worker processes for the refits.
+    client : distributed.Client, optional
+        The run's Dask client (``processes.dask_session``); None: the local pool.
 
     Returns
     -------
@@ -130,7 +132,7 @@ def form_after_effects(check: dict, rc, setup, model, fits: dict, jobs: int) -> 
     order = sorted(screened, key=screened.get)[:FORM_REFITS]
     payload = (plant_to_toml(rc.replace(options={OPTION: other})), setup, model)
     tasks = [FitEffect(effect_candidate(e)) for e in order]
-    refits = {f"{r.name}@{other}": r for r, _ in run_fits(tasks, jobs, payload)} if tasks else {}
+    refits = {f"{r.name}@{other}": r for r, _ in run_fits(tasks, jobs, payload, client=client)} if tasks else {}
     replays += sum(r.sims + 1 for r in refits.values())
     out["replays"] = check["replays"] + replays
     scores = score_all({**fits, **refits}, model.size)

@@ -128,7 +128,7 @@ def _task(context, task) -> FitResult:
 
 def _prepare_task(context, item):
     """Stages 1-2 of the single-recording engine on one recording (a worker task)."""
-    from compliance.diagnosis.servo.diagnose import prepare_recording
+    from compliance.diagnosis.servo.stage import prepare_recording
 
     cfg, stride = context
     frame, meta = item
@@ -267,7 +267,7 @@ def diagnose_joint(cfg: PlantConfig, recordings, *, effects=None, jobs: int | No
     InputError
         No recording, an open-loop recording, an unknown effect, a recording the replay cannot use.
     """
-    from compliance.diagnosis.servo.diagnose import check_effects
+    from compliance.diagnosis.servo.stage import check_effects
 
     t0 = time.perf_counter()
     if not recordings:

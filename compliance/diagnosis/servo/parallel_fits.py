@@ -128,13 +128,14 @@ def _run_task(context: PerProcess, task):
     return res, vec
 
 
-def run_fits(tasks, jobs: int, payload, scheduler: str | None = None) -> list:
-    """(result, residual vector) of every fit task, in task order, on ``jobs`` processes (or Dask).
+def run_fits(tasks, jobs: int, payload, scheduler: str | None = None, client=None) -> list:
+    """(result, residual vector) of every fit task, in task order, on ``jobs`` processes (or Dask: the
+    ``scheduler`` address, or the run's Dask ``client`` from ``processes.dask_session``).
 
     ``payload`` is (plant TOML text, replay set-up, residual model); a task that raises raises here.
     """
     results, stats = map_tasks(_run_task, PerProcess(_fit_context, *payload), list(tasks), workers=jobs,
-                               scheduler=scheduler, progress=False, label="fits", retries=0)
+                               scheduler=scheduler, client=client, progress=False, label="fits", retries=0)
     stats.raise_if_failed()
     return results
 

@@ -1,4 +1,5 @@
-"""The diagnosis as a JSON document (docs/diagnosis-schema.md): plain numbers, SI units named.
+"""The result of one diagnosis of a servo recording (``Diagnosis``, built once by ``servo.diagnose.diagnose``:
+frozen) and its JSON document (docs/diagnosis-schema.md): plain numbers, SI units named.
 
 Also the validation report's ``diagnosis`` entry (``govcheck diagnose --report``,
 :func:`validation_with_diagnosis`): the recording validated before and after, the explanation
@@ -7,15 +8,20 @@ quoting the fits of the table printed beside it, the winner's parameters grouped
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+from functools import cached_property
+
 
 from compliance.effects import EFFECTS
 from compliance.diagnosis.servo.instrument_candidates import finding_words, is_instrument
 from compliance.files.jsonable import json_number, jsonable
+from compliance.model.config import PlantConfig
 from compliance.model.parameters import BASE_BY_KEY
 from compliance.diagnosis.servo.candidates import FRICTION_LEVEL
 from compliance.diagnosis.evidence.residuals import UNITS
 from compliance.diagnosis.servo.selection import RESIDUAL_LIMIT
 from compliance.diagnosis.verdicts.candidate_set import CandidateSet
+from compliance.diagnosis.verdicts.verdict import DiagnosisVerdict
 
 SCHEMA = "govcheck-diagnosis/1"  # docs/diagnosis-schema.md
 
@@ -154,7 +160,7 @@ def validation_with_diagnosis(cfg, frame, meta: dict, diag, data: dict) -> dict:
         The plant the recording was diagnosed against.
     frame, meta
         The recording (``recordings.reader.read_recording``).
-    diag : diagnosis.servo.result.Diagnosis
+    diag : Diagnosis
         The diagnosis (its fitted configuration is validated too, when there is one).
     data : dict
         ``diag.to_dict()`` (explanation, verdict, ranked effects, winner).
@@ -172,3 +178,54 @@ def validation_with_diagnosis(cfg, frame, meta: dict, diag, data: dict) -> dict:
         entry["added"] = _added(next(e for e in data["effects"] if e["name"] == data["winner"]))
     result["diagnosis"] = entry
     return result
+
+
+@dataclass(frozen=True)
+class Diagnosis:
+    """Result of ``diagnose`` (``to_dict`` gives the documented JSON); every field is known when it is built."""
+
+    verdict: DiagnosisVerdict
+    reason: str
+    winner: str | None
+    runner_up: str | None
+    fits: dict
+    scores: dict
+    fit_before: dict
+    fit_after: dict
+    objective_before: dict
+    objective_after: dict
+    windows: list
+    floors: dict
+    cfg: PlantConfig
+    fitted_cfg: PlantConfig | None
+    recording: str
+    seconds: float
+    simulations: int
+    jobs: int
+    notes: list = field(default_factory=list)
+    traces: dict = field(default_factory=dict)
+    agreement: dict = field(default_factory=dict)  # candidate -> share of its chi-square gain inside the windows
+    located_regimes: list = field(default_factory=list)
+    ambiguous: list = field(default_factory=list)  # explanations the recording cannot tell apart (winner first)
+    signals_left: dict = field(default_factory=dict)  # signal -> normalised RMS above select.RESIDUAL_LIMIT after the winner
+    search: list = field(default_factory=list)  # rounds of the multi-effect search (servo/effect_sets.py)
+    contributions: dict = field(default_factory=dict)  # effect -> its own contribution in the winning set
+    suggested_test: dict | None = None  # discriminate.design_test for an ambiguous recording
+    empirical: dict | None = None  # empirical.empirical_term when the library leaves residual
+    split: dict | None = None  # split.split_scan: does the recording pin a lag's split or only its total
+    friction_form: dict | None = None  # friction_form.friction_form_check: another friction law as the base
+
+    def ranked(self) -> list[str]:
+        """Candidate names by BIC, best first (nominal included)."""
+        return sorted(self.scores, key=lambda k: self.scores[k].bic)
+
+    @cached_property
+    def explanation(self) -> str:
+        """The finding in words (``servo.explanation.explain``), written from the fields above when first read."""
+        from compliance.diagnosis.servo.explanation import explain
+
+        return explain(self)
+
+    def to_dict(self, saved_model: str | None = None) -> dict:
+        """The JSON document of docs/diagnosis-schema.md (``saved_model``: where ``save_fitted`` wrote the fitted plant)."""
+        return diagnosis_to_dict(self, saved_model)
