@@ -8,6 +8,7 @@ import numpy as np
 
 from compliance.diagnosis.friction_bench.fit import PRESSURE_EFFECT
 from compliance.diagnosis.friction_bench.position import POSITION_FRICTION
+from compliance.diagnosis.friction_bench.pressure_shape import NONLINEAR_PRESSURE, PRESSURE_FORCE
 from compliance.diagnosis.friction_bench.laws import core_equivalent
 from compliance.units.formatting import fmt_si
 from compliance.diagnosis.verdicts.verdict import DiagnosisVerdict
@@ -45,7 +46,13 @@ def explain_friction(d) -> str:
     w = d.fits[d.winner]
     p = w.params
     parts = []
-    if "pressure_coefficient" in p:
+    if "pressure_exponent" in p:
+        parts.append(f"seal friction that rises with the chamber pressure along a power law (k_p p_r (p_g/p_r)^n, "
+                     f"k_p = {fmt_si(p['pressure_coefficient'], 'N/Pa')}, n = {p['pressure_exponent']:.2f}, p_r = "
+                     f"{fmt_si(p['reference_pressure'], 'Pa')} gauge, on F_C and F_S; the bench effect \u201c{NONLINEAR_PRESSURE.meaning}\u201d, "
+                     "kept because it predicts held-out runs better; the plant model's linear effect matches it at p_r only"
+                     f"{core_equivalent(p)})")
+    elif "pressure_coefficient" in p:
         parts.append(f"seal friction that rises with the chamber pressure (k_p = {fmt_si(p['pressure_coefficient'], 'N/Pa')} "
                      f"on F_C and F_S{core_equivalent(p)})")
     if "bristle_stiffness" in p:
@@ -59,6 +66,12 @@ def explain_friction(d) -> str:
                      f"a = {fmt_si(p['position_gradient'], '1/m')}, c = {fmt_si(p['position_curvature'], '1/m^2')}, "
                      f"x_r = {fmt_si(p['reference_position'], 'm')}; the bench effect \u201c{POSITION_FRICTION.meaning}\u201d, "
                      "kept because it predicts held-out runs better)")
+    if "bias_per_pressure_squared" in p:
+        pmax = max(r.pressure for r in runs)
+        parts.append(f"a direction-independent force of {fmt_si(p['bias_per_pressure_squared'] * pmax ** 2, 'N')} at "
+                     f"{fmt_si(pmax, 'Pa')} gauge growing with the square of the pressure (c2 = "
+                     f"{fmt_si(p['bias_per_pressure_squared'], 'N/Pa^2')}; the bench effect \u201c{PRESSURE_FORCE.meaning}\u201d, kept "
+                     "because it predicts the held-out runs' force offsets)")
     ra = w.rms_per_run()
     text += (f" The missing physics: {' and '.join(parts)}. Adding it cuts the RMS friction error from {fmt_si(np.mean(rb), 'N')} "
              f"to {fmt_si(np.mean(ra), 'N')} ({fmt_si(rb[lo], 'N')} \u2192 {fmt_si(ra[lo], 'N')} at {fmt_si(runs[lo].pressure, 'Pa')} gauge, "

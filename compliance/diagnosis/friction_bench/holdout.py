@@ -15,10 +15,14 @@ sample. Per run the table gives
 - ``ratio`` (held-out / in-sample) and ``ratio_without_offset`` (both with the run's own
   offset removed: the friction law's prediction alone).
 
-``median_ratio`` (median over the runs of held-out / in-sample) is the proof asked for: a law
-that only describes the runs it saw degrades far more out of sample. An added effect is kept
-only when it *earns its parameters on held-out runs* (``earns``): it lowers the held-out error
-of at least ``EARN_FOLDS`` of the runs and the median held-out error by ``EARN_GAIN``.
+``median_ratio`` (median over the runs of held-out / in-sample, each run's force offset
+included) is the proof asked for: a law that only describes the runs it saw degrades far more out
+of sample. ``ratio_without_offset`` is reported beside it, never in its place: the offset is what
+the bias law fitted on the other runs fails to predict of the held-out run's force zero.
+A declared bench effect (``fit.BENCH_EFFECTS``) is kept only when it *earns its parameters on
+held-out runs* (``earns``): it lowers the held-out error of at least ``EARN_FOLDS`` of the runs and
+the median held-out error by ``EARN_GAIN`` (and the BIC over all runs). A ratio can rise when an
+effect is kept: the effect lowers the in-sample error more than the held-out error.
 The folds run on the shared executor (``processes.map_tasks``).
 """
 
@@ -29,6 +33,7 @@ import numpy as np
 from compliance.files.jsonable import json_number
 from compliance.diagnosis.friction_bench.fit import LawFit, fit_law, predict, start_from
 from compliance.diagnosis.friction_bench.position import POSITION_FRICTION
+from compliance.diagnosis.friction_bench.pressure_shape import NONLINEAR_PRESSURE, PRESSURE_FORCE
 from compliance.units.formatting import fmt_si
 from compliance.diagnosis.verdicts.candidate_set import CandidateSet
 
@@ -36,6 +41,8 @@ MIN_RUNS = 3  # fit on at least two pressures, predict a third
 RATIO_TARGET = 1.5  # median held-out error within this multiple of the in-sample error (our target)
 EARN_GAIN = 0.05  # an added effect must lower the median held-out error by 5 % ... (our choice)
 EARN_FOLDS = 0.75  # ... and the held-out error of at least 3 runs in 4 (our choice)
+MIN_PRESSURE_STEP = 0.3e5  # Pa; runs closer in pressure count as one pressure
+BENCH_MEANINGS = {e.name: e.meaning for e in (NONLINEAR_PRESSURE, PRESSURE_FORCE, POSITION_FRICTION)}
 
 
 def _fold(context, item) -> np.ndarray:
@@ -86,6 +93,21 @@ def holdout_table(runs, full: LawFit, held: list) -> dict:
             "unit": "N"}
 
 
+def pooled_holdout(tables: list) -> dict | None:
+    """The held-out proof over every run of every seal (None without a held-out table).
+
+    ``median_ratio`` is the median over all runs of held-out / in-sample RMS, each run's force
+    offset included (the figure judged against ``RATIO_TARGET``); ``median_ratio_without_offset``
+    removes each run's own mean error in both (the friction law's prediction alone).
+    """
+    rows = [row for t in tables if t for row in t["runs"]]
+    if not rows:
+        return None
+    ratio = float(np.median([r["ratio"] for r in rows]))
+    return {"runs": len(rows), "median_ratio": ratio, "ratio_target": RATIO_TARGET, "within_target": bool(ratio <= RATIO_TARGET),
+            "median_ratio_without_offset": float(np.median([r["ratio_without_offset"] for r in rows]))}
+
+
 def earns(with_effect: dict, without: dict) -> dict:
     """Does an added effect earn its parameters on held-out runs? Both tables over the same runs."""
     a = np.array([row["held_out_rms"] for row in with_effect["runs"]])
@@ -106,52 +128,90 @@ def holdout_words(table: dict, seal: str) -> str:
             f"{fmt_si(table['median_held_out_rms'], 'N')} against {fmt_si(table['median_in_sample_rms'], 'N')} in sample "
             f"(median ratio {table['median_ratio']:.2f}, target \u2264 {table['ratio_target']:g}; worst "
             f"{worst['ratio']:.2f} at {fmt_si(worst['pressure_gauge'], 'Pa')} gauge); the held-out runs' own force zeros "
-            f"differ from the others' bias line by up to {fmt_si(max(abs(r['held_out_offset']) for r in rows), 'N')} "
+            f"differ from the bias the others give by up to {fmt_si(max(abs(r['held_out_offset']) for r in rows), 'N')} "
             f"(a bench finding: the sensor zero moves between runs of {seal}, not friction physics); without each "
             f"run's own offset the median ratio is {table['median_ratio_without_offset']:.2f}.")
 
 
 
 
-def prove_out_of_sample(runs, fits: dict, law: str, try_position: bool, *, jobs: int | None = None) -> dict:
-    """The held-out table of ``law`` and, when ``try_position``, whether ``position_dependent_friction`` earns its place.
+def _applies(effect, law: str, runs) -> bool:
+    """Can ``effect`` be added to ``law`` and be refitted in every fold?
+
+    The pressure shapes add a third pressure parameter (n to F_C0 and k_p; c2 to c0 and c1): a fold
+    refits the law on the other runs, so it needs three distinct pressures among them.
+    """
+    from compliance.diagnosis.friction_bench.fit import PRESSURE_EFFECT
+
+    terms = CandidateSet.parse(law).terms
+    if effect.name in terms:
+        return False
+    pressures = np.unique(np.round([r.pressure / MIN_PRESSURE_STEP for r in runs]))
+    if effect is NONLINEAR_PRESSURE:
+        return PRESSURE_EFFECT in terms and pressures.size >= MIN_RUNS + 1
+    if effect is PRESSURE_FORCE:
+        return pressures.size >= MIN_RUNS + 1
+    return True
+
+
+def prove_out_of_sample(runs, fits: dict, law: str, try_effects: bool, *, jobs: int | None = None) -> dict:
+    """The held-out table of ``law`` and, when ``try_effects``, which declared bench effects earn their place.
+
+    The bench effects (``fit.BENCH_EFFECTS``: nonlinear_pressure_friction, pressure_force_curvature,
+    position_dependent_friction, in that order) are tried one after another on the law kept so far;
+    one is kept when it earns its parameters on held-out runs (``earns``) *and* lowers the BIC by
+    ``selection.SIGNIFICANCE`` over all runs.
 
     Returns
     -------
     dict
         ``holdout`` (table of the law finally kept, or None with fewer than ``MIN_RUNS`` runs),
-        ``position`` (the added effect's held-out comparison, its fitted shape and table, or None)
-        and ``law`` (the law kept; its LawFit is added to ``fits`` when it is the new one).
+        ``effects`` (per effect tried: its held-out comparison, ``delta_bic``, ``kept``, fitted
+        parameters and table), ``position`` (the position effect's entry, or None) and ``law`` (the
+        law kept; its LawFit is in ``fits``, the effects not kept are removed from it).
     """
-    from compliance.diagnosis.friction_bench.fit import POSITION_EFFECT
+    from compliance.diagnosis.friction_bench.fit import BENCH_EFFECTS, law_scores
+    from compliance.diagnosis.servo.selection import SIGNIFICANCE
 
     held = held_out_residuals(runs, fits[law], jobs=jobs)
     if held is None:
-        return {"holdout": None, "position": None, "law": law}
+        return {"holdout": None, "effects": [], "position": None, "law": law}
     table = holdout_table(runs, fits[law], held)
-    position = None
-    if try_position and POSITION_EFFECT not in CandidateSet.parse(law).terms:
-        name = CandidateSet.parse(law).plus(POSITION_EFFECT).name if law != "baseline" else POSITION_EFFECT
+    tried = []
+    for effect in (BENCH_EFFECTS if try_effects else ()):
+        if not _applies(effect, law, runs):
+            continue
+        name = CandidateSet.parse(law).plus(effect.name).name if law != "baseline" else effect.name
         fits[name] = fit_law(runs, name, start_from(fits[law].params))
         other = holdout_table(runs, fits[name], held_out_residuals(runs, fits[name], jobs=jobs))
-        position = {"candidate": name, **earns(other, table), "holdout": other}
-        position["parameters"] = {q: fits[name].params[q] for q in ("position_gradient", "position_curvature", "reference_position")}
-        if position["earned"]:
+        scores = law_scores(fits, fits[law].n)
+        trial = {"effect": effect.name, "candidate": name, **earns(other, table), "holdout": other,
+                 "delta_bic": json_number(scores[law].bic - scores[name].bic),
+                 "parameters": {q.name: fits[name].params[q.name] for q in effect.params}}
+        if effect is POSITION_FRICTION:
+            trial["parameters"]["reference_position"] = fits[name].params["reference_position"]
+        if effect is NONLINEAR_PRESSURE:
+            trial["parameters"]["reference_pressure"] = fits[name].params["reference_pressure"]
+        trial["kept"] = bool(trial["earned"] and scores[law].bic - scores[name].bic >= SIGNIFICANCE)
+        if trial["kept"]:
             table, law = other, name
-        else:  # not a candidate of the ranking: its held-out comparison is reported under ``position``
+        else:  # not a candidate of the ranking: its held-out comparison is reported under ``effects``
             fits.pop(name)
-    return {"holdout": table, "position": position, "law": law}
+        tried.append(trial)
+    position = next((t for t in tried if t["effect"] == POSITION_FRICTION.name), None)
+    return {"holdout": table, "effects": tried, "position": position, "law": law}
 
 
-def position_words(position: dict | None) -> str:
-    """One sentence on whether ``position_dependent_friction`` earned its parameters on held-out runs."""
-    if not position:
-        return ""
-    verdict = "kept" if position["earned"] else "not kept"
-    return (f" {POSITION_FRICTION.meaning[0].upper() + POSITION_FRICTION.meaning[1:]} , a declared bench effect: median "
-            f"held-out error {fmt_si(position['median_held_out_rms_without'], 'N')} without it, "
-            f"{fmt_si(position['median_held_out_rms_with'], 'N')} with it, lower in {position['runs_improved']} of "
-            f"{position['runs']} held-out runs: {verdict} (rule: {position['rule']}).")
+def effect_words(tried: list) -> str:
+    """One sentence per declared bench effect tried: did it earn its parameters on held-out runs?"""
+    out = ""
+    for t in tried:
+        meaning = BENCH_MEANINGS[t["effect"]]
+        verdict = "kept" if t["kept"] else ("not kept (BIC)" if t["earned"] else "not kept")
+        out += (f" {meaning[0].upper() + meaning[1:]}, a declared bench effect: median held-out error "
+                f"{fmt_si(t['median_held_out_rms_without'], 'N')} without it, {fmt_si(t['median_held_out_rms_with'], 'N')} "
+                f"with it, lower in {t['runs_improved']} of {t['runs']} held-out runs: {verdict} (rule: {t['rule']}).")
+    return out
 
 
-__all__ = ["holdout_table", "held_out_residuals", "earns", "holdout_words", "prove_out_of_sample", "position_words", "MIN_RUNS", "RATIO_TARGET"]
+__all__ = ["holdout_table", "held_out_residuals", "earns", "holdout_words", "prove_out_of_sample", "effect_words", "MIN_RUNS", "RATIO_TARGET"]
