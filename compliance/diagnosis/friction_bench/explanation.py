@@ -67,11 +67,12 @@ def explain_friction(d) -> str:
                      f"x_r = {fmt_si(p['reference_position'], 'm')}; the bench effect \u201c{POSITION_FRICTION.meaning}\u201d, "
                      "kept because it predicts held-out runs better)")
     if "bias_per_pressure_squared" in p:
-        pmax = max(r.pressure for r in runs)
-        parts.append(f"a direction-independent force of {fmt_si(p['bias_per_pressure_squared'] * pmax ** 2, 'N')} at "
-                     f"{fmt_si(pmax, 'Pa')} gauge growing with the square of the pressure (c2 = "
-                     f"{fmt_si(p['bias_per_pressure_squared'], 'N/Pa^2')}; the bench effect \u201c{PRESSURE_FORCE.meaning}\u201d, kept "
-                     "because it predicts the held-out runs' force offsets)")
+        span = max(r.pressure for r in runs) - min(r.pressure for r in runs)
+        # c2 p^2 trades off against c1 p: its size is how far it bends the bias from a straight line, c2 span^2 / 4
+        parts.append(f"a direction-independent force curved in the pressure (c2 p_g\u00b2, c2 = "
+                     f"{fmt_si(p['bias_per_pressure_squared'], 'N/Pa^2')}: up to {fmt_si(abs(p['bias_per_pressure_squared']) * span ** 2 / 4, 'N')} "
+                     f"off a straight line across the pressures; the bench effect \u201c{PRESSURE_FORCE.meaning}\u201d, kept because it "
+                     "predicts the held-out runs' force offsets)")
     ra = w.rms_per_run()
     text += (f" The missing physics: {' and '.join(parts)}. Adding it cuts the RMS friction error from {fmt_si(np.mean(rb), 'N')} "
              f"to {fmt_si(np.mean(ra), 'N')} ({fmt_si(rb[lo], 'N')} \u2192 {fmt_si(ra[lo], 'N')} at {fmt_si(runs[lo].pressure, 'Pa')} gauge, "
@@ -104,6 +105,14 @@ def format_friction(d: dict, quiet: bool = False) -> str:
             for r in h["runs"]:
                 lines.append(f"  {r['run']:28s} {r['pressure_gauge']/1e5:9.2f} {r['in_sample_rms']:14.3f} {r['held_out_rms']:13.3f} "
                              f"{r['ratio']:6.2f} {r['held_out_offset']:+11.2f} {r['noise_floor']:10.3f}")
-            lines.append(f"  median held-out / in-sample: {h['median_ratio']:.2f} (target <= {h['ratio_target']:g})")
+            lines.append(f"  median held-out / in-sample: {h['median_ratio']:.2f} (target <= {h['ratio_target']:g}); "
+                         f"without each run's own offset: {h['median_ratio_without_offset']:.2f}")
+            for t in s.get("bench_effects") or []:
+                lines.append(f"  bench effect {t['effect']}: {'kept' if t['kept'] else 'not kept'} (held-out error lower in "
+                             f"{t['runs_improved']} of {t['runs']} runs, median {100 * t['median_gain']:+.1f} %, dBIC {t['delta_bic']:.0f})")
+    pooled = d.get("holdout_pooled")
+    if pooled and len(d["seals"]) > 1:
+        lines.append(f"all seals, {pooled['runs']} runs: median held-out / in-sample {pooled['median_ratio']:.2f} "
+                     f"(target <= {pooled['ratio_target']:g}); without each run's own offset: {pooled['median_ratio_without_offset']:.2f}")
     lines.append(f"{d['timing']['seconds']:.1f} s")
     return "\n".join(lines)

@@ -175,6 +175,8 @@ def fit_law(runs: list[Run], name: str, start: dict | None = None) -> LawFit:
     scans = [("stribeck_velocity", [-3.0, -2.5, -2.0, -1.5])]
     if presliding and "bristle_stiffness" not in (start or {}):
         scans.append(("bristle_stiffness", [3.0, 3.5, 4.0, 4.5, 5.0, 5.5, 6.0, 7.0]))
+    if "pressure_exponent" in names and "pressure_exponent" not in (start or {}):  # k_p p_r fixed: n bends the rise about p_r
+        scans.append(("pressure_exponent", [math.log10(e) for e in (0.5, 0.75, 1.5, 2.0, 3.0, 4.0)]))
     for pname, grid in scans:
         j = names.index(pname)
         trials = []
