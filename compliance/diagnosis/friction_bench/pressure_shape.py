@@ -47,7 +47,7 @@ PRESSURE_FORCE = BenchEffect(
     name="pressure_force_curvature",
     meaning=("a direction-independent force that grows with the square of the chamber pressure (pressure transducer "
              "non-linearity or a piston area that changes with pressure: instrumentation, not friction)"),
-    params=(Param("bias_per_pressure_squared", "N/Pa**2", "direction-independent force per Pa^2 of chamber gauge pressure, c2",
+    params=(Param("bias_per_pressure_squared", "N/Pa^2", "direction-independent force per Pa^2 of chamber gauge pressure, c2",
                   0.0, (-2e-10, 2e-10)),),
     equations="F_bias = c0 + c1 p_g + c2 p_g^2",
     source="friction = F - p_g A (Zillen et al. eq. 3) with a second-order pressure-force term: our choice",
