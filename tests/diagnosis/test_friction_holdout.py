@@ -155,6 +155,9 @@ def _docs_block_is_console_output(console: str):
     assert sum(bool(summary.match(line)) for line in block) == 2
     assert any(summary.match(line) for line in console.splitlines())
     assert sum(line.startswith("  bench effect ") for line in block) == 6 and block[-1].startswith("all seals, 8 runs:")
+    refit = re.compile(r"^  (pressure exponent n|c2) refitted without each run: .+; all runs: .+$")
+    assert sum(bool(refit.match(line)) for line in block) == 3
+    assert any(refit.match(line) for line in console.splitlines())
 
 
 def test_real_o_ring_fixture_held_out_table(tmp_path):

@@ -107,6 +107,7 @@ def format_friction(d: dict, quiet: bool = False) -> str:
                              f"{r['ratio']:6.2f} {r['held_out_offset']:+11.2f} {r['noise_floor']:10.3f}")
             lines.append(f"  median held-out / in-sample: {h['median_ratio']:.2f} (target <= {h['ratio_target']:g}); "
                          f"without each run's own offset: {h['median_ratio_without_offset']:.2f}")
+            lines += _refit_lines(h)
             for t in s.get("bench_effects") or []:
                 lines.append(f"  bench effect {t['effect']}: {'kept' if t['kept'] else 'not kept'} (held-out error lower in "
                              f"{t['runs_improved']} of {t['runs']} runs, median {100 * t['median_gain']:+.1f} %, dBIC {t['delta_bic']:.0f})")
@@ -116,3 +117,20 @@ def format_friction(d: dict, quiet: bool = False) -> str:
                      f"(target <= {pooled['ratio_target']:g}); without each run's own offset: {pooled['median_ratio_without_offset']:.2f}")
     lines.append(f"{d['timing']['seconds']:.1f} s")
     return "\n".join(lines)
+
+
+_REFIT_WORDS = {"pressure_exponent": ("pressure exponent n", ""), "bias_per_pressure_squared": ("c2", "N/Pa^2")}
+
+
+def _refit_lines(h: dict) -> list[str]:
+    """Per pressure-shape parameter, its value refitted without each run and with all runs (console)."""
+    from compliance.units.formatting import fmt_si
+
+    out = []
+    for key, (label, unit) in _REFIT_WORDS.items():
+        every = h.get("refit_all_runs", {}).get(key)
+        if not every:
+            continue
+        folds = ", ".join(fmt_si(r["refit"][key]["value"], unit, r["refit"][key]["stderr"]) for r in h["runs"])
+        out.append(f"  {label} refitted without each run: {folds}; all runs: {fmt_si(every['value'], unit, every['stderr'])}")
+    return out

@@ -203,7 +203,12 @@ def _param_stderr(names, res, chi2, n) -> dict:
     rho = min(max(rho, 0.0), 0.99)
     s2 = max(1.0, chi2 / max(n - k, 1)) * (1 + rho) / (1 - rho)
     try:
-        cov = np.linalg.pinv(res.jac.T @ res.jac) * s2
+        # columns scaled to unit norm first: k_p and c1 (N/Pa) span ten decades against the rest, and an unscaled
+        # pseudo-inverse would cut the small directions and report standard errors far too small
+        d = np.linalg.norm(res.jac, axis=0)
+        d[d == 0] = 1.0
+        js = res.jac / d
+        cov = np.linalg.pinv(js.T @ js) / np.outer(d, d) * s2
         su = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     except np.linalg.LinAlgError:
         su = np.full(k, np.inf)

@@ -7,11 +7,15 @@ sample. Per run the table gives
 - ``in_sample_rms``: the RMS error of the law fitted with every run, on this run [N];
 - ``held_out_rms``: the RMS error of the law fitted without this run, on this run [N];
 - ``held_out_offset``: the mean of that error: the run's own force zero relative to the
-  bias line the other runs give (a bench finding, not physics: a sensor zero that moves
+  bias the other runs give (a bench finding, not physics: a sensor zero that moves
   between runs), and ``held_out_rms_without_offset`` with it removed;
 - ``in_sample_offset``: the run's own mean error under the all-runs law: its run-to-run
   offset (a bench finding), and ``in_sample_rms_without_offset``;
 - ``noise_floor``: the force sensor's noise [N];
+- ``refit``: the pressure parameters of the law refitted without this run (``REFIT_KEYS``, value
+  and standard error): with three pressures left a three-parameter pressure shape is determined
+  with none to spare, and folds that disagree by many standard errors say the shape is not the
+  seal's whole story (``refit_all_runs`` gives the all-runs values);
 - ``ratio`` (held-out / in-sample) and ``ratio_without_offset`` (both with the run's own
   offset removed: the friction law's prediction alone).
 
@@ -42,20 +46,29 @@ RATIO_TARGET = 1.5  # median held-out error within this multiple of the in-sampl
 EARN_GAIN = 0.05  # an added effect must lower the median held-out error by 5 % ... (our choice)
 EARN_FOLDS = 0.75  # ... and the held-out error of at least 3 runs in 4 (our choice)
 MIN_PRESSURE_STEP = 0.3e5  # Pa; runs closer in pressure count as one pressure
+REFIT_KEYS = ("pressure_coefficient", "pressure_exponent", "bias_per_pressure", "bias_per_pressure_squared")
 BENCH_MEANINGS = {e.name: e.meaning for e in (NONLINEAR_PRESSURE, PRESSURE_FORCE, POSITION_FRICTION)}
 
 
-def _fold(context, item) -> np.ndarray:
-    """Held-out residual [N] of run ``i`` under the law refitted on the other runs."""
+def _fold(context, item) -> tuple[np.ndarray, dict]:
+    """Held-out residual [N] of run ``i`` under the law refitted on the other runs, and that refit's pressure parameters."""
     runs, name, start = context
     i = item
     fit = fit_law([r for j, r in enumerate(runs) if j != i], name, start)
     r = runs[i]
-    return (r.friction - predict(r, fit))[r.valid]
+    return (r.friction - predict(r, fit))[r.valid], _pressure_parameters(fit)
 
 
-def held_out_residuals(runs, full: LawFit, *, jobs: int | None = None, scheduler: str | None = None) -> list | None:
-    """Each run's residual [N] under the law ``full.name`` refitted without it (None: fewer than ``MIN_RUNS`` runs)."""
+def _pressure_parameters(fit: LawFit) -> dict:
+    """The pressure shape a fit found: ``REFIT_KEYS`` it has, each ``{value, stderr}`` (SI)."""
+    return {k: {"value": json_number(fit.params[k]), "stderr": json_number(fit.stderr.get(k))} for k in REFIT_KEYS if k in fit.params}
+
+
+def held_out_fits(runs, full: LawFit, *, jobs: int | None = None, scheduler: str | None = None) -> list | None:
+    """Per run, (its residual [N], the refit's pressure parameters) under the law ``full.name`` refitted without it.
+
+    None with fewer than ``MIN_RUNS`` runs.
+    """
     if len(runs) < MIN_RUNS:
         return None
     from compliance.processes import map_tasks
@@ -70,9 +83,9 @@ def held_out_residuals(runs, full: LawFit, *, jobs: int | None = None, scheduler
 def holdout_table(runs, full: LawFit, held: list) -> dict:
     """The out-of-sample table of one law (see the module docstring); JSON-ready."""
     rows = []
-    for r, ins, h in zip(runs, full.residuals, held):
+    for r, ins, (h, refit) in zip(runs, full.residuals, held):
         off, ioff = float(np.mean(h)), float(np.mean(ins))
-        rows.append({"run": r.name, "pressure_gauge": json_number(r.pressure),
+        rows.append({"run": r.name, "pressure_gauge": json_number(r.pressure), "refit": refit,
                      "in_sample_rms": json_number(float(np.sqrt(np.mean(ins * ins)))),
                      "in_sample_offset": json_number(ioff),
                      "in_sample_rms_without_offset": json_number(float(np.sqrt(np.mean((ins - ioff) ** 2)))),
@@ -90,7 +103,7 @@ def holdout_table(runs, full: LawFit, held: list) -> dict:
             "median_ratio_without_offset": float(np.median([row["ratio_without_offset"] for row in rows])),
             "median_held_out_rms": float(np.median([row["held_out_rms"] for row in rows])),
             "median_in_sample_rms": float(np.median([row["in_sample_rms"] for row in rows])),
-            "unit": "N"}
+            "refit_all_runs": _pressure_parameters(full), "unit": "N"}
 
 
 def pooled_holdout(tables: list) -> dict | None:
@@ -173,7 +186,7 @@ def prove_out_of_sample(runs, fits: dict, law: str, try_effects: bool, *, jobs: 
     from compliance.diagnosis.friction_bench.fit import BENCH_EFFECTS, law_scores
     from compliance.diagnosis.servo.selection import SIGNIFICANCE
 
-    held = held_out_residuals(runs, fits[law], jobs=jobs)
+    held = held_out_fits(runs, fits[law], jobs=jobs)
     if held is None:
         return {"holdout": None, "effects": [], "position": None, "law": law}
     table = holdout_table(runs, fits[law], held)
@@ -183,7 +196,7 @@ def prove_out_of_sample(runs, fits: dict, law: str, try_effects: bool, *, jobs: 
             continue
         name = CandidateSet.parse(law).plus(effect.name).name if law != "baseline" else effect.name
         fits[name] = fit_law(runs, name, start_from(fits[law].params))
-        other = holdout_table(runs, fits[name], held_out_residuals(runs, fits[name], jobs=jobs))
+        other = holdout_table(runs, fits[name], held_out_fits(runs, fits[name], jobs=jobs))
         scores = law_scores(fits, fits[law].n)
         trial = {"effect": effect.name, "candidate": name, **earns(other, table), "holdout": other,
                  "delta_bic": json_number(scores[law].bic - scores[name].bic),
@@ -214,4 +227,4 @@ def effect_words(tried: list) -> str:
     return out
 
 
-__all__ = ["holdout_table", "held_out_residuals", "earns", "holdout_words", "prove_out_of_sample", "effect_words", "MIN_RUNS", "RATIO_TARGET"]
+__all__ = ["holdout_table", "held_out_fits", "earns", "holdout_words", "prove_out_of_sample", "effect_words", "MIN_RUNS", "RATIO_TARGET"]
