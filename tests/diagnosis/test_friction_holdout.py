@@ -17,7 +17,7 @@ from compliance.characterise.friction_map import piston_area, synthetic_friction
 from compliance.diagnosis.friction_bench.diagnose import FRICTION_RESIDUAL_LIMIT, diagnose_friction
 from compliance.diagnosis.friction_bench.explanation import format_friction
 from compliance.diagnosis.friction_bench.runs import prepare_runs
-from compliance.diagnosis.friction_bench.fit import fit_law
+from compliance.diagnosis.friction_bench.fit import BENCH_EFFECTS, fit_law
 from compliance.diagnosis.friction_bench.holdout import earns, prove_out_of_sample
 from compliance.diagnosis.friction_bench.laws import position_factor
 from compliance.diagnosis.friction_bench.pressure_shape import pressure_rise
@@ -45,16 +45,22 @@ def _runs(gradient: float):
     return prepare_runs(out, None)
 
 
-def _pressure_runs(exponent: float = 1.0, curvature: float = 0.0):
+def _pressure_runs(exponent: float = 1.0, curvature: float = 0.0, drift: float = 0.0):
     """Four runs (1, 3, 5, 7 bar) of a seal whose friction levels rise by KP p_r (p_g / p_r)^exponent (p_r = 4 bar,
-    the runs' median pressure) and whose bench adds a direction-independent curvature * p_g^2 [N/Pa^2]."""
+    the runs' median pressure) and scale by 1 + drift (t - t_m) in each run [1/s], and whose bench adds a
+    direction-independent curvature * p_g^2 [N/Pa^2]."""
     area = piston_area(0.0257)
     out = []
     for i, bar in enumerate((1.0, 3.0, 5.0, 7.0)):
         p = bar * 1e5
         rise = pressure_rise(p, KP, exponent, 4e5)
-        f = synthetic_friction_run([0.005, 0.015], LAW, area=area, pressure_gauge=p, seed=i, pressure_coefficient=rise / p)
-        f["force"] = f["force"] + curvature * p * p + np.random.default_rng(10 + i).normal(0.0, NOISE, len(f))
+        f = synthetic_friction_run([0.005, 0.015, 0.005, 0.015], LAW, area=area, pressure_gauge=p, seed=i,
+                                   pressure_coefficient=rise / p)
+        t = f["time"].to_numpy()
+        v = np.gradient(f["position"].to_numpy(), t)
+        levels = f["force"].to_numpy() - p * area - LAW["viscous"] * v  # the viscous part does not drift
+        f["force"] = (p * area + levels * (1.0 + drift * (t - 0.5 * t[-1])) + LAW["viscous"] * v + curvature * p * p
+                      + np.random.default_rng(10 + i).normal(0.0, NOISE, len(f)))
         out.append((f, {"source_path": f"seal_{bar:.0f}bar.csv", "bore": 0.0257}))
     return prepare_runs(out, None)
 
@@ -74,11 +80,12 @@ def test_power_law_pressure_rise_is_found_and_predicts_every_held_out_pressure()
     tried = _effects(proof)
     assert tried["nonlinear_pressure_friction"]["kept"] and tried["nonlinear_pressure_friction"]["runs_improved"] >= 3
     assert tried["nonlinear_pressure_friction"]["median_held_out_rms_without"] > 3 * tried["nonlinear_pressure_friction"]["median_held_out_rms_with"]
-    assert not tried["pressure_force_curvature"]["kept"] and not tried["position_dependent_friction"]["kept"]
+    assert not any(tried[e]["kept"] for e in ("pressure_force_curvature", "position_dependent_friction", "friction_drift"))
     assert proof["law"] == "pressure_dependent_friction+nonlinear_pressure_friction"
-    # within 10 %: the fit stops after fit.MAX_NFEV evaluations, and v_s and F_S - F_C of these short runs trade off with it
-    assert fits[proof["law"]].params["pressure_exponent"] == pytest.approx(2.0, abs=0.2)
-    assert fits[proof["law"]].params["pressure_coefficient"] == pytest.approx(KP, rel=0.15)
+    # within 5 % (10 % on k_p): the Stribeck dip of these short runs is not resolved (v_s ends on its bound) and the
+    # viscous term trades with the levels
+    assert fits[proof["law"]].params["pressure_exponent"] == pytest.approx(2.0, abs=0.1)
+    assert fits[proof["law"]].params["pressure_coefficient"] == pytest.approx(KP, rel=0.1)
     for row in proof["holdout"]["runs"]:
         assert row["held_out_rms"] < FRICTION_RESIDUAL_LIMIT * NOISE
     assert proof["holdout"]["median_ratio"] < 1.2
@@ -99,6 +106,21 @@ def test_quadratic_pressure_force_is_kept_as_a_bench_effect_and_predicts_the_run
     assert max(abs(r["held_out_offset"]) for r in proof["holdout"]["runs"]) < 2 * NOISE
     gain = tried["pressure_force_curvature"]
     assert gain["median_held_out_rms_without"] > 3 * gain["median_held_out_rms_with"]  # the offsets dominated before
+
+
+def test_friction_drift_shared_by_the_runs_is_kept_and_predicts_each_run():
+    """Friction levels rising 0.5 %/s in every run (a seal warming over ~20 s of strokes: +10 % end to end): the
+    drift is kept with its rate recovered, and each held-out run is predicted to the 3 x noise of a complete law."""
+    runs = _pressure_runs(drift=0.005)
+    fits = {"pressure_dependent_friction": fit_law(runs, "pressure_dependent_friction")}
+    proof = prove_out_of_sample(runs, fits, "pressure_dependent_friction", True, jobs=1)
+    tried = _effects(proof)
+    assert tried["friction_drift"]["kept"] and tried["friction_drift"]["runs_improved"] == 4
+    assert not tried["nonlinear_pressure_friction"]["kept"] and not tried["pressure_force_curvature"]["kept"]
+    # within 10 %: r is relative to the levels, and on these short runs the fit moves part of the viscous force into them
+    assert fits[proof["law"]].params["drift_rate"] == pytest.approx(0.005, rel=0.1)
+    for row in proof["holdout"]["runs"]:
+        assert row["held_out_rms"] < FRICTION_RESIDUAL_LIMIT * NOISE
 
 
 def test_true_law_predicts_held_out_pressures_to_the_noise_and_position_effect_earns_its_place():
@@ -128,7 +150,7 @@ def test_position_effect_not_kept_when_the_runs_have_none():
     assert not proof["position"]["earned"]
     assert proof["law"] == "pressure_dependent_friction" and len(fits) == 1  # the rejected candidates are not ranked
     assert [t["effect"] for t in proof["effects"]] == ["nonlinear_pressure_friction", "pressure_force_curvature",
-                                                      "position_dependent_friction"]
+                                                      "position_dependent_friction", "friction_drift"]
     assert not any(t["kept"] for t in proof["effects"])
     assert proof["holdout"]["median_ratio"] < 1.1
     assert max(r["held_out_rms"] for r in proof["holdout"]["runs"]) < FRICTION_RESIDUAL_LIMIT * NOISE
@@ -154,7 +176,8 @@ def _docs_block_is_console_output(console: str):
     summary = re.compile(r"^  median held-out / in-sample: \d+\.\d\d \(target <= 1\.5\); without each run's own offset: \d+\.\d\d$")
     assert sum(bool(summary.match(line)) for line in block) == 2
     assert any(summary.match(line) for line in console.splitlines())
-    assert sum(line.startswith("  bench effect ") for line in block) == 6 and block[-1].startswith("all seals, 8 runs:")
+    assert sum(line.startswith("  bench effect ") for line in block) == 2 * len(BENCH_EFFECTS)
+    assert block[-1].startswith("all seals, 8 runs:")
     refit = re.compile(r"^  (pressure exponent n|c2) refitted without each run: .+; all runs: .+$")
     assert sum(bool(refit.match(line)) for line in block) == 3
     assert any(refit.match(line) for line in console.splitlines())
@@ -183,7 +206,7 @@ def test_real_o_ring_fixture_held_out_table(tmp_path):
     assert h["median_ratio"] <= 1.5 and h["within_target"]
     assert h["median_ratio_without_offset"] <= h["median_ratio"]
     tried = {t["effect"]: t for t in seal["bench_effects"]}
-    assert set(tried) == {"nonlinear_pressure_friction", "pressure_force_curvature", "position_dependent_friction"}
+    assert set(tried) == {"nonlinear_pressure_friction", "pressure_force_curvature", "position_dependent_friction", "friction_drift"}
     curve = tried["pressure_force_curvature"]
     assert curve["kept"] and curve["runs_improved"] >= 3
     bend = -curve["parameters"]["bias_per_pressure_squared"] * 6e5 ** 2 / 4  # N off a straight line at mid-range

@@ -16,7 +16,10 @@ once:
 3. candidates: ``pressure_dependent_friction`` (F_C and F_S rise by k_p p_g, the core
    effect of that name), ``presliding_hysteresis`` (LuGre bristles, stiffness sigma0) and both;
    each fitted, ranked by BIC on the normalised residuals (``servo.selection.score_all``);
-4. explain, per pressure before/after RMS, and the fitted law per seal.
+4. prove out of sample (``holdout``): each pressure predicted by the law refitted on the others;
+   the declared bench effects (power-law pressure rise, curved pressure force, friction along the
+   stroke, drift during a run) kept only when they earn their parameters there;
+5. explain, per pressure before/after RMS, and the fitted law per seal.
 """
 
 from __future__ import annotations

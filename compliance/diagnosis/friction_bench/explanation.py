@@ -9,6 +9,7 @@ import numpy as np
 from compliance.diagnosis.friction_bench.fit import PRESSURE_EFFECT
 from compliance.diagnosis.friction_bench.position import POSITION_FRICTION
 from compliance.diagnosis.friction_bench.pressure_shape import NONLINEAR_PRESSURE, PRESSURE_FORCE
+from compliance.diagnosis.friction_bench.running_in import FRICTION_DRIFT
 from compliance.diagnosis.friction_bench.laws import core_equivalent
 from compliance.units.formatting import fmt_si
 from compliance.diagnosis.verdicts.verdict import DiagnosisVerdict
@@ -65,6 +66,10 @@ def explain_friction(d) -> str:
         parts.append(f"friction that changes along the stroke (levels \u00d7 (1 + a (x \u2212 x_r) + c (x \u2212 x_r)\u00b2), "
                      f"a = {fmt_si(p['position_gradient'], '1/m')}, c = {fmt_si(p['position_curvature'], '1/m^2')}, "
                      f"x_r = {fmt_si(p['reference_position'], 'm')}; the bench effect \u201c{POSITION_FRICTION.meaning}\u201d, "
+                     "kept because it predicts held-out runs better)")
+    if "drift_rate" in p:
+        parts.append(f"friction that drifts during each run (both levels \u00d7 (1 + r (t \u2212 t_m)), r = "
+                     f"{100 * p['drift_rate']:.3f} %/s from the run's mid time; the bench effect \u201c{FRICTION_DRIFT.meaning}\u201d, "
                      "kept because it predicts held-out runs better)")
     if "bias_per_pressure_squared" in p:
         span = max(r.pressure for r in runs) - min(r.pressure for r in runs)

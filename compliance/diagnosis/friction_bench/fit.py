@@ -19,15 +19,16 @@ from scipy.optimize import least_squares
 from compliance.diagnosis.friction_bench.laws import bias_force, friction_force
 from compliance.diagnosis.friction_bench.position import POSITION_FRICTION, reference_position
 from compliance.diagnosis.friction_bench.pressure_shape import NONLINEAR_PRESSURE, PRESSURE_FORCE, reference_pressure
+from compliance.diagnosis.friction_bench.running_in import FRICTION_DRIFT
 from compliance.diagnosis.friction_bench.runs import Run
 from compliance.diagnosis.verdicts.candidate_set import CandidateSet
 
 
-MAX_NFEV = 40  # least-squares evaluations per candidate law (besides the Jacobian's)
+MAX_NFEV = 100  # least-squares evaluations per candidate law (besides the Jacobian's); the real runs stop on ftol well before
 PRESSURE_EFFECT = "pressure_dependent_friction"
 PRESLIDING = "presliding_hysteresis"
 POSITION_EFFECT = POSITION_FRICTION.name
-BENCH_EFFECTS = (NONLINEAR_PRESSURE, PRESSURE_FORCE, POSITION_FRICTION)  # declared, each kept only if it earns its place held out
+BENCH_EFFECTS = (NONLINEAR_PRESSURE, PRESSURE_FORCE, POSITION_FRICTION, FRICTION_DRIFT)  # declared, each kept only if it earns its place held out
 LAWS = {  # candidate -> (pressure dependent, pre-sliding)
     "baseline": (False, False),
     PRESSURE_EFFECT: (True, False),

@@ -38,6 +38,7 @@ from compliance.files.jsonable import json_number
 from compliance.diagnosis.friction_bench.fit import LawFit, fit_law, predict, start_from
 from compliance.diagnosis.friction_bench.position import POSITION_FRICTION
 from compliance.diagnosis.friction_bench.pressure_shape import NONLINEAR_PRESSURE, PRESSURE_FORCE
+from compliance.diagnosis.friction_bench.running_in import FRICTION_DRIFT
 from compliance.units.formatting import fmt_si
 from compliance.diagnosis.verdicts.candidate_set import CandidateSet
 
@@ -47,7 +48,7 @@ EARN_GAIN = 0.05  # an added effect must lower the median held-out error by 5 % 
 EARN_FOLDS = 0.75  # ... and the held-out error of at least 3 runs in 4 (our choice)
 MIN_PRESSURE_STEP = 0.3e5  # Pa; runs closer in pressure count as one pressure
 REFIT_KEYS = ("pressure_coefficient", "pressure_exponent", "bias_per_pressure", "bias_per_pressure_squared")
-BENCH_MEANINGS = {e.name: e.meaning for e in (NONLINEAR_PRESSURE, PRESSURE_FORCE, POSITION_FRICTION)}
+BENCH_MEANINGS = {e.name: e.meaning for e in (NONLINEAR_PRESSURE, PRESSURE_FORCE, POSITION_FRICTION, FRICTION_DRIFT)}
 
 
 def _fold(context, item) -> tuple[np.ndarray, dict]:
@@ -171,7 +172,7 @@ def prove_out_of_sample(runs, fits: dict, law: str, try_effects: bool, *, jobs: 
     """The held-out table of ``law`` and, when ``try_effects``, which declared bench effects earn their place.
 
     The bench effects (``fit.BENCH_EFFECTS``: nonlinear_pressure_friction, pressure_force_curvature,
-    position_dependent_friction, in that order) are tried one after another on the law kept so far;
+    position_dependent_friction, friction_drift, in that order) are tried one after another on the law kept so far;
     one is kept when it earns its parameters on held-out runs (``earns``) *and* lowers the BIC by
     ``selection.SIGNIFICANCE`` over all runs.
 

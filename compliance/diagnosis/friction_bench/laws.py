@@ -15,7 +15,9 @@ F_f the seal friction. Three friction laws, nested:
 - position-dependent seal friction (``friction_bench.position.POSITION_FRICTION``): both levels
   scale with 1 + a1 (x - x_r) + a2 (x - x_r)^2 along the stroke;
 - a pressure rise along a power law, k_p p_r (p_g / p_r)^n, and a bias term c2 p_g^2
-  (``friction_bench.pressure_shape``).
+  (``friction_bench.pressure_shape``);
+- friction drifting during each run: both levels scale with 1 + r (t - t_m)
+  (``friction_bench.running_in``).
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ from numba import njit
 from compliance.physics.friction import lugre_sampled_force, stribeck_magnitude
 from compliance.diagnosis.friction_bench.position import MIN_FACTOR
 from compliance.diagnosis.friction_bench.pressure_shape import pressure_rise
+from compliance.diagnosis.friction_bench.running_in import drift_factor
 
 
 @njit(cache=True)
@@ -89,7 +92,7 @@ def friction_force(velocity, pressure_gauge, time, params: dict, *, presliding: 
     v = np.asarray(velocity, dtype=float)
     g = stribeck_level(v, pressure_gauge, params["coulomb"], params["static"], params["stribeck_velocity"],
                        params.get("pressure_coefficient", 0.0), params.get("pressure_exponent", 1.0),
-                       params.get("reference_pressure", 1.0)) * position_factor(position, params)
+                       params.get("reference_pressure", 1.0)) * position_factor(position, params) * drift_factor(time, params)
     if presliding:
         dt = np.concatenate(([0.0], np.diff(np.asarray(time, dtype=float))))
         return lugre_sampled_force(np.ascontiguousarray(v), np.ascontiguousarray(g), dt, float(params["bristle_stiffness"]), n_sub) \
