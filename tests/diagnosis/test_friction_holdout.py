@@ -18,7 +18,7 @@ from compliance.diagnosis.friction_bench.diagnose import FRICTION_RESIDUAL_LIMIT
 from compliance.diagnosis.friction_bench.explanation import format_friction
 from compliance.diagnosis.friction_bench.runs import prepare_runs
 from compliance.diagnosis.friction_bench.fit import BENCH_EFFECTS, fit_law
-from compliance.diagnosis.friction_bench.holdout import earns, prove_out_of_sample
+from compliance.diagnosis.friction_bench.holdout import earns, pooled_holdout, prove_out_of_sample
 from compliance.diagnosis.friction_bench.laws import position_factor
 from compliance.diagnosis.friction_bench.pressure_shape import pressure_rise
 
@@ -154,6 +154,17 @@ def test_position_effect_not_kept_when_the_runs_have_none():
     assert not any(t["kept"] for t in proof["effects"])
     assert proof["holdout"]["median_ratio"] < 1.1
     assert max(r["held_out_rms"] for r in proof["holdout"]["runs"]) < FRICTION_RESIDUAL_LIMIT * NOISE
+
+
+def test_pooled_ratio_is_the_median_over_every_run_of_every_seal():
+    def table(ratios):
+        return {"runs": [{"ratio": r, "ratio_without_offset": r - 0.1} for r in ratios]}
+
+    pooled = pooled_holdout([table([1.0, 1.1, 1.2, 1.3]), None, table([1.4, 2.0, 2.2, 3.9])])
+    assert pooled["runs"] == 8 and pooled["median_ratio"] == pytest.approx(1.35) and pooled["within_target"]
+    assert pooled["median_ratio_without_offset"] == pytest.approx(1.25)
+    assert not pooled_holdout([table([1.4, 2.0, 2.2, 3.9])])["within_target"]
+    assert pooled_holdout([None]) is None
 
 
 def test_earns_needs_most_runs_and_a_median_gain():
