@@ -51,8 +51,8 @@ def explain_friction(d) -> str:
         parts.append(f"seal friction that rises with the chamber pressure along a power law (k_p p_r (p_g/p_r)^n, "
                      f"k_p = {fmt_si(p['pressure_coefficient'], 'N/Pa')}, n = {p['pressure_exponent']:.2f}, p_r = "
                      f"{fmt_si(p['reference_pressure'], 'Pa')} gauge, on F_C and F_S; the bench effect \u201c{NONLINEAR_PRESSURE.meaning}\u201d, "
-                     "kept because it predicts held-out runs better; the plant model's linear effect matches it at p_r only"
-                     f"{core_equivalent(p)})")
+                     f"kept because it predicts held-out runs better{core_equivalent(p)}, a straight line that meets the power law "
+                     "at zero and at p_r only)")
     elif "pressure_coefficient" in p:
         parts.append(f"seal friction that rises with the chamber pressure (k_p = {fmt_si(p['pressure_coefficient'], 'N/Pa')} "
                      f"on F_C and F_S{core_equivalent(p)})")
