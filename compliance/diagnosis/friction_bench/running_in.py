@@ -1,10 +1,10 @@
 """Declared bench effect: seal friction that drifts during a run (``friction_drift``).
 
-An elastomer seal's friction is not fixed over a run of strokes: the contact warms with the
-friction work and the lubricant film is redistributed by each stroke, so the friction level
-drifts with the time the seal has been sliding (running-in; the time dependence of elastomer seal
-friction is described in Parker O-Ring Handbook ORD 5700, 2021, section 5, "Friction"). Both
-Stribeck levels are scaled by one factor linear in the time from the middle of each run:
+An elastomer seal's friction is not fixed over a run of strokes: running friction heats the seal,
+the warmed elastomer swells and presses harder, and its friction rises (Apple Rubber, Seal Design
+Guide, "Effects of friction"); the lubricant film is also redistributed by each stroke. The
+friction level therefore drifts with the time the seal has been sliding. Both Stribeck levels are
+scaled by one factor linear in the time from the middle of each run:
 
     F_C,S(t) = F_C,S * (1 + r (t - t_m)),   t_m = the run's mid time,
 
@@ -25,7 +25,7 @@ FRICTION_DRIFT = BenchEffect(
     meaning="the seal's friction level drifts during each run (running-in: the contact warms, the lubricant film moves)",
     params=(Param("drift_rate", "1/s", "relative change of both friction levels per second of the run, r", 0.0, (-0.02, 0.02)),),
     equations="F_C,S(t) = F_C,S (1 + r (t - t_m))",
-    source="time dependence of elastomer seal friction (Parker O-Ring Handbook ORD 5700, 2021); linear form: our choice",
+    source="friction heating swells the seal and raises its friction (Apple Rubber, Seal Design Guide); linear form: our choice",
 )
 
 
