@@ -16,7 +16,10 @@ once:
 3. candidates: ``pressure_dependent_friction`` (F_C and F_S rise by k_p p_g, the core
    effect of that name), ``presliding_hysteresis`` (LuGre bristles, stiffness sigma0) and both;
    each fitted, ranked by BIC on the normalised residuals (``servo.selection.score_all``);
-4. explain, per pressure before/after RMS, and the fitted law per seal.
+4. prove out of sample (``holdout``): each pressure predicted by the law refitted on the others;
+   the declared bench effects (power-law pressure rise, curved pressure force, friction along the
+   stroke, drift during a run) kept only when they earn their parameters there;
+5. explain, per pressure before/after RMS, and the fitted law per seal.
 """
 
 from __future__ import annotations
@@ -27,14 +30,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from compliance.files.jsonable import json_number
-from compliance.diagnosis.friction_bench.fit import LAWS, PRESLIDING, PRESSURE_EFFECT, LawFit, fit_law
-from compliance.diagnosis.friction_bench.position import POSITION_FRICTION
+from compliance.diagnosis.friction_bench.fit import BENCH_EFFECTS, LAWS, PRESLIDING, PRESSURE_EFFECT, LawFit, fit_law, law_scores
 from compliance.diagnosis.friction_bench.explanation import explain_friction, format_friction  # noqa: F401 (re-exported)
-from compliance.diagnosis.friction_bench.holdout import holdout_words, position_words, prove_out_of_sample
+from compliance.diagnosis.friction_bench.holdout import effect_words, holdout_words, pooled_holdout, prove_out_of_sample
 from compliance.diagnosis.friction_bench.runs import Run, prepare_runs
 from compliance.diagnosis.servo.report_data import SCHEMA
 from compliance.diagnosis.friction_bench.residual_structure import friction_structure
-from compliance.diagnosis.servo.selection import EXPLAINED_ENOUGH, NOISE_TOLERANCE, score_all
+from compliance.diagnosis.servo.selection import EXPLAINED_ENOUGH, NOISE_TOLERANCE
 from compliance.diagnosis.verdicts.candidate_set import CandidateSet
 from compliance.diagnosis.verdicts.verdict import DiagnosisVerdict
 
@@ -44,7 +46,7 @@ from compliance.diagnosis.verdicts.verdict import DiagnosisVerdict
 FRICTION_RESIDUAL_LIMIT = 3.0
 UNITS = {"bias": "N", "bias_per_pressure": "N/Pa", "coulomb": "N", "static": "N", "stribeck_velocity": "m/s",
          "viscous": "N*s/m", "pressure_coefficient": "N/Pa", "bristle_stiffness": "N/m", "reference_position": "m",
-         **{q.name: q.unit for q in POSITION_FRICTION.params}}
+         "reference_pressure": "Pa", **{q.name: q.unit for e in BENCH_EFFECTS for q in e.params}}
 MEANING = {
     "bias": "force-sensor zero (direction-independent)",
     "bias_per_pressure": "piston-area error: direction-independent force per Pa of chamber pressure",
@@ -55,7 +57,8 @@ MEANING = {
     "pressure_coefficient": "rise of F_C and F_S per Pa of chamber gauge pressure, k_p",
     "bristle_stiffness": "LuGre bristle stiffness sigma0 (pre-sliding distance = F_C/sigma0)",
     "reference_position": "x_r, centre of the position-dependent friction (median position of the runs; not fitted)",
-    **{q.name: q.meaning for q in POSITION_FRICTION.params},
+    "reference_pressure": "p_r, reference of the power-law pressure rise (median run pressure; not fitted)",
+    **{q.name: q.meaning for e in BENCH_EFFECTS for q in e.params},
 }
 
 
@@ -110,6 +113,7 @@ class SealDiagnosis:
     structure: dict | None = None  # friction_structure: what the law leaves, named (empirical)
     holdout: dict | None = None  # friction_holdout: each pressure predicted by the law fitted on the others
     position: dict | None = None  # friction_holdout: does position_dependent_friction earn its parameters held out
+    bench_effects: list = field(default_factory=list)  # friction_holdout: every declared bench effect tried held out
 
     def to_dict(self) -> dict:
         """JSON-ready (SI units; see docs/diagnosis-schema.md, friction)."""
@@ -139,15 +143,10 @@ class SealDiagnosis:
             "windows": self.located, "windows_after": self.located_after,
             "noise_floor": {"value": json_number(self.noise_floor), "unit": "N"},
             "structure_left": self.structure, "holdout": self.holdout, "position_effect": self.position,
+            "bench_effects": self.bench_effects,
         }
 
 
-
-
-def _scores(fits: dict, n: int) -> dict:
-    scores = score_all({"nominal": _as_fit(fits["baseline"]), **{k: _as_fit(v) for k, v in fits.items() if k != "baseline"}}, n)
-    scores["baseline"] = scores.pop("nominal")
-    return scores
 
 
 def diagnose_seal(runs: list[Run], jobs: int | None = None) -> SealDiagnosis:
@@ -172,7 +171,7 @@ def diagnose_seal(runs: list[Run], jobs: int | None = None) -> SealDiagnosis:
                           "bristle_stiffness": math.log10(fits[PRESLIDING].params["bristle_stiffness"])})
         fits[name] = fit_law(runs, name, start)
     n = fits["baseline"].n
-    scores = _scores(fits, n)
+    scores = law_scores(fits, n)
     located = locate_friction(runs, fits["baseline"])
     floor = float(np.median([r.floor for r in runs]))
     rms_norm = math.sqrt(fits["baseline"].chi2 / n)
@@ -192,12 +191,11 @@ def diagnose_seal(runs: list[Run], jobs: int | None = None) -> SealDiagnosis:
                 winner = k
         verdict = DiagnosisVerdict.MISSING_PHYSICS if scores[winner].explained >= EXPLAINED_ENOUGH else DiagnosisVerdict.UNEXPLAINED
     proof = prove_out_of_sample(runs, fits, winner or "baseline", verdict != DiagnosisVerdict.NO_MISMATCH, jobs=jobs)
-    if proof["law"] != (winner or "baseline"):  # position_dependent_friction earned its parameters held out ...
-        scores = _scores(fits, n)
-        if scores[winner or "baseline"].bic - scores[proof["law"]].bic >= SIGNIFICANCE:  # ... and by BIC
-            winner = proof["law"]
-            cands.append(winner)
-            verdict = DiagnosisVerdict.MISSING_PHYSICS if scores[winner].explained >= EXPLAINED_ENOUGH else DiagnosisVerdict.UNEXPLAINED
+    if proof["law"] != (winner or "baseline"):  # declared bench effects earned their parameters held out and by BIC
+        scores = law_scores(fits, n)
+        winner = proof["law"]
+        cands.append(winner)
+        verdict = DiagnosisVerdict.MISSING_PHYSICS if scores[winner].explained >= EXPLAINED_ENOUGH else DiagnosisVerdict.UNEXPLAINED
     ranked = sorted(cands, key=lambda k: scores[k].bic)
     runner = next((k for k in ranked if k != winner), None)
     located_after = locate_friction(runs, fits[winner]) if winner else None
@@ -205,7 +203,7 @@ def diagnose_seal(runs: list[Run], jobs: int | None = None) -> SealDiagnosis:
     if verdict == DiagnosisVerdict.MISSING_PHYSICS and after > FRICTION_RESIDUAL_LIMIT:
         verdict = DiagnosisVerdict.PARTIALLY_EXPLAINED  # as select.honest: complete only within the stated multiple of the noise
     diag = SealDiagnosis(runs[0].seal, runs, fits, scores, verdict, winner, runner, located, located_after, "", floor,
-                         holdout=proof["holdout"], position=proof["position"])
+                         holdout=proof["holdout"], position=proof["position"], bench_effects=proof["effects"])
     if verdict != DiagnosisVerdict.NO_MISMATCH:
         diag.structure = friction_structure(runs, fits[winner or "baseline"])
     diag.explanation = explain_friction(diag)
@@ -214,14 +212,8 @@ def diagnose_seal(runs: list[Run], jobs: int | None = None) -> SealDiagnosis:
                              f"{FRICTION_RESIDUAL_LIMIT:g});"
                              f" empirical suggestion, not a declared effect: {diag.structure['words']}")
     if diag.holdout:
-        diag.explanation += holdout_words(diag.holdout, diag.seal) + position_words(diag.position)
+        diag.explanation += holdout_words(diag.holdout, diag.seal) + effect_words(diag.bench_effects)
     return diag
-
-
-def _as_fit(f: LawFit):
-    from compliance.diagnosis.servo.fit import FitResult
-
-    return FitResult(f.name, tuple(range(f.k)), [], [], f.chi2, {}, f.n)
 
 
 @dataclass
@@ -238,7 +230,8 @@ class FrictionDiagnosis:
         worst_first = (DiagnosisVerdict.UNEXPLAINED, DiagnosisVerdict.PARTIALLY_EXPLAINED, DiagnosisVerdict.MISSING_PHYSICS)
         overall = next((v for v in worst_first if v in verdicts), DiagnosisVerdict.NO_MISMATCH)
         return {"schema": SCHEMA, "kind": "friction", "recordings": self.files, "verdict": overall,
-                "seals": [s.to_dict() for s in self.seals], "timing": {"seconds": self.seconds}}
+                "seals": [s.to_dict() for s in self.seals], "holdout_pooled": pooled_holdout([s.holdout for s in self.seals]),
+                "timing": {"seconds": self.seconds}}
 
 
 def diagnose_friction(runs, *, bore: float | None = None, jobs: int | None = None) -> FrictionDiagnosis:

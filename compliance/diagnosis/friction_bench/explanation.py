@@ -8,6 +8,8 @@ import numpy as np
 
 from compliance.diagnosis.friction_bench.fit import PRESSURE_EFFECT
 from compliance.diagnosis.friction_bench.position import POSITION_FRICTION
+from compliance.diagnosis.friction_bench.pressure_shape import NONLINEAR_PRESSURE, PRESSURE_FORCE
+from compliance.diagnosis.friction_bench.running_in import FRICTION_DRIFT
 from compliance.diagnosis.friction_bench.laws import core_equivalent
 from compliance.units.formatting import fmt_si
 from compliance.diagnosis.verdicts.verdict import DiagnosisVerdict
@@ -45,7 +47,13 @@ def explain_friction(d) -> str:
     w = d.fits[d.winner]
     p = w.params
     parts = []
-    if "pressure_coefficient" in p:
+    if "pressure_exponent" in p:
+        parts.append(f"seal friction that rises with the chamber pressure along a power law (k_p p_r (p_g/p_r)^n, "
+                     f"k_p = {fmt_si(p['pressure_coefficient'], 'N/Pa')}, n = {p['pressure_exponent']:.2f}, p_r = "
+                     f"{fmt_si(p['reference_pressure'], 'Pa')} gauge, on F_C and F_S; the bench effect \u201c{NONLINEAR_PRESSURE.meaning}\u201d, "
+                     f"kept because it predicts held-out runs better{core_equivalent(p)}, a straight line that meets the power law "
+                     "at zero and at p_r only)")
+    elif "pressure_coefficient" in p:
         parts.append(f"seal friction that rises with the chamber pressure (k_p = {fmt_si(p['pressure_coefficient'], 'N/Pa')} "
                      f"on F_C and F_S{core_equivalent(p)})")
     if "bristle_stiffness" in p:
@@ -59,6 +67,17 @@ def explain_friction(d) -> str:
                      f"a = {fmt_si(p['position_gradient'], '1/m')}, c = {fmt_si(p['position_curvature'], '1/m^2')}, "
                      f"x_r = {fmt_si(p['reference_position'], 'm')}; the bench effect \u201c{POSITION_FRICTION.meaning}\u201d, "
                      "kept because it predicts held-out runs better)")
+    if "drift_rate" in p:
+        parts.append(f"friction that drifts during each run (both levels \u00d7 (1 + r (t \u2212 t_m)), r = "
+                     f"{100 * p['drift_rate']:.3f} %/s from the run's mid time; the bench effect \u201c{FRICTION_DRIFT.meaning}\u201d, "
+                     "kept because it predicts held-out runs better)")
+    if "bias_per_pressure_squared" in p:
+        span = max(r.pressure for r in runs) - min(r.pressure for r in runs)
+        # c2 p^2 trades off against c1 p: its size is how far it bends the bias from a straight line, c2 span^2 / 4
+        parts.append(f"a direction-independent force curved in the pressure (c2 p_g\u00b2, c2 = "
+                     f"{fmt_si(p['bias_per_pressure_squared'], 'N/Pa^2')}: up to {fmt_si(abs(p['bias_per_pressure_squared']) * span ** 2 / 4, 'N')} "
+                     f"off a straight line across the pressures; the bench effect \u201c{PRESSURE_FORCE.meaning}\u201d, kept because it "
+                     "predicts the held-out runs' force offsets)")
     ra = w.rms_per_run()
     text += (f" The missing physics: {' and '.join(parts)}. Adding it cuts the RMS friction error from {fmt_si(np.mean(rb), 'N')} "
              f"to {fmt_si(np.mean(ra), 'N')} ({fmt_si(rb[lo], 'N')} \u2192 {fmt_si(ra[lo], 'N')} at {fmt_si(runs[lo].pressure, 'Pa')} gauge, "
@@ -91,6 +110,32 @@ def format_friction(d: dict, quiet: bool = False) -> str:
             for r in h["runs"]:
                 lines.append(f"  {r['run']:28s} {r['pressure_gauge']/1e5:9.2f} {r['in_sample_rms']:14.3f} {r['held_out_rms']:13.3f} "
                              f"{r['ratio']:6.2f} {r['held_out_offset']:+11.2f} {r['noise_floor']:10.3f}")
-            lines.append(f"  median held-out / in-sample: {h['median_ratio']:.2f} (target <= {h['ratio_target']:g})")
+            lines.append(f"  median held-out / in-sample: {h['median_ratio']:.2f} (target <= {h['ratio_target']:g}); "
+                         f"without each run's own offset: {h['median_ratio_without_offset']:.2f}")
+            lines += _refit_lines(h)
+            for t in s.get("bench_effects") or []:
+                lines.append(f"  bench effect {t['effect']}: {'kept' if t['kept'] else 'not kept'} (held-out error lower in "
+                             f"{t['runs_improved']} of {t['runs']} runs, median {100 * t['median_gain']:+.1f} %, dBIC {t['delta_bic']:.0f})")
+    pooled = d.get("holdout_pooled")
+    if pooled and len(d["seals"]) > 1:
+        lines.append(f"all seals, {pooled['runs']} runs: median held-out / in-sample {pooled['median_ratio']:.2f} "
+                     f"(target <= {pooled['ratio_target']:g}); without each run's own offset: {pooled['median_ratio_without_offset']:.2f}")
     lines.append(f"{d['timing']['seconds']:.1f} s")
     return "\n".join(lines)
+
+
+_REFIT_WORDS = {"pressure_exponent": ("pressure exponent n", ""), "bias_per_pressure_squared": ("c2", "N/Pa^2")}
+
+
+def _refit_lines(h: dict) -> list[str]:
+    """Per pressure-shape parameter, its value refitted without each run and with all runs (console)."""
+    from compliance.units.formatting import fmt_si
+
+    out = []
+    for key, (label, unit) in _REFIT_WORDS.items():
+        every = h.get("refit_all_runs", {}).get(key)
+        if not every:
+            continue
+        folds = ", ".join(fmt_si(r["refit"][key]["value"], unit, r["refit"][key]["stderr"]) for r in h["runs"])
+        out.append(f"  {label} refitted without each run: {folds}; all runs: {fmt_si(every['value'], unit, every['stderr'])}")
+    return out

@@ -7,18 +7,26 @@ sample. Per run the table gives
 - ``in_sample_rms``: the RMS error of the law fitted with every run, on this run [N];
 - ``held_out_rms``: the RMS error of the law fitted without this run, on this run [N];
 - ``held_out_offset``: the mean of that error: the run's own force zero relative to the
-  bias line the other runs give (a bench finding, not physics: a sensor zero that moves
+  bias the other runs give (a bench finding, not physics: a sensor zero that moves
   between runs), and ``held_out_rms_without_offset`` with it removed;
 - ``in_sample_offset``: the run's own mean error under the all-runs law: its run-to-run
   offset (a bench finding), and ``in_sample_rms_without_offset``;
 - ``noise_floor``: the force sensor's noise [N];
+- ``refit``: the pressure parameters of the law refitted without this run (``REFIT_KEYS``, value
+  and standard error): with three pressures left a three-parameter pressure shape is determined
+  with none to spare, and folds that disagree by many standard errors say the shape is not the
+  seal's whole story (``refit_all_runs`` gives the all-runs values);
 - ``ratio`` (held-out / in-sample) and ``ratio_without_offset`` (both with the run's own
   offset removed: the friction law's prediction alone).
 
-``median_ratio`` (median over the runs of held-out / in-sample) is the proof asked for: a law
-that only describes the runs it saw degrades far more out of sample. An added effect is kept
-only when it *earns its parameters on held-out runs* (``earns``): it lowers the held-out error
-of at least ``EARN_FOLDS`` of the runs and the median held-out error by ``EARN_GAIN``.
+``median_ratio`` (median over the runs of held-out / in-sample, each run's force offset
+included) is the proof asked for: a law that only describes the runs it saw degrades far more out
+of sample. ``ratio_without_offset`` is reported beside it, never in its place: the offset is what
+the bias law fitted on the other runs fails to predict of the held-out run's force zero.
+A declared bench effect (``fit.BENCH_EFFECTS``) is kept only when it *earns its parameters on
+held-out runs* (``earns``): it lowers the held-out error of at least ``EARN_FOLDS`` of the runs and
+the median held-out error by ``EARN_GAIN`` (and the BIC over all runs). A ratio can rise when an
+effect is kept: the effect lowers the in-sample error more than the held-out error.
 The folds run on the shared executor (``processes.map_tasks``).
 """
 
@@ -29,6 +37,8 @@ import numpy as np
 from compliance.files.jsonable import json_number
 from compliance.diagnosis.friction_bench.fit import LawFit, fit_law, predict, start_from
 from compliance.diagnosis.friction_bench.position import POSITION_FRICTION
+from compliance.diagnosis.friction_bench.pressure_shape import NONLINEAR_PRESSURE, PRESSURE_FORCE
+from compliance.diagnosis.friction_bench.running_in import FRICTION_DRIFT
 from compliance.units.formatting import fmt_si
 from compliance.diagnosis.verdicts.candidate_set import CandidateSet
 
@@ -36,19 +46,30 @@ MIN_RUNS = 3  # fit on at least two pressures, predict a third
 RATIO_TARGET = 1.5  # median held-out error within this multiple of the in-sample error (our target)
 EARN_GAIN = 0.05  # an added effect must lower the median held-out error by 5 % ... (our choice)
 EARN_FOLDS = 0.75  # ... and the held-out error of at least 3 runs in 4 (our choice)
+MIN_PRESSURE_STEP = 0.3e5  # Pa; runs closer in pressure count as one pressure
+REFIT_KEYS = ("pressure_coefficient", "pressure_exponent", "bias_per_pressure", "bias_per_pressure_squared")
+BENCH_MEANINGS = {e.name: e.meaning for e in (NONLINEAR_PRESSURE, PRESSURE_FORCE, POSITION_FRICTION, FRICTION_DRIFT)}
 
 
-def _fold(context, item) -> np.ndarray:
-    """Held-out residual [N] of run ``i`` under the law refitted on the other runs."""
+def _fold(context, item) -> tuple[np.ndarray, dict]:
+    """Held-out residual [N] of run ``i`` under the law refitted on the other runs, and that refit's pressure parameters."""
     runs, name, start = context
     i = item
     fit = fit_law([r for j, r in enumerate(runs) if j != i], name, start)
     r = runs[i]
-    return (r.friction - predict(r, fit))[r.valid]
+    return (r.friction - predict(r, fit))[r.valid], _pressure_parameters(fit)
 
 
-def held_out_residuals(runs, full: LawFit, *, jobs: int | None = None, scheduler: str | None = None) -> list | None:
-    """Each run's residual [N] under the law ``full.name`` refitted without it (None: fewer than ``MIN_RUNS`` runs)."""
+def _pressure_parameters(fit: LawFit) -> dict:
+    """The pressure shape a fit found: ``REFIT_KEYS`` it has, each ``{value, stderr}`` (SI)."""
+    return {k: {"value": json_number(fit.params[k]), "stderr": json_number(fit.stderr.get(k))} for k in REFIT_KEYS if k in fit.params}
+
+
+def held_out_fits(runs, full: LawFit, *, jobs: int | None = None, scheduler: str | None = None) -> list | None:
+    """Per run, (its residual [N], the refit's pressure parameters) under the law ``full.name`` refitted without it.
+
+    None with fewer than ``MIN_RUNS`` runs.
+    """
     if len(runs) < MIN_RUNS:
         return None
     from compliance.processes import map_tasks
@@ -63,9 +84,9 @@ def held_out_residuals(runs, full: LawFit, *, jobs: int | None = None, scheduler
 def holdout_table(runs, full: LawFit, held: list) -> dict:
     """The out-of-sample table of one law (see the module docstring); JSON-ready."""
     rows = []
-    for r, ins, h in zip(runs, full.residuals, held):
+    for r, ins, (h, refit) in zip(runs, full.residuals, held):
         off, ioff = float(np.mean(h)), float(np.mean(ins))
-        rows.append({"run": r.name, "pressure_gauge": json_number(r.pressure),
+        rows.append({"run": r.name, "pressure_gauge": json_number(r.pressure), "refit": refit,
                      "in_sample_rms": json_number(float(np.sqrt(np.mean(ins * ins)))),
                      "in_sample_offset": json_number(ioff),
                      "in_sample_rms_without_offset": json_number(float(np.sqrt(np.mean((ins - ioff) ** 2)))),
@@ -83,7 +104,22 @@ def holdout_table(runs, full: LawFit, held: list) -> dict:
             "median_ratio_without_offset": float(np.median([row["ratio_without_offset"] for row in rows])),
             "median_held_out_rms": float(np.median([row["held_out_rms"] for row in rows])),
             "median_in_sample_rms": float(np.median([row["in_sample_rms"] for row in rows])),
-            "unit": "N"}
+            "refit_all_runs": _pressure_parameters(full), "unit": "N"}
+
+
+def pooled_holdout(tables: list) -> dict | None:
+    """The held-out proof over every run of every seal (None without a held-out table).
+
+    ``median_ratio`` is the median over all runs of held-out / in-sample RMS, each run's force
+    offset included (the figure judged against ``RATIO_TARGET``); ``median_ratio_without_offset``
+    removes each run's own mean error in both (the friction law's prediction alone).
+    """
+    rows = [row for t in tables if t for row in t["runs"]]
+    if not rows:
+        return None
+    ratio = float(np.median([r["ratio"] for r in rows]))
+    return {"runs": len(rows), "median_ratio": ratio, "ratio_target": RATIO_TARGET, "within_target": bool(ratio <= RATIO_TARGET),
+            "median_ratio_without_offset": float(np.median([r["ratio_without_offset"] for r in rows]))}
 
 
 def earns(with_effect: dict, without: dict) -> dict:
@@ -106,52 +142,90 @@ def holdout_words(table: dict, seal: str) -> str:
             f"{fmt_si(table['median_held_out_rms'], 'N')} against {fmt_si(table['median_in_sample_rms'], 'N')} in sample "
             f"(median ratio {table['median_ratio']:.2f}, target \u2264 {table['ratio_target']:g}; worst "
             f"{worst['ratio']:.2f} at {fmt_si(worst['pressure_gauge'], 'Pa')} gauge); the held-out runs' own force zeros "
-            f"differ from the others' bias line by up to {fmt_si(max(abs(r['held_out_offset']) for r in rows), 'N')} "
+            f"differ from the bias the others give by up to {fmt_si(max(abs(r['held_out_offset']) for r in rows), 'N')} "
             f"(a bench finding: the sensor zero moves between runs of {seal}, not friction physics); without each "
             f"run's own offset the median ratio is {table['median_ratio_without_offset']:.2f}.")
 
 
 
 
-def prove_out_of_sample(runs, fits: dict, law: str, try_position: bool, *, jobs: int | None = None) -> dict:
-    """The held-out table of ``law`` and, when ``try_position``, whether ``position_dependent_friction`` earns its place.
+def _applies(effect, law: str, runs) -> bool:
+    """Can ``effect`` be added to ``law`` and be refitted in every fold?
+
+    The pressure shapes add a third pressure parameter (n to F_C0 and k_p; c2 to c0 and c1): a fold
+    refits the law on the other runs, so it needs three distinct pressures among them.
+    """
+    from compliance.diagnosis.friction_bench.fit import PRESSURE_EFFECT
+
+    terms = CandidateSet.parse(law).terms
+    if effect.name in terms:
+        return False
+    pressures = np.unique(np.round([r.pressure / MIN_PRESSURE_STEP for r in runs]))
+    if effect is NONLINEAR_PRESSURE:
+        return PRESSURE_EFFECT in terms and pressures.size >= MIN_RUNS + 1
+    if effect is PRESSURE_FORCE:
+        return pressures.size >= MIN_RUNS + 1
+    return True
+
+
+def prove_out_of_sample(runs, fits: dict, law: str, try_effects: bool, *, jobs: int | None = None) -> dict:
+    """The held-out table of ``law`` and, when ``try_effects``, which declared bench effects earn their place.
+
+    The bench effects (``fit.BENCH_EFFECTS``: nonlinear_pressure_friction, pressure_force_curvature,
+    position_dependent_friction, friction_drift, in that order) are tried one after another on the law kept so far;
+    one is kept when it earns its parameters on held-out runs (``earns``) *and* lowers the BIC by
+    ``selection.SIGNIFICANCE`` over all runs.
 
     Returns
     -------
     dict
         ``holdout`` (table of the law finally kept, or None with fewer than ``MIN_RUNS`` runs),
-        ``position`` (the added effect's held-out comparison, its fitted shape and table, or None)
-        and ``law`` (the law kept; its LawFit is added to ``fits`` when it is the new one).
+        ``effects`` (per effect tried: its held-out comparison, ``delta_bic``, ``kept``, fitted
+        parameters and table), ``position`` (the position effect's entry, or None) and ``law`` (the
+        law kept; its LawFit is in ``fits``, the effects not kept are removed from it).
     """
-    from compliance.diagnosis.friction_bench.fit import POSITION_EFFECT
+    from compliance.diagnosis.friction_bench.fit import BENCH_EFFECTS, law_scores
+    from compliance.diagnosis.servo.selection import SIGNIFICANCE
 
-    held = held_out_residuals(runs, fits[law], jobs=jobs)
+    held = held_out_fits(runs, fits[law], jobs=jobs)
     if held is None:
-        return {"holdout": None, "position": None, "law": law}
+        return {"holdout": None, "effects": [], "position": None, "law": law}
     table = holdout_table(runs, fits[law], held)
-    position = None
-    if try_position and POSITION_EFFECT not in CandidateSet.parse(law).terms:
-        name = CandidateSet.parse(law).plus(POSITION_EFFECT).name if law != "baseline" else POSITION_EFFECT
+    tried = []
+    for effect in (BENCH_EFFECTS if try_effects else ()):
+        if not _applies(effect, law, runs):
+            continue
+        name = CandidateSet.parse(law).plus(effect.name).name if law != "baseline" else effect.name
         fits[name] = fit_law(runs, name, start_from(fits[law].params))
-        other = holdout_table(runs, fits[name], held_out_residuals(runs, fits[name], jobs=jobs))
-        position = {"candidate": name, **earns(other, table), "holdout": other}
-        position["parameters"] = {q: fits[name].params[q] for q in ("position_gradient", "position_curvature", "reference_position")}
-        if position["earned"]:
+        other = holdout_table(runs, fits[name], held_out_fits(runs, fits[name], jobs=jobs))
+        scores = law_scores(fits, fits[law].n)
+        trial = {"effect": effect.name, "candidate": name, **earns(other, table), "holdout": other,
+                 "delta_bic": json_number(scores[law].bic - scores[name].bic),
+                 "parameters": {q.name: fits[name].params[q.name] for q in effect.params}}
+        if effect is POSITION_FRICTION:
+            trial["parameters"]["reference_position"] = fits[name].params["reference_position"]
+        if effect is NONLINEAR_PRESSURE:
+            trial["parameters"]["reference_pressure"] = fits[name].params["reference_pressure"]
+        trial["kept"] = bool(trial["earned"] and scores[law].bic - scores[name].bic >= SIGNIFICANCE)
+        if trial["kept"]:
             table, law = other, name
-        else:  # not a candidate of the ranking: its held-out comparison is reported under ``position``
+        else:  # not a candidate of the ranking: its held-out comparison is reported under ``effects``
             fits.pop(name)
-    return {"holdout": table, "position": position, "law": law}
+        tried.append(trial)
+    position = next((t for t in tried if t["effect"] == POSITION_FRICTION.name), None)
+    return {"holdout": table, "effects": tried, "position": position, "law": law}
 
 
-def position_words(position: dict | None) -> str:
-    """One sentence on whether ``position_dependent_friction`` earned its parameters on held-out runs."""
-    if not position:
-        return ""
-    verdict = "kept" if position["earned"] else "not kept"
-    return (f" {POSITION_FRICTION.meaning[0].upper() + POSITION_FRICTION.meaning[1:]} , a declared bench effect: median "
-            f"held-out error {fmt_si(position['median_held_out_rms_without'], 'N')} without it, "
-            f"{fmt_si(position['median_held_out_rms_with'], 'N')} with it, lower in {position['runs_improved']} of "
-            f"{position['runs']} held-out runs: {verdict} (rule: {position['rule']}).")
+def effect_words(tried: list) -> str:
+    """One sentence per declared bench effect tried: did it earn its parameters on held-out runs?"""
+    out = ""
+    for t in tried:
+        meaning = BENCH_MEANINGS[t["effect"]]
+        verdict = "kept" if t["kept"] else ("not kept (BIC)" if t["earned"] else "not kept")
+        out += (f" {meaning[0].upper() + meaning[1:]}, a declared bench effect: median held-out error "
+                f"{fmt_si(t['median_held_out_rms_without'], 'N')} without it, {fmt_si(t['median_held_out_rms_with'], 'N')} "
+                f"with it, lower in {t['runs_improved']} of {t['runs']} held-out runs: {verdict} (rule: {t['rule']}).")
+    return out
 
 
-__all__ = ["holdout_table", "held_out_residuals", "earns", "holdout_words", "prove_out_of_sample", "position_words", "MIN_RUNS", "RATIO_TARGET"]
+__all__ = ["holdout_table", "held_out_fits", "earns", "holdout_words", "prove_out_of_sample", "effect_words", "MIN_RUNS", "RATIO_TARGET"]

@@ -13,7 +13,11 @@ F_f the seal friction. Three friction laws, nested:
   and which makes the friction build up over a pre-sliding displacement g/sigma0 after each
   reversal instead of jumping;
 - position-dependent seal friction (``friction_bench.position.POSITION_FRICTION``): both levels
-  scale with 1 + a1 (x - x_r) + a2 (x - x_r)^2 along the stroke.
+  scale with 1 + a1 (x - x_r) + a2 (x - x_r)^2 along the stroke;
+- a pressure rise along a power law, k_p p_r (p_g / p_r)^n, and a bias term c2 p_g^2
+  (``friction_bench.pressure_shape``);
+- friction drifting during each run: both levels scale with 1 + r (t - t_m)
+  (``friction_bench.running_in``).
 """
 
 from __future__ import annotations
@@ -23,6 +27,8 @@ from numba import njit
 
 from compliance.physics.friction import lugre_sampled_force, stribeck_magnitude
 from compliance.diagnosis.friction_bench.position import MIN_FACTOR
+from compliance.diagnosis.friction_bench.pressure_shape import pressure_rise
+from compliance.diagnosis.friction_bench.running_in import drift_factor
 
 
 @njit(cache=True)
@@ -34,15 +40,18 @@ def _stribeck_levels(speed, coulomb, static, stribeck_velocity):
     return out
 
 
-def stribeck_level(speed, pressure_gauge, coulomb0, static0, stribeck_velocity, pressure_coefficient=0.0):
-    """g(v, p) = F_C(p) + (F_S(p) - F_C(p)) exp(-|v|/v_s) [N] (both levels rise by k_p p_g).
+def stribeck_level(speed, pressure_gauge, coulomb0, static0, stribeck_velocity, pressure_coefficient=0.0,
+                   pressure_exponent=1.0, reference_pressure=1.0):
+    """g(v, p) = F_C(p) + (F_S(p) - F_C(p)) exp(-|v|/v_s) [N] (both levels rise by ``pressure_shape.pressure_rise``:
+    k_p p_g, or k_p p_r (p_g / p_r)^n with an exponent).
 
     Evaluated by ``compliance.physics.friction.stribeck_magnitude``, the simulator's kernel.
     """
     v = np.ascontiguousarray(speed, dtype=float).ravel()
     p = np.broadcast_to(np.asarray(pressure_gauge, dtype=float), np.shape(speed)).ravel()
-    fc = np.ascontiguousarray(coulomb0 + pressure_coefficient * p, dtype=float)
-    fs = np.ascontiguousarray(static0 + pressure_coefficient * p, dtype=float)
+    rise = pressure_rise(p, pressure_coefficient, pressure_exponent, reference_pressure)
+    fc = np.ascontiguousarray(coulomb0 + rise, dtype=float)
+    fs = np.ascontiguousarray(static0 + rise, dtype=float)
     return _stribeck_levels(v, fc, fs, float(stribeck_velocity)).reshape(np.shape(speed))
 
 
@@ -71,7 +80,8 @@ def friction_force(velocity, pressure_gauge, time, params: dict, *, presliding: 
         [s] (the LuGre state integrates over it).
     params : dict
         ``coulomb`` [N], ``static`` [N], ``stribeck_velocity`` [m/s], ``viscous`` [N*s/m],
-        ``pressure_coefficient`` [N/Pa] (0: pressure-independent), ``bristle_stiffness``
+        ``pressure_coefficient`` [N/Pa] (0: pressure-independent; with ``nonlinear_pressure_friction``
+        ``pressure_exponent`` [-] and ``reference_pressure`` [Pa]), ``bristle_stiffness``
         sigma0 [N/m] (with ``presliding``); with ``position_dependent_friction``: ``position_gradient``
         [1/m], ``position_curvature`` [1/m^2], ``reference_position`` [m].
     presliding : bool
@@ -81,7 +91,8 @@ def friction_force(velocity, pressure_gauge, time, params: dict, *, presliding: 
     """
     v = np.asarray(velocity, dtype=float)
     g = stribeck_level(v, pressure_gauge, params["coulomb"], params["static"], params["stribeck_velocity"],
-                       params.get("pressure_coefficient", 0.0)) * position_factor(position, params)
+                       params.get("pressure_coefficient", 0.0), params.get("pressure_exponent", 1.0),
+                       params.get("reference_pressure", 1.0)) * position_factor(position, params) * drift_factor(time, params)
     if presliding:
         dt = np.concatenate(([0.0], np.diff(np.asarray(time, dtype=float))))
         return lugre_sampled_force(np.ascontiguousarray(v), np.ascontiguousarray(g), dt, float(params["bristle_stiffness"]), n_sub) \
@@ -90,8 +101,10 @@ def friction_force(velocity, pressure_gauge, time, params: dict, *, presliding: 
 
 
 def bias_force(pressure_gauge, params: dict) -> np.ndarray:
-    """Direction-independent force of the bench [N]: sensor zero c0 plus area error c1 * p_g."""
-    return params.get("bias", 0.0) + params.get("bias_per_pressure", 0.0) * np.asarray(pressure_gauge, dtype=float)
+    """Direction-independent force of the bench [N]: sensor zero c0, area error c1 p_g and (with
+    ``pressure_force_curvature``) c2 p_g^2."""
+    p = np.asarray(pressure_gauge, dtype=float)
+    return params.get("bias", 0.0) + (params.get("bias_per_pressure", 0.0) + params.get("bias_per_pressure_squared", 0.0) * p) * p
 
 
 def core_equivalent(p: dict) -> str:

@@ -11,8 +11,8 @@ empirical term (``evidence.empirical_force.sparse_fit``, BIC stopping rule):
 - velocity shape: sign(v) sqrt(|v|/v_ref) and sign(v) (|v|/v_ref)^2 besides the viscous term;
 - pressure shape: sign(v) (p_g / 1 bar)^2 (a non-linear rise of the friction with pressure);
 - run-to-run differences: one constant per run beyond the common bias, a drift linear in time
-  within a run, and a friction level of its own per run (a pressure dependence the law's
-  linear rise does not follow).
+  within a run, a friction level of its own per run (a pressure dependence the law does not
+  follow) and a friction level drifting linearly in time within a run.
 
 The terms are reported in words with their size and what they remove; the law plus the terms
 is the empirical model of the seal (labelled an empirical suggestion, not a declared effect).
@@ -74,13 +74,16 @@ def _features(runs) -> tuple[dict[str, np.ndarray], dict[str, str]]:
         feats[f"drift_{r.name}"] = g
         words[f"drift_{r.name}"] = f"a force drifting by {{value}} over run {r.name} (drift during the run)"
         feats[f"level_{r.name}"] = f * sgn
-        words[f"level_{r.name}"] = f"friction {{sign}} by {{size}} in run {r.name} (a pressure dependence the linear law misses)"
+        words[f"level_{r.name}"] = f"friction {{sign}} by {{size}} in run {r.name} (a pressure dependence the law misses)"
+        feats[f"friction_drift_{r.name}"] = g * sgn
+        words[f"friction_drift_{r.name}"] = f"friction {{rising}} by {{size}} over run {r.name} (drift of the friction during the run)"
         start += m
     return feats, words
 
 
 def _words(template: str, c: float) -> str:
-    return template.format(sign="higher" if c > 0 else "lower", size=fmt_si(abs(c), "N", digits=2),
+    return template.format(sign="higher" if c > 0 else "lower", rising="rising" if c > 0 else "falling",
+                           size=fmt_si(abs(c), "N", digits=2),
                            value=("+" if c >= 0 else "") + fmt_si(c, "N", digits=2))
 
 
