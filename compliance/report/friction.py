@@ -162,8 +162,9 @@ def _holdout_context(h: dict | None) -> dict | None:
              "noise": fmt_value(r["noise_floor"], "N", 2)} for r in h["runs"]]
     note = (f"Law {h['law']}, refitted without the held-out run. Median held-out / in-sample: {h['median_ratio']:.2f} "
             f"(target \u2264 {h['ratio_target']:g}); with each run's own offset removed: {h['median_ratio_without_offset']:.2f}. "
-            "The run offset is the held-out run's force zero against the other runs' bias line: a bench finding "
-            "(the sensor zero moves between runs), not friction physics.")
+            "The run offset is the mean of the held-out run's error against the law fitted on the other runs, their "
+            "force bias included (curved in pressure when the pressure-squared bias is kept): a bench finding (a force "
+            "zero that moves between runs), not friction physics.")
     return {"rows": rows, "note": note}
 
 

@@ -41,7 +41,7 @@ POSITION_FRICTION = BenchEffect(
     params=(
         Param("position_gradient", "1/m", "relative change of both friction levels per metre of travel at mid-travel, a1",
               0.0, (-40.0, 40.0)),
-        Param("position_curvature", "1/m**2", "relative curvature of the friction levels along the stroke, a2",
+        Param("position_curvature", "1/m^2", "relative curvature of the friction levels along the stroke, a2",
               0.0, (-2000.0, 2000.0)),
     ),
     equations="F_C,S(x, p) = (F_C0,S0 + k_p p_g) (1 + a1 (x - x_r) + a2 (x - x_r)^2)",
