@@ -29,6 +29,9 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+# the environment as the user's shell gave it, before this script imports compliance (which sets its own
+# process-wide defaults, e.g. one BLAS thread): each side's process starts from it and sets its own
+ENV = dict(os.environ)
 BUDGET = 15.0  # s per 30 s recording on 2 cores (issue 24)
 
 
@@ -60,7 +63,7 @@ def _diagnose(code: Path, rec: Path, out: Path, jobs: int) -> tuple[float, dict]
     """Wall time of one cold ``diagnose`` process running the package in ``code``, and its JSON."""
     if out.exists():
         out.unlink()
-    env = dict(os.environ, PYTHONPATH=str(code))
+    env = dict(ENV, PYTHONPATH=str(code))
     env.pop("NUMBA_CACHE_DIR", None)  # each side its own cache, keyed by its own compiled sources
     cmd = [sys.executable, "-m", "compliance", "diagnose", str(rec), "--json", str(out), "--jobs", str(jobs), "--quiet"]
     t0 = time.perf_counter()
