@@ -160,7 +160,8 @@ def _holdout_context(h: dict | None) -> dict | None:
              "held": fmt_value(r["held_out_rms"], "N", 3), "ratio": fmt_num(r["ratio"], 3),
              "offset": fmt_value(r["held_out_offset"], "N", 2), "ratio0": fmt_num(r["ratio_without_offset"], 3),
              "noise": fmt_value(r["noise_floor"], "N", 2)} for r in h["runs"]]
-    note = (f"Law {h['law']}, refitted without the held-out run. Median held-out / in-sample: {h['median_ratio']:.2f} "
+    law = h["law"].replace("+", " + ")  # a long sum of effects must break at its plus signs
+    note = (f"Law {law}, refitted without the held-out run. Median held-out / in-sample: {h['median_ratio']:.2f} "
             f"(target \u2264 {h['ratio_target']:g}); with each run's own offset removed: {h['median_ratio_without_offset']:.2f}. "
             "The run offset is the mean of the held-out run's error against the law fitted on the other runs, their "
             "force bias included (curved in pressure when the pressure-squared bias is kept): a bench finding (a force "
