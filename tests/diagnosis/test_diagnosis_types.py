@@ -18,6 +18,17 @@ def test_a_diagnosis_cannot_be_changed_after_it_is_built():
     assert "explanation" not in {f.name for f in fields(Diagnosis)}  # written from the fields, not set later
 
 
+def test_a_friction_bench_diagnosis_cannot_be_changed_after_it_is_built():
+    from compliance.diagnosis.friction_bench.diagnose import FrictionDiagnosis, SealDiagnosis
+
+    seal = SealDiagnosis(**{f.name: None for f in fields(SealDiagnosis)})
+    whole = FrictionDiagnosis([seal], 1.0, ["a.csv"])
+    with pytest.raises(FrozenInstanceError):
+        seal.explanation = "set later"
+    with pytest.raises(FrozenInstanceError):
+        whole.seconds = 0.0
+
+
 def test_diagnosis_verdicts_are_their_json_words():
     assert DiagnosisVerdict("missing_physics") is DiagnosisVerdict.MISSING_PHYSICS
     assert f"{DiagnosisVerdict.NO_MISMATCH}" == "no_mismatch"

@@ -25,7 +25,7 @@ once:
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace as dc_replace
 
 import numpy as np
 
@@ -95,9 +95,9 @@ def locate_friction(runs: list[Run], fit: LawFit) -> dict:
 
 
 # ----------------------------------------------------------------------------- diagnosis
-@dataclass
+@dataclass(frozen=True)
 class SealDiagnosis:
-    """The friction diagnosis of one seal."""
+    """The friction diagnosis of one seal (built once by ``diagnose_seal``)."""
 
     seal: str
     runs: list
@@ -202,23 +202,22 @@ def diagnose_seal(runs: list[Run], jobs: int | None = None) -> SealDiagnosis:
     after = math.sqrt(fits[winner].chi2 / n) if winner else rms_norm
     if verdict == DiagnosisVerdict.MISSING_PHYSICS and after > FRICTION_RESIDUAL_LIMIT:
         verdict = DiagnosisVerdict.PARTIALLY_EXPLAINED  # as select.honest: complete only within the stated multiple of the noise
+    structure = friction_structure(runs, fits[winner or "baseline"]) if verdict != DiagnosisVerdict.NO_MISMATCH else None
     diag = SealDiagnosis(runs[0].seal, runs, fits, scores, verdict, winner, runner, located, located_after, "", floor,
-                         holdout=proof["holdout"], position=proof["position"], bench_effects=proof["effects"])
-    if verdict != DiagnosisVerdict.NO_MISMATCH:
-        diag.structure = friction_structure(runs, fits[winner or "baseline"])
-    diag.explanation = explain_friction(diag)
-    if diag.structure:
-        diag.explanation += (f" The law leaves {after:.1f} times the force noise (complete only within "
-                             f"{FRICTION_RESIDUAL_LIMIT:g});"
-                             f" empirical suggestion, not a declared effect: {diag.structure['words']}")
+                         structure=structure, holdout=proof["holdout"], position=proof["position"],
+                         bench_effects=proof["effects"])
+    words = explain_friction(diag)  # the explanation is written from every other field
+    if structure:
+        words += (f" The law leaves {after:.1f} times the force noise (complete only within {FRICTION_RESIDUAL_LIMIT:g});"
+                  f" empirical suggestion, not a declared effect: {structure['words']}")
     if diag.holdout:
-        diag.explanation += holdout_words(diag.holdout, diag.seal) + effect_words(diag.bench_effects)
-    return diag
+        words += holdout_words(diag.holdout, diag.seal) + effect_words(diag.bench_effects)
+    return dc_replace(diag, explanation=words)
 
 
-@dataclass
+@dataclass(frozen=True)
 class FrictionDiagnosis:
-    """Friction diagnosis of every seal in the files given."""
+    """Friction diagnosis of every seal in the files given (built once by ``diagnose_friction``)."""
 
     seals: list = field(default_factory=list)
     seconds: float = 0.0
@@ -252,9 +251,5 @@ def diagnose_friction(runs, *, bore: float | None = None, jobs: int | None = Non
     groups: dict[str, list[Run]] = {}
     for r in prepared:
         groups.setdefault(r.seal, []).append(r)
-    out = FrictionDiagnosis(files=[str(m.get("source_path", "")) for _, m in runs])
-    for seal, rs in groups.items():
-        rs.sort(key=lambda r: r.pressure)
-        out.seals.append(diagnose_seal(rs, jobs))
-    out.seconds = _time.perf_counter() - t0
-    return out
+    seals = [diagnose_seal(sorted(rs, key=lambda r: r.pressure), jobs) for rs in groups.values()]
+    return FrictionDiagnosis(seals, _time.perf_counter() - t0, [str(m.get("source_path", "")) for _, m in runs])
