@@ -2,7 +2,8 @@
 ``compliance.diagnosis.verdicts.verdict`` (diagnoses).
 
 A status (``pass``, ``fail``, ``not_evaluated``, ``uncertain``), a run's overall verdict
-(``incomplete``), a basis (``modelled``, ``by_construction``) or a diagnosis verdict
+(``incomplete``), a basis (``modelled``, ``by_construction``), a requirement's severity
+(``mandatory``, ``advisory``) or a diagnosis verdict
 (``missing_physics``, ``unexplained``, ...) written as a bare string in code is a second spelling
 that a typo or a rename silently breaks. These read the source with ``ast``:
 such a value may appear only as a *name* of something (a dict key, a subscript, the key of a
@@ -17,7 +18,7 @@ import ast
 from pathlib import Path
 
 from compliance.diagnosis.verdicts.verdict import DiagnosisVerdict
-from compliance.requirements.verdict import Basis, Overall, Status
+from compliance.requirements.verdict import Basis, Overall, Severity, Status
 
 PACKAGE = Path(__file__).resolve().parents[1] / "compliance"
 OWNERS = {PACKAGE / "requirements" / "verdict.py", PACKAGE / "diagnosis" / "verdicts" / "verdict.py"}
@@ -25,9 +26,9 @@ OWNERS = {PACKAGE / "requirements" / "verdict.py", PACKAGE / "diagnosis" / "verd
 # "disabled", "assumed" (also a parameter source: paper / assumed / derived / user), "uncertain"
 # (also a sweep file's table of uncertain parameters)
 SHARED_WORDS = {"open", "disabled", "assumed", "uncertain"}
-VERDICT_WORDS = {m.value for enum in (Status, Overall, Basis, DiagnosisVerdict) for m in enum} - SHARED_WORDS
+VERDICT_WORDS = {m.value for enum in (Status, Overall, Basis, Severity, DiagnosisVerdict) for m in enum} - SHARED_WORDS
 KEY_METHODS = {"get", "pop", "setdefault"}
-ENUMS = {"Status", "Overall", "Basis", "DiagnosisVerdict"}
+ENUMS = {"Status", "Overall", "Basis", "Severity", "DiagnosisVerdict"}
 
 
 def _name_positions(tree: ast.AST) -> set[int]:

@@ -16,7 +16,7 @@ A mandatory requirement whose passing rows are all by construction does not coun
 from __future__ import annotations
 
 from compliance.model.parameters import used_by_model
-from compliance.requirements.verdict import Basis, Overall, Status
+from compliance.requirements.verdict import Basis, Overall, Severity, Status
 
 __all__ = ["limit_assumed", "requirement_basis", "row_basis", "verdict_qualifier"]
 
@@ -130,7 +130,7 @@ def verdict_qualifier(results: dict) -> str | None:
     if (results.get("summary") or {}).get("status") != Overall.PASS:
         return None
     words = []
-    if any(e.get("limit_assumed") and e.get("status") == Status.PASS and e.get("severity") == "mandatory"
+    if any(e.get("limit_assumed") and e.get("status") == Status.PASS and e.get("severity") == Severity.MANDATORY
            for e in results.get("requirements") or []):
         words.append("against assumed targets")
     plant = results.get("plant") or {}

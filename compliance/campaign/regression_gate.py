@@ -17,7 +17,7 @@ A requirement already failing in the baseline is reported, not counted as a regr
 from __future__ import annotations
 
 from compliance.campaign.results_files import _STATUS_WORD
-from compliance.requirements.verdict import Overall, Status
+from compliance.requirements.verdict import Overall, Severity, Status
 
 
 def _worst(entry: dict | None):
@@ -43,7 +43,7 @@ def _status_reasons(rid: str, b: dict | None, c: dict | None, why: str | None, a
         return ["requirement removed in the candidate"], None
     if b is None and cs == Status.FAIL:
         return ["new requirement fails"], None
-    if cs == Status.NOT_EVALUATED and (bs == Status.PASS or (bs == Status.FAIL and c["severity"] == "mandatory")):
+    if cs == Status.NOT_EVALUATED and (bs == Status.PASS or (bs == Status.FAIL and c["severity"] == Severity.MANDATORY)):
         if allowed:
             return [], f"{bs} -> not_evaluated allowed explicitly (--allow-not-evaluated {rid}): {why}"
         return [f"{bs} -> not_evaluated: could not be evaluated: {why}"], None

@@ -14,7 +14,7 @@ from compliance.campaign.coverage import CASES_BASIS, case_coverage_text
 from compliance.errors import InputError
 from compliance.files.atomic import write_text_atomic
 from compliance.files.jsonable import json_text, read_json
-from compliance.requirements.verdict import Basis, Status
+from compliance.requirements.verdict import Basis, Severity, Status
 from compliance.presentation.values import limit_as_written
 from compliance.units.formatting import STATUS_WORD as _STATUS_WORD  # the one status-word table
 
@@ -217,7 +217,7 @@ def junit_xml(results: dict) -> str:
                 reason = (r.get("reason") or "not evaluated") if st == Status.NOT_EVALUATED else (
                     f"uncertain: band {band.get('low')} .. {band.get('high')} straddles the limit; decided by "
                     + ", ".join(band.get("deciding") or []))
-                if e["severity"] == "mandatory":
+                if e["severity"] == Severity.MANDATORY:
                     cnt["errors"] += 1
                     body = f"<error message={quoteattr(reason)} type=\"{st}\"/>"
                 else:

@@ -33,7 +33,7 @@ from compliance.requirements.requirement_set import RequirementSet
 from compliance.campaign.basis import verdict_qualifier
 from compliance.campaign.coverage import case_coverage, unjudged
 from compliance.campaign.uncertainty import local_bands, ranged_parameters
-from compliance.requirements.verdict import Basis, Status, overall_status
+from compliance.requirements.verdict import Basis, Severity, Status, overall_status
 
 __all__ = [
     "RESULTS_SCHEMA",
@@ -68,7 +68,7 @@ def summary_counts(entries: list[dict]) -> dict:
     counts = {s: sum(1 for e in entries if e["status"] == s) for s in Status}  # in declared order
     counts["pass_by_construction"] = sum(1 for e in entries if _by_construction(e))
     counts[Status.PASS] -= counts["pass_by_construction"]  # a pass by construction is not evidence: never counted as a pass
-    counts["fail_mandatory"] = sum(1 for e in entries if e["status"] == Status.FAIL and e["severity"] == "mandatory")
+    counts["fail_mandatory"] = sum(1 for e in entries if e["status"] == Status.FAIL and e["severity"] == Severity.MANDATORY)
     counts["fail_advisory"] = counts[Status.FAIL] - counts["fail_mandatory"]
     return counts
 
@@ -80,7 +80,7 @@ def summary_section(entries: list[dict], notes: list[str], uncertainty: dict | N
         "status": overall_status(judged),
         "counts": summary_counts(entries),
         "failed": [e["id"] for e in entries if e["status"] == Status.FAIL],
-        "failed_mandatory": [e["id"] for e in entries if e["status"] == Status.FAIL and e["severity"] == "mandatory"],
+        "failed_mandatory": [e["id"] for e in entries if e["status"] == Status.FAIL and e["severity"] == Severity.MANDATORY],
         "not_evaluated": [e["id"] for e in entries if e["status"] == Status.NOT_EVALUATED],
         "open": [e["id"] for e in entries if e["status"] == Status.OPEN],
         "passed_by_construction": [e["id"] for e in entries if _by_construction(e)],

@@ -29,6 +29,7 @@ from __future__ import annotations
 import math
 
 from compliance.errors import InputError
+from compliance.requirements.verdict import Severity
 
 __all__ = ["CONFLICT", "NARROWING", "RATE_SPLIT", "TENSION", "check_consistency", "consistency_findings"]
 
@@ -56,7 +57,7 @@ def _lower(req, stroke):
 
 def _finding(kind, a, b, procedure, text, **figures) -> dict:
     return {"kind": kind, "requirements": [a.id, b.id], "procedure": procedure, "text": text,
-            "mandatory": a.severity == "mandatory" and b.severity == "mandatory", **figures}
+            "mandatory": a.severity == Severity.MANDATORY and b.severity == Severity.MANDATORY, **figures}
 
 
 def _tau_vs_speed(reqset, stroke, tau_req, v_req) -> list[dict]:

@@ -16,11 +16,11 @@ from compliance.metrics.catalogue import METRICS, STEP_OPTION_DEFAULTS
 from compliance.procedures.kinds import KINDS, parse_setting
 from compliance.requirements.schema import OPEN_LIMIT
 from compliance.requirements.requirement_set import LimitHistory, OperatingPoint, Procedure, Requirement
-from compliance.requirements.verdict import COMPARATORS
+from compliance.requirements.verdict import COMPARATORS, Severity
 
 __all__ = ["SEVERITIES", "SOURCES", "build_operating_point", "build_procedure", "build_requirement", "parse_limit"]
 
-SEVERITIES = ("mandatory", "advisory")
+SEVERITIES = tuple(Severity)
 SOURCES = ("simulation", "linear")
 
 
@@ -141,7 +141,7 @@ def build_requirement(rid, e, origin, defined_in, ops, procs, hist) -> Requireme
     title = where.need(e, "title")
     metric = where.need(e, "metric", list(METRICS))
     comparator = where.need(e, "comparator", list(COMPARATORS))
-    severity = where.choice(e, "severity", "mandatory", SEVERITIES)
+    severity = Severity(where.choice(e, "severity", Severity.MANDATORY, SEVERITIES))
     source = where.choice(e, "source", "simulation", SOURCES)
     limit = parse_limit(e, where.key("limit"), metric, comparator)
     op_names = tuple(e.get("operating_points") or ())
@@ -255,6 +255,6 @@ def _limit_history(rid: str, metric: str, comparator: str, limit, hist) -> tuple
             lim = parse_limit(snap, f"{fpath}: requirements.{rid}.limit", metric, snap.get("comparator", comparator))
         except InputError:
             lim = None if str(snap.get("limit", "")).lower() == OPEN_LIMIT else limit
-        history.append(LimitHistory(fpath, snap.get("comparator", comparator), lim, snap.get("severity", "mandatory"),
+        history.append(LimitHistory(fpath, snap.get("comparator", comparator), lim, snap.get("severity", Severity.MANDATORY),
                                     bool(snap.get("enabled", True)), bool(snap.get("allow_loosen", False))))
     return tuple(history)

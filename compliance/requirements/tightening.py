@@ -11,6 +11,7 @@ import math
 
 from compliance.errors import InputError
 from compliance.requirements.requirement_set import Requirement, format_limit
+from compliance.requirements.verdict import Severity
 
 __all__ = ["check_tightening"]
 
@@ -47,7 +48,7 @@ def check_tightening(req: Requirement, stroke: float) -> list[str]:
             if b[0] < a[0] - tol or b[1] > a[1] + tol:
                 problems.append(f"widens the limit from {format_limit(prev.comparator, prev.limit, 'open')} "
                                 f"to {format_limit(cur.comparator, cur.limit, 'open')}")
-        if prev.severity == "mandatory" and cur.severity == "advisory":
+        if prev.severity == Severity.MANDATORY and cur.severity == Severity.ADVISORY:
             problems.append("lowers the severity from mandatory to advisory")
         if prev.enabled and not cur.enabled:
             problems.append("disables it")

@@ -49,6 +49,13 @@ class Basis(StrEnum):
     NOT_EVALUATED = "not_evaluated"  # no value
 
 
+class Severity(StrEnum):
+    """Whether a requirement decides the run's verdict (a requirement file's ``severity``)."""
+
+    MANDATORY = "mandatory"  # a failure fails the run
+    ADVISORY = "advisory"  # reported beside the verdict, never deciding it
+
+
 @dataclass(frozen=True)
 class Verdict:
     """A value judged against a limit (all SI)."""
@@ -158,7 +165,7 @@ def overall_status(items) -> Overall:
     requirements whose limit is still open (a purchaser's data-sheet value nobody set) are
     reported but do not decide the verdict.
     """
-    mand = [(it[1], it[2] if len(it) > 2 else None) for it in items if it[0] == "mandatory"]
+    mand = [(it[1], it[2] if len(it) > 2 else None) for it in items if it[0] == Severity.MANDATORY]
     st = [s for s, _ in mand]
     if Status.FAIL in st:
         return Overall.FAIL

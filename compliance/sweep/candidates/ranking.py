@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 
-from compliance.requirements.verdict import Basis, Status
+from compliance.requirements.verdict import Basis, Severity, Status
 from compliance.sweep.candidates.evaluate import judged
 
 __all__ = ["SETTINGS_COST", "candidate_passes", "failing_mandatory", "rank_key", "requirement_passes"]
@@ -33,7 +33,7 @@ def failing_mandatory(row: dict) -> list[str]:
     if not judged(row):
         return ["<invalid>"]
     return sorted(rid for rid, r in row["requirements"].items()
-                  if r.get("severity") == "mandatory" and r.get("status") not in (Status.OPEN, Status.DISABLED)
+                  if r.get("severity") == Severity.MANDATORY and r.get("status") not in (Status.OPEN, Status.DISABLED)
                   and not requirement_passes(r))
 
 
@@ -45,7 +45,7 @@ def candidate_passes(row: dict) -> bool:
 def _total_shortfall(row: dict) -> float:
     total = 0.0
     for r in row["requirements"].values():
-        if r.get("severity") != "mandatory" or r.get("status") in (Status.OPEN, Status.DISABLED) or requirement_passes(r):
+        if r.get("severity") != Severity.MANDATORY or r.get("status") in (Status.OPEN, Status.DISABLED) or requirement_passes(r):
             continue
         m = r.get("margin_pct")
         total += max(0.0, -m / 100.0) if m is not None else 1.0  # not evaluated: a full limit short

@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from compliance.files.atomic import write_bytes_atomic, write_text_atomic
-from compliance.requirements.verdict import Status
+from compliance.requirements.verdict import Severity, Status
 from compliance.sweep.candidates.evaluate import judged
 from compliance.sweep.candidates.ranking import rank_key
 from compliance.sweep.candidates.runner import shortfall, total_shortfall
@@ -70,7 +70,7 @@ def tightest(df: pd.DataFrame, rows: list[dict], k: int = 2) -> list[str]:
     scored = []
     for rid, s in sev.items():
         col = f"{rid}.margin_pct"
-        if s == "mandatory" and col in df and df[col].notna().any():
+        if s == Severity.MANDATORY and col in df and df[col].notna().any():
             scored.append((float(df[col].median()), rid))
     return [rid for _, rid in sorted(scored)[:k]]
 

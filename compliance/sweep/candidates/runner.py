@@ -12,7 +12,7 @@ import math
 
 from compliance.campaign.executor import warm_up
 from compliance.processes import map_tasks
-from compliance.requirements.verdict import Status
+from compliance.requirements.verdict import Severity, Status
 from compliance.sweep.candidates.evaluate import Context, Unjudged, evaluate_batch, judged
 
 __all__ = ["batch_size", "run_candidates", "shortfall", "total_shortfall"]
@@ -73,7 +73,7 @@ def shortfall(row: dict) -> float:
         return math.inf
     worst = 0.0
     for r in row["requirements"].values():
-        if r["severity"] != "mandatory" or r["status"] in (Status.OPEN, Status.DISABLED):
+        if r["severity"] != Severity.MANDATORY or r["status"] in (Status.OPEN, Status.DISABLED):
             continue
         if r["status"] == Status.NOT_EVALUATED or r["margin_pct"] is None:
             if r["status"] != Status.PASS:
@@ -88,4 +88,4 @@ def total_shortfall(row: dict) -> float:
     if not math.isfinite(shortfall(row)):
         return math.inf
     return sum(max(0.0, -r["margin_pct"] / 100.0) for r in row["requirements"].values()
-               if r["severity"] == "mandatory" and r["status"] in (Status.PASS, Status.FAIL) and r["margin_pct"] is not None)
+               if r["severity"] == Severity.MANDATORY and r["status"] in (Status.PASS, Status.FAIL) and r["margin_pct"] is not None)

@@ -16,6 +16,7 @@ from compliance.sweep.remedies.binding_physics import explain_closest
 from compliance.sweep.candidates.ranking import SETTINGS_COST, candidate_passes, rank_key
 from compliance.sweep.remedies.smallest_change import describe_candidate
 from compliance.sweep.candidates.runner import run_candidates
+from compliance.requirements.verdict import Severity
 
 __all__ = ["CONFIDENCE", "YIELD_TARGET", "as_given", "finish", "remedy_configuration", "remedy_values"]
 
@@ -65,7 +66,7 @@ def _yield(rem, ctx, cfg, uncertain, run_kw, units):
         "target": YIELD_TARGET, "confidence": CONFIDENCE, "meets": a["lower_bound"] >= YIELD_TARGET,
         "uncertain": y["uncertain"], "drivers": [{"path": d["path"], "rho": d["worst_margin"]} for d in y["drivers"][:3]],
         "worst_requirements": sorted(({"requirement": r["requirement"], "fraction": r["fraction"]} for r in y["requirements"]
-                                      if r["severity"] == "mandatory" and r["fraction"] is not None),
+                                      if r["severity"] == Severity.MANDATORY and r["fraction"] is not None),
                                      key=lambda r: r["fraction"])[:3],
     }
 

@@ -28,7 +28,7 @@ import math
 
 import numpy as np
 
-from compliance.requirements.verdict import Overall, Status
+from compliance.requirements.verdict import Overall, Severity, Status
 from compliance.sweep.candidates.evaluate import judged
 from compliance.sweep.candidates.results import change
 from compliance.sweep.candidates.ranking import SETTINGS_COST, candidate_passes, failing_mandatory, rank_key
@@ -45,7 +45,7 @@ TARGET = 0.02  # margin (fraction of the limit) the linear step aims for, agains
 def mandatory_margins(row: dict) -> dict:
     """Mandatory requirement id -> margin as a fraction of its limit (judged ones only)."""
     return {rid: r["margin_pct"] / 100.0 for rid, r in row["requirements"].items()
-            if r["severity"] == "mandatory" and r["status"] in (Status.PASS, Status.FAIL) and r["margin_pct"] is not None}
+            if r["severity"] == Severity.MANDATORY and r["status"] in (Status.PASS, Status.FAIL) and r["margin_pct"] is not None}
 
 
 def binding(row: dict) -> tuple[str | None, float | None]:
