@@ -1,9 +1,9 @@
-"""Verdict names are a type: spelt once, in ``compliance.requirements.verdict`` (requirements) and
-``compliance.diagnosis.verdicts.verdict`` (diagnoses).
+"""Verdict names are a type: spelt once, in ``compliance.requirements.verdict`` (requirements),
+``compliance.sweep.remedies.outcome`` (remedy searches) and ``compliance.diagnosis.verdicts.verdict`` (diagnoses).
 
 A status (``pass``, ``fail``, ``not_evaluated``, ``uncertain``), a run's overall verdict
 (``incomplete``), a basis (``modelled``, ``by_construction``), a requirement's severity
-(``mandatory``, ``advisory``) or a diagnosis verdict
+(``mandatory``, ``advisory``), a remedy search's outcome (``found``, ``none_found``, ...) or a diagnosis verdict
 (``missing_physics``, ``unexplained``, ...) written as a bare string in code is a second spelling
 that a typo or a rename silently breaks. These read the source with ``ast``:
 such a value may appear only as a *name* of something (a dict key, a subscript, the key of a
@@ -19,16 +19,18 @@ from pathlib import Path
 
 from compliance.diagnosis.verdicts.verdict import DiagnosisVerdict
 from compliance.requirements.verdict import Basis, Overall, Severity, Status
+from compliance.sweep.remedies.outcome import RemedyStatus
 
 PACKAGE = Path(__file__).resolve().parents[1] / "compliance"
-OWNERS = {PACKAGE / "requirements" / "verdict.py", PACKAGE / "diagnosis" / "verdicts" / "verdict.py"}
+OWNERS = {PACKAGE / "requirements" / "verdict.py", PACKAGE / "diagnosis" / "verdicts" / "verdict.py",
+          PACKAGE / "sweep" / "remedies" / "outcome.py"}
 # words that are also plain words or other vocabularies: "open" (a limit nobody set, as text),
 # "disabled", "assumed" (also a parameter source: paper / assumed / derived / user), "uncertain"
 # (also a sweep file's table of uncertain parameters)
 SHARED_WORDS = {"open", "disabled", "assumed", "uncertain"}
-VERDICT_WORDS = {m.value for enum in (Status, Overall, Basis, Severity, DiagnosisVerdict) for m in enum} - SHARED_WORDS
+VERDICT_WORDS = {m.value for enum in (Status, Overall, Basis, Severity, RemedyStatus, DiagnosisVerdict) for m in enum} - SHARED_WORDS
 KEY_METHODS = {"get", "pop", "setdefault"}
-ENUMS = {"Status", "Overall", "Basis", "Severity", "DiagnosisVerdict"}
+ENUMS = {"Status", "Overall", "Basis", "Severity", "RemedyStatus", "DiagnosisVerdict"}
 
 
 def _name_positions(tree: ast.AST) -> set[int]:

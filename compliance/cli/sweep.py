@@ -12,6 +12,7 @@ from pathlib import Path
 
 from compliance.cli.common import add_jobs, add_parser, add_quiet, add_scheduler, check_scheduler
 from compliance.errors import InputError
+from compliance.sweep.remedies.outcome import RemedyStatus
 
 
 def register(subparsers):
@@ -187,7 +188,7 @@ def save_remedy(args, cfg, rem) -> None:
     """Write the remedy configuration (``--save-remedy``) when one was found; say so either way."""
     if not args.save_remedy:
         return
-    if rem.get("status") != "found":
+    if rem.get("status") != RemedyStatus.FOUND:
         print(f"--save-remedy {args.save_remedy}: nothing written (no verified remedy in the declared space)", file=sys.stderr)
         return
     from compliance.model.config import save_plant

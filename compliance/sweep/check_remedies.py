@@ -17,6 +17,7 @@ from compliance.sweep.candidates.evaluate import make_context
 from compliance.model.parameters import param_handle
 from compliance.sweep.candidates.spec import Adjustable, Uncertain
 from compliance.sweep.tolerance.yield_mc import nominal_values
+from compliance.sweep.remedies.outcome import RemedyStatus
 
 __all__ = ["DEFAULT_SPACE", "DEFAULT_TOLERANCES", "YIELD_UNITS", "default_space", "remedies_for_check"]
 
@@ -120,7 +121,7 @@ def remedies_for_check(cfg, reqset, sweep_file: str | None, *, workers=None, pro
     with dask_session(scheduler, client) as session:
         run_kw = {"workers": workers, "progress": progress, "client": session, "scheduler": scheduler, "store": store}
         given = as_given(ctx, run_kw)
-        if given["status"] == "already_passes":
+        if given["status"] == RemedyStatus.ALREADY_PASSES:
             return given
         rem = staged_search(ctx, cfg, adjust, base, cat, iterations=iterations, run_kw=run_kw, limiter=limiter,
                             verify=lambda v: verify_settings(cfg, reqset, paths, v, workers=workers))

@@ -17,6 +17,7 @@ from compliance.sweep.candidates.ranking import SETTINGS_COST, candidate_passes,
 from compliance.sweep.remedies.smallest_change import describe_candidate
 from compliance.sweep.candidates.runner import run_candidates
 from compliance.requirements.verdict import Severity
+from compliance.sweep.remedies.outcome import RemedyStatus
 
 __all__ = ["CONFIDENCE", "YIELD_TARGET", "as_given", "finish", "remedy_configuration", "remedy_values"]
 
@@ -34,11 +35,11 @@ def remedy_values(rem: dict) -> dict | None:
 
 
 def as_given(ctx, run_kw) -> dict:
-    """Judge the configuration as given: ``{"status": "already_passes" | "fails", "row", "candidate", ...}``."""
+    """Judge the configuration as given: ``{"status": RemedyStatus.ALREADY_PASSES | "fails", "row", "candidate", ...}``."""
     (row,), _ = run_candidates(ctx, [{}], **{**run_kw, "label": "as given"})
-    out = {"status": "already_passes" if candidate_passes(row) else "fails", "row": row,
+    out = {"status": RemedyStatus.ALREADY_PASSES if candidate_passes(row) else RemedyStatus.FAILS, "row": row,
            "candidate": describe_candidate((), {}, {}, row)}
-    if out["status"] == "already_passes":
+    if out["status"] == RemedyStatus.ALREADY_PASSES:
         out.update(space=[], failed=[], sensitivities=[], out_of_reach=[], remedy=None, closest=out.pop("candidate"),
                    evaluated=1, note="every mandatory requirement passes as configured: nothing to change")
         out.pop("row")
@@ -83,7 +84,7 @@ def _closest_configuration(cfg, ctx, closest):
 def finish(rem, given, ctx, cfg, reqset, uncertain, catalogue, *, run_kw, yield_units) -> dict:
     """Complete the ``remedies`` section (see the module note); ``given`` is :func:`as_given`'s answer."""
     rem["as_given_failed"] = given["candidate"]["failed_mandatory"]
-    if rem["status"] == "none_found":
+    if rem["status"] == RemedyStatus.NONE_FOUND:
         _never_worse(rem, given)
         c = rem["closest"]
         tried_limiter = any(s["path"].startswith("controller.setpoint_") for s in rem["space"])
@@ -94,7 +95,7 @@ def finish(rem, given, ctx, cfg, reqset, uncertain, catalogue, *, run_kw, yield_
                        f"the closest{hw} fails {len(c['failed_mandatory'])} ({', '.join(c['failed_mandatory'])}) where the "
                        f"configuration as given fails {len(given['candidate']['failed_mandatory'])}. Why: {rem['explanation']} "
                        "This is the evidence of a search, not a proof that no pass exists.")
-    elif rem["status"] == "found":
+    elif rem["status"] == RemedyStatus.FOUND:
         r = rem["remedy"]
         r.setdefault("cost", SETTINGS_COST * r["change"])
         if yield_units:

@@ -35,6 +35,7 @@ from compliance.sweep.candidates.ranking import SETTINGS_COST, candidate_passes,
 from compliance.sweep.candidates.runner import run_candidates, shortfall
 from compliance.sweep.candidates.sampling import from_normalised, to_normalised
 from compliance.units.formatting import fmt_margin_pct
+from compliance.sweep.remedies.outcome import RemedyStatus
 
 __all__ = ["STEP", "TARGET", "binding", "closeness", "describe_candidate", "find_remedy", "mandatory_margins", "unreachable"]
 
@@ -184,7 +185,7 @@ def find_remedy(ctx, adjust, base: dict, *, verify, iterations: int = 4, seeds=(
     judged = [(start, row0)] + list(seeds)
     space = [{"path": a.param.path, "unit": a.param.unit, "low": a.low, "high": a.high, "base": float(base[a.param.path])}
              for a in adjust]
-    out = {"status": "already_passes", "space": space, "failed": [], "sensitivities": [], "out_of_reach": [],
+    out = {"status": RemedyStatus.ALREADY_PASSES, "space": space, "failed": [], "sensitivities": [], "out_of_reach": [],
            "remedy": None, "closest": None, "evaluated": 1 + len(seeds), "note": ""}
     if candidate_passes(row0):
         out["note"] = "every mandatory requirement passes as configured: nothing to change"
@@ -216,7 +217,7 @@ def find_remedy(ctx, adjust, base: dict, *, verify, iterations: int = 4, seeds=(
             remedy["verified"] = {"status": results["summary"]["status"],
                                   "failed_mandatory": results["summary"]["failed_mandatory"]}
             if results["summary"]["status"] == Overall.PASS:
-                out.update(status="found", remedy=remedy,
+                out.update(status=RemedyStatus.FOUND, remedy=remedy,
                            note=f"verified by a full campaign of the changed configuration ({len(results['runs'])} runs)")
                 return out
         if key((cand, row)) < key((cur, cur_row)):
@@ -242,7 +243,7 @@ def _judge(ctx, settings, *, fixed, **run_kw):
 
 
 def _none_found(out, adjust, start, closest):
-    out.update(status="none_found", closest=describe_candidate(adjust, start, *closest))
+    out.update(status=RemedyStatus.NONE_FOUND, closest=describe_candidate(adjust, start, *closest))
     rid = out["closest"]["binding"]
     reach = (f" Out of reach of every declared parameter by the local sensitivities: {', '.join(out['out_of_reach'])}."
              if out["out_of_reach"] else "")

@@ -23,6 +23,7 @@ from compliance.sweep.remedies.limiter_space import limiter_stage_start
 from compliance.sweep.candidates.ranking import SETTINGS_COST, candidate_passes, failing_mandatory, rank_key
 from compliance.sweep.remedies.smallest_change import find_remedy
 from compliance.sweep.candidates.runner import run_candidates
+from compliance.sweep.remedies.outcome import RemedyStatus
 
 __all__ = ["staged_search"]
 
@@ -33,14 +34,14 @@ def _stage(ctx, adjust, base, verify, run_kw, iterations, fixed=None, cost=0.0, 
                       fixed=fixed, cost=cost)
     _report_from(rem, adjust, given or base)
     rem["hardware_cost"] = cost
-    if rem["status"] == "already_passes" and fixed:  # the hardware alone, at these settings, passes: verify it
+    if rem["status"] == RemedyStatus.ALREADY_PASSES and fixed:  # the hardware alone, at these settings, passes: verify it
         results = verify({**fixed, **rem["closest"]["values"]})
         if results["summary"]["status"] == Overall.PASS:
             remedy = {**rem["closest"], "verified": {"status": Overall.PASS, "failed_mandatory": []}}
-            rem.update(status="found", remedy=remedy, closest=None,
+            rem.update(status=RemedyStatus.FOUND, remedy=remedy, closest=None,
                        note=f"verified by a full campaign of the changed configuration ({len(results['runs'])} runs)")
         else:
-            rem["status"] = "none_found"
+            rem["status"] = RemedyStatus.NONE_FOUND
     return rem
 
 
@@ -82,7 +83,7 @@ def staged_search(ctx, cfg, adjust, base, catalogue, *, verify, run_kw, iteratio
     rem["stages"] = [{"stage": "settings", "status": rem["status"], "evaluated": rem["evaluated"]}]
     rem["hardware_tried"] = []
     adjust_all = tuple(adjust)
-    if rem["status"] == "none_found" and limiter is not None:
+    if rem["status"] == RemedyStatus.NONE_FOUND and limiter is not None:
         lim_adjust, lim_start = limiter
         start = limiter_stage_start(adjust, (rem["closest"] or {}).get("values") or base, lim_start)
         rl = _stage(ctx, tuple(adjust) + tuple(lim_adjust), start, verify, run_kw, iterations,
@@ -91,12 +92,12 @@ def staged_search(ctx, cfg, adjust, base, catalogue, *, verify, run_kw, iteratio
                                          "evaluated": rl["evaluated"]}]
         rl["evaluated"] += rem["evaluated"]
         rl["hardware_tried"] = []
-        if rl["status"] == "found" or _better(rl.get("closest"), rem.get("closest"), 0.0):
+        if rl["status"] == RemedyStatus.FOUND or _better(rl.get("closest"), rem.get("closest"), 0.0):
             rl["settings_only"] = {k: rem[k] for k in ("closest", "sensitivities", "out_of_reach")}
             rem, adjust_all = rl, tuple(adjust) + tuple(lim_adjust)
         else:
             rem["stages"], rem["evaluated"] = rl["stages"], rl["evaluated"]
-    if rem["status"] != "none_found" or catalogue is None:
+    if rem["status"] != RemedyStatus.NONE_FOUND or catalogue is None:
         return rem
     best_settings = {a.param.path: (rem["closest"] or {}).get("values", base).get(a.param.path, base.get(a.param.path))
                      for a in adjust_all}
@@ -123,9 +124,9 @@ def staged_search(ctx, cfg, adjust, base, catalogue, *, verify, run_kw, iteratio
             pick["hardware"] = [{"option": o.name, "group": o.group, "title": o.title, "cost": o.cost} for o in opts]
             pick["hardware_values"] = fixed
             pick["cost"] = cost + SETTINGS_COST * pick["change"]
-        if hw["status"] == "found":
+        if hw["status"] == RemedyStatus.FOUND:
             hw["remedy"].update(hardware=pick["hardware"], hardware_values=fixed, cost=pick["cost"])
-            rem.update(status="found", remedy=hw["remedy"], closest=None,
+            rem.update(status=RemedyStatus.FOUND, remedy=hw["remedy"], closest=None,
                        note=hw["note"] + "; hardware: " + ", ".join(o.title for o in opts))
             return rem
         if _better(pick, rem.get("closest"), cost):
