@@ -7,6 +7,9 @@ from pathlib import Path as _Path
 __version__ = "0.1.0"
 
 
+_COMPILED_STAGES = ("physics", "effects", "model", "simulation", "diagnosis")  # every folder with compiled code
+
+
 def _numba_cache_dir() -> str:
     """A numba cache folder keyed by the compiled sources.
 
@@ -17,8 +20,8 @@ def _numba_cache_dir() -> str:
     here = _Path(__file__).resolve().parent
     digest = _hashlib.sha256()
     # every package that holds compiled code or the slot layout it freezes (effects generate the slots)
-    for sub in ("physics", "effects", "model", "simulation", "diagnosis"):
-        for f in sorted((here / sub).glob("*.py")):
+    for sub in _COMPILED_STAGES:
+        for f in sorted((here / sub).rglob("*.py")):  # rooms inside a stage too (diagnosis/friction_bench)
             digest.update(f.read_bytes())
     return str(here / "__pycache__" / f"numba-{digest.hexdigest()[:16]}")
 
