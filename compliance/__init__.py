@@ -7,7 +7,15 @@ from pathlib import Path as _Path
 __version__ = "0.1.0"
 
 
-_COMPILED_STAGES = ("physics", "effects", "model", "simulation", "diagnosis")  # every folder with compiled code
+_COMPILED_STAGES = ("physics", "effects", "model", "simulation")  # the compiled core and the slot layout it freezes
+
+
+def _compiled_sources(here: _Path) -> list:
+    """Every source the compiled code is built from: the core's stages whole, and any other module with a kernel."""
+    core = [f for sub in _COMPILED_STAGES for f in sorted((here / sub).rglob("*.py"))]
+    others = [f for f in sorted(here.rglob("*.py"))
+              if f.relative_to(here).parts[0] not in _COMPILED_STAGES and b"@njit" in f.read_bytes()]
+    return core + others
 
 
 def _numba_cache_dir() -> str:
@@ -15,14 +23,12 @@ def _numba_cache_dir() -> str:
 
     numba invalidates a cached function only when its own file changes, not when a kernel it
     inlines from another module does; keying the folder by every compiled source avoids ever
-    running a stale core.
+    running a stale core (and an edit elsewhere does not recompile it).
     """
     here = _Path(__file__).resolve().parent
     digest = _hashlib.sha256()
-    # every package that holds compiled code or the slot layout it freezes (effects generate the slots)
-    for sub in _COMPILED_STAGES:
-        for f in sorted((here / sub).rglob("*.py")):  # rooms inside a stage too (diagnosis/friction_bench)
-            digest.update(f.read_bytes())
+    for f in _compiled_sources(here):
+        digest.update(f.read_bytes())
     return str(here / "__pycache__" / f"numba-{digest.hexdigest()[:16]}")
 
 
