@@ -84,12 +84,14 @@ def test_joint_model_splits_blocks_of_their_own_lengths():
     assert parts["R2:position"].tolist() == [6.0, 7.0] and jm.block_sizes == [3, 3, 2] and jm.size == 8
 
 
+def _written(recs, folder) -> list[str]:
+    """The recordings as files ``r0.csv``, ``r1.csv``, ... in ``folder``."""
+    return [str(write_recording(frame, meta, folder / f"r{i}.csv")[0]) for i, (frame, meta) in enumerate(recs)]
+
+
 def test_joint_cli_refuses_report_before_work(tmp_path, recordings, capsys):
     _, recs = recordings
-    paths = []
-    for i, (frame, meta) in enumerate(recs):
-        path, _ = write_recording(frame, meta, tmp_path / f"r{i}.csv")
-        paths.append(str(path))
+    paths = _written(recs, tmp_path)
     out = tmp_path / "j.html"
     assert main(["diagnose", "plant-a", *paths, "--report", str(out)]) == 2
     assert "not available for a joint diagnosis" in capsys.readouterr().err and not out.exists()
@@ -100,10 +102,7 @@ def test_joint_cli_end_to_end_names_the_pressure_law(tmp_path, recordings):
     import json
 
     _, recs = recordings
-    paths = []
-    for i, (frame, meta) in enumerate(recs):
-        path, _ = write_recording(frame, meta, tmp_path / f"r{i}.csv")
-        paths.append(str(path))
+    paths = _written(recs, tmp_path)
     out = tmp_path / "j.json"
     assert main(["diagnose", "plant-a", *paths, "--effects", "pressure_dependent_friction", "--json", str(out),
                  "--jobs", "2", "-q"]) == 0
@@ -117,7 +116,7 @@ def test_one_recording_on_a_dask_cluster_gives_the_local_pools_diagnosis(tmp_pat
     import json
 
     _, recs = recordings
-    path, _ = write_recording(*recs[1], tmp_path / "r.csv")
+    path = _written(recs[1:], tmp_path)[0]
     outs = {}
     for label, extra in (("pool", ["--jobs", "2"]), ("dask", ["--scheduler", "local:2"])):
         outs[label] = tmp_path / f"{label}.json"

@@ -274,10 +274,10 @@ def diagnose(cfg: PlantConfig, frame, meta: dict, *, effects=None, jobs: int | N
     names = check_effects(cfg, effects)
     with dask_session(scheduler) as client:
         cfg, st, form, dec = _based_search(cfg, frame, meta, stride, jobs, names, recalibrate, client)
-        return _conclude(cfg, meta, st, form, dec, t0, jobs, suggest_test)
+        return _conclude(cfg, meta, st, form, dec, t0, suggest_test)
 
 
-def _conclude(cfg: PlantConfig, meta: dict, st: Stage, form, dec: dict, t0: float, jobs: int, suggest_test: bool) -> Diagnosis:
+def _conclude(cfg: PlantConfig, meta: dict, st: Stage, form, dec: dict, t0: float, suggest_test: bool) -> Diagnosis:
     """Stages 6-7 after the search: the lag split, the figures' full replays, contributions, the suggested test."""
     winner, verdict_name = dec["winner"], dec["verdict"]
     split = _split(st, winner, verdict_name, dec)
@@ -308,7 +308,7 @@ def _conclude(cfg: PlantConfig, meta: dict, st: Stage, form, dec: dict, t0: floa
         objective_before=_objective(st, "nominal"), objective_after=dec["after"] if winner else None,
         windows=_window_rows(st, seg_win), floors=dict(st.model.floors), cfg=cfg, fitted_cfg=fitted_cfg,
         recording=st.setup.source, seconds=time.perf_counter() - t0,
-        simulations=st.sims + (split["replays"] if split else 0), jobs=jobs, notes=notes,
+        simulations=st.sims + (split["replays"] if split else 0), jobs=st.jobs, notes=notes,
         traces={"time": st.setup.time, "recorded": st.model.recorded, "before": full_nom, "after": full_win,
                 "objective_before": st.nominal_sim, "objective_after": seg_win},
         agreement=agreement, located_regimes=where_words(st.events), ambiguous=dec["ambiguous"], signals_left=dec["left"],

@@ -67,9 +67,9 @@ def prepare_recording(cfg: PlantConfig, frame, meta: dict, stride: int, jobs: in
     events, event_mask, _ = locate_mismatch(rc, setup, model.signals, nominal_sim)
     nominal_rms = {s: v["rms_normalised"] for s, v in signal_fit(model, nominal_sim).items()}
     nvec = model.vector(nominal_sim)
-    st = Stage(setup, rc, nominal_sim, model, events, event_mask, nominal_rms, nvec, (plant_to_toml(rc), setup, model), jobs)
+    st = Stage(setup, rc, nominal_sim, model, events, event_mask, nominal_rms, nvec, (plant_to_toml(rc), setup, model), jobs,
+               client=client)
     st.sims += sims
-    st.client = client
     chi2, parts = chi2_parts(model, nvec)
     st.fits["nominal"] = FitResult("nominal", (), [], [], chi2, parts, model.size, 0, 0.0, "nominal model")
     return st
