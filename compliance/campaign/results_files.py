@@ -15,7 +15,7 @@ from compliance.errors import InputError
 from compliance.files.atomic import write_text_atomic
 from compliance.files.jsonable import json_text, read_json
 from compliance.requirements.verdict import Basis, Severity, Status
-from compliance.presentation.values import limit_as_written
+from compliance.presentation.values import band_pct_text, limit_as_written
 from compliance.units.formatting import STATUS_WORD as _STATUS_WORD  # the one status-word table
 
 RESULTS_SCHEMA = "govcheck-results/1"
@@ -117,9 +117,9 @@ def _table_row(e: dict) -> tuple:
         margin = d["margin_pct"]
     elif w.get("margin") is not None:
         margin = d.get("margin", "-")
-    band = w.get("band")
-    if band and band.get("margin_low_pct") is not None:
-        margin += f" [{band['margin_low_pct']:+.0f}..{band['margin_high_pct']:+.0f} %]"
+    band = band_pct_text(w.get("band"), w.get("margin_pct"))
+    if band:
+        margin += f" {band}"
     where = w.get("run") or "-"
     if w.get("which"):
         where += f" ({w['which']})"

@@ -73,6 +73,12 @@ class PlantConfig:
         """SI value of a base parameter."""
         return self.params[key]
 
+    def load_curve_forces(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """The load curve the model applies: (position [m], closing force [N]), the drawn forces x ``load.curve_scale``."""
+        if self.load_curve is None:
+            return None
+        return self.load_curve[0], self.load_curve[1] * self.params.get("load.curve_scale", 1.0)
+
     def option(self, key: str) -> str:
         """Value of an option such as ``friction.model``."""
         return self.options[key]

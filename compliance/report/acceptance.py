@@ -13,7 +13,7 @@ from __future__ import annotations
 from compliance.errors import InputError
 from compliance.metrics import METRICS
 from compliance.metrics.catalogue import STEP_OPTION_DEFAULTS
-from compliance.presentation.values import limit_as_written, metric_text
+from compliance.presentation.values import limit_as_written, row_texts
 from compliance.requirements.verdict import Status
 from compliance.units.amounts import parse_amount
 from compliance.units.formatting import fmt_value, unit_text
@@ -236,7 +236,7 @@ def conclusions(results: dict) -> list[dict]:
         if e["status"] not in (Status.FAIL, Status.UNCERTAIN, Status.NOT_EVALUATED, Status.OPEN):
             continue
         w = e.get("worst") or {}
-        value = metric_text(w.get("value"), e["metric"]) if w else "\u2013"
+        value = row_texts(w, e["metric"])["value"] if w else "\u2013"
         if e["status"] == Status.OPEN:
             finding = f"no limit set; value found {value}"
         elif e["status"] == Status.NOT_EVALUATED:

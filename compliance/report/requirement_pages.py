@@ -12,7 +12,7 @@ from __future__ import annotations
 import re
 
 from compliance.metrics import METRICS
-from compliance.presentation.values import limit_as_written, metric_text
+from compliance.presentation.values import limit_as_written, metric_text, row_texts
 from compliance.requirements.verdict import Status
 from compliance.units.formatting import fmt_margin_pct, fmt_value, unit_text
 
@@ -72,9 +72,10 @@ def _row_cells(e: dict, r: dict) -> dict:
         steps.append({"text": txt, "excluded": excluded or s.get("value") is None})
         cannot.append(facts.get("cannot_fail"))
     cannot_fail = bool(cannot) and all(c is True for c in cannot)
-    margin = None if r.get("margin") is None else metric_text(r["margin"], metric)
-    return {"req": e["id"], "procedure": r.get("procedure"), "ops": [r.get("operating_point")], "value": metric_text(r.get("value"), metric),
-            "which": r.get("which"), "margin": margin, "margin_pct": fmt_margin_pct(r.get("margin_pct")),
+    texts = row_texts(r, metric)
+    margin = None if r.get("margin") is None else texts["margin"]
+    return {"req": e["id"], "procedure": r.get("procedure"), "ops": [r.get("operating_point")], "value": texts["value"],
+            "which": r.get("which"), "margin": margin, "margin_pct": texts["margin_pct"],
             "status": r.get("status"), "reason": str(r.get("reason")).split(":")[0] if r.get("reason") else None,
             "raw": r.get("value"), "raw_margin": r.get("margin"), "metric": metric,
             "steps": steps, "cannot_fail": cannot_fail,
@@ -104,9 +105,10 @@ def _grouped(rows: list[dict]) -> list[dict]:
                            "excluded": True}] + g["steps"]
             continue
         worst = min(ms, key=lambda c: c["raw_margin"] if c["raw_margin"] is not None else float("inf"))
-        vals = [c["raw"] for c in ms if isinstance(c["raw"], (int, float))]
-        if vals and min(vals) != max(vals):
-            lo, hi = metric_text(min(vals), g["metric"]), metric_text(max(vals), g["metric"])
+        vals = [c for c in ms if isinstance(c["raw"], (int, float))]
+        if vals and min(c["raw"] for c in vals) != max(c["raw"] for c in vals):
+            # each end as its own row prints it (the one formatter's digits: a failing value never reads as its limit)
+            lo, hi = min(vals, key=lambda c: c["raw"])["value"], max(vals, key=lambda c: c["raw"])["value"]
             g["value"] = lo if lo == hi else f"{lo.rsplit(' ', 1)[0]}\u2013{hi}"
         g.update(margin=worst["margin"], margin_pct=worst["margin_pct"], which=worst["which"], run=worst["run"])
         per_point = " \u00b7 ".join(f"{c['ops'][0]} {c['value']}" for c in ms)
@@ -227,8 +229,8 @@ def requirement_pages(results: dict, start: int = 1) -> tuple[list[dict], list[d
             reqs.append({"id": e["id"], "title": e["title"], "status": e["status"], "severity": e["severity"],
                          "metric": e["metric"], "meaning": (METRICS.get(e["metric"]).meaning if METRICS.get(e["metric"]) else ""),
                          "standard": e.get("standard"), "clause": reader_text(e.get("clause")), "note": reader_text(e.get("note")),
-                         "limit": limit_as_written(e), "value": metric_text(w.get("value"), e["metric"]) if w else "\u2013",
-                         "margin_pct": fmt_margin_pct(w.get("margin_pct")), "cases": cases,
+                         "limit": limit_as_written(e), "value": row_texts(w, e["metric"])["value"] if w else "\u2013",
+                         "margin_pct": row_texts(w, e["metric"])["margin_pct"] if w else None, "cases": cases,
                          "cannot_fail": sum(1 for c in cases if c["cannot_fail"]),
                          "not_evaluated": sum(len(c["ops"]) for c in cases if c["status"] == Status.NOT_EVALUATED)})
         reasons = _distinct_reasons(str(x) for e in entries for r in e["rows"] for x in

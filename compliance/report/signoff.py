@@ -14,9 +14,9 @@ from collections import Counter
 from compliance.campaign.coverage import case_coverage, case_coverage_text
 from compliance.campaign.basis import verdict_qualifier
 from compliance.model.parameters import used_by_model
-from compliance.presentation.values import limit_as_written, metric_text
+from compliance.presentation.values import limit_as_written, row_texts
 from compliance.requirements.verdict import Overall, Status
-from compliance.units.formatting import fmt_margin_pct, fmt_si
+from compliance.units.formatting import fmt_si
 
 SOURCE_WORDS = {"paper": "from the paper", "assumed": "assumed", "derived": "derived", "user": "set by the user",
                 "fitted": "fitted to a recording"}
@@ -139,8 +139,8 @@ def failures(results: dict) -> list[dict]:
         if e["status"] != Status.FAIL:
             continue
         w = e.get("worst") or {}
-        out.append({"id": e["id"], "title": e["title"], "severity": e["severity"], "value": metric_text(w.get("value"), e["metric"]),
-                    "limit": limit_as_written(e), "margin_pct": fmt_margin_pct(w.get("margin_pct")),
+        out.append({"id": e["id"], "title": e["title"], "severity": e["severity"], "value": row_texts(w, e["metric"])["value"],
+                    "limit": limit_as_written(e), "margin_pct": row_texts(w, e["metric"])["margin_pct"],
                     "where": f"{w.get('procedure')} at {w.get('operating_point')}" if w.get("procedure") else None,
                     "remedy": remedies.get(e["id"]), "anchor": "req-" + e["id"]})
     return out
