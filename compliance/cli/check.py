@@ -152,6 +152,9 @@ def run(args) -> int:
 
     check_consistency(reqset, cfg.p("cylinder.stroke"), args.allow_conflicts)  # before any simulation
     check_uncertainty_option(args, cfg)
+    from compliance.evidence import check_sources, model_evidence
+
+    check_sources(cfg)
     stages = 1 + bool(args.linear) + (render is not None)
     # the campaign reports its runs itself on a terminal; in a CI log these stage lines (and a heartbeat) show progress
     with progress(stages, "check", quiet=args.quiet or sys.stderr.isatty(), unit="stage", first="campaign") as bar:
@@ -159,6 +162,7 @@ def run(args) -> int:
                                uncertainty="local" if args.uncertainty is None else None)
         if args.uncertainty:
             monte_carlo(cfg, reqset, results, args)
+        results["model_evidence"] = model_evidence(cfg, results)  # on the final statuses
         bar.update(1)
         if args.linear:
             from compliance.linear.operating_points import linear_for_campaign

@@ -22,10 +22,11 @@ from compliance.files.atomic import write_text_atomic
 from compliance.model.assumptions import read_assumptions
 from compliance.model.config_fields import SECTIONS, atmosphere_of, effect_values, load_curve_field, section_values
 from compliance.model.parameters import BASE_BY_KEY, BASE_PARAMS, OPTIONS
+from compliance.model.evidence_sources import parse_model_evidence
 from compliance.model.identity import parse_identity
 from compliance.model.toml_file import read_toml
 
-_TOP_KEYS = {"name", "description", "provenance", "effects", "identity"}
+_TOP_KEYS = {"name", "description", "provenance", "effects", "identity", "model_evidence"}
 
 
 _suggest = did_you_mean
@@ -68,6 +69,8 @@ class PlantConfig:
     provenance: Mapping[str, str] = field(default_factory=dict)
     identity: Mapping[str, Any] = field(default_factory=dict)  # optional [identity]: site, unit, equipment (model/identity.py)
     assumptions: Mapping[str, Any] = field(default_factory=dict)  # key -> range / derived_for (model/assumptions.py)
+    # optional [model_evidence]: the paper and recordings the model answers to (model/evidence_sources.py)
+    model_evidence: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({"paper": None, "recordings": ()}))
 
     def p(self, key: str) -> float:
         """SI value of a base parameter."""
@@ -222,6 +225,7 @@ def plant_from_dict(data: dict[str, Any], where: str = "<configuration>", digest
         provenance=MappingProxyType({str(k): str(v) for k, v in (data.get("provenance") or {}).items()}),
         identity=parse_identity(data.get("identity"), where),
         assumptions=MappingProxyType(read_assumptions(data, where, params, atmosphere_of(data, where))),
+        model_evidence=parse_model_evidence(data.get("model_evidence"), where, None if where.startswith("<") else where),
     )
     _check_physical(cfg, where)
     return cfg
@@ -304,6 +308,7 @@ def plant_to_toml(cfg: PlantConfig) -> str:
         lines.append("position = { values = [" + ", ".join(_fmt(x) for x in xs) + '], unit = "m" }')
         lines.append("force = { values = [" + ", ".join(_fmt(f) for f in fs) + '], unit = "N" }')
         lines.append("")
+    lines += _model_evidence_toml(cfg)
     for ename, vals in cfg.effects.items():
         eff = EFFECTS[ename]
         lines.append(f"[effects.{ename}]")
@@ -314,6 +319,20 @@ def plant_to_toml(cfg: PlantConfig) -> str:
             lines.append(f'{p.name} = "{_fmt(v)} {p.unit}"' if p.unit else f"{p.name} = {_fmt(v)}")
         lines.append("")
     return "\n".join(lines)
+
+
+def _model_evidence_toml(cfg: PlantConfig) -> list[str]:
+    """The ``[model_evidence]`` table of a saved configuration (recording paths as resolved when it was read)."""
+    ev = cfg.model_evidence or {}
+    if not ev.get("paper") and not ev.get("recordings"):
+        return []
+    lines = ["[model_evidence]"]
+    if ev.get("paper"):
+        lines.append(f"paper = {_toml_str(ev['paper'])}")
+    if ev.get("recordings"):
+        rows = ["{ " + ", ".join(f"{k} = {_toml_str(v)}" for k, v in r.items()) + " }" for r in ev["recordings"]]
+        lines.append("recordings = [" + ", ".join(rows) + "]")
+    return lines + [""]
 
 
 def _toml_str(s: str) -> str:
