@@ -162,14 +162,39 @@ def summary_lines(results: dict) -> list[str]:
     others = len(findings) - sum(1 for f in findings if f.get("mandatory"))
     if others:
         out.append(f"  requirement set: {others} more finding(s) involving advisory requirements (results JSON, 'findings')")
+    out += evidence_lines(results)
     top = s.get("top_assumptions") or (results.get("uncertainty") or {}).get("top_assumptions") or []
     if top:
         out.append("  assumptions that matter most: " + "; ".join(f"{a['parameter']} ({a['why']})" for a in top))
     for n in s.get("notes", []):
         out.append(f"  {n}")
     qualifier = s["qualifier"] if "qualifier" in s else verdict_qualifier(results)
+    pending = [f"{w} {', '.join(ids)}" for w, ids in (("uncertain:", _mandatory(results, Status.UNCERTAIN)),
+                                                       ("not evaluated:", _mandatory(results, Status.NOT_EVALUATED))) if ids]
     out.append(f"VERDICT: {s['status'].upper()}" + (f" ({qualifier})" if qualifier else "")
-               + (f" (mandatory failures: {', '.join(s['failed_mandatory'])})" if s.get("failed_mandatory") else ""))
+               + (f" (mandatory failures: {', '.join(s['failed_mandatory'])})" if s.get("failed_mandatory") else "")
+               + (f" (mandatory {'; '.join(pending)})" if pending else ""))
+    return out
+
+
+def _mandatory(results: dict, status) -> list[str]:
+    return [e["id"] for e in results["requirements"] if e["severity"] == Severity.MANDATORY and e["status"] == status]
+
+
+def evidence_lines(results: dict) -> list[str]:
+    """The model's evidence and the loop's stability margins under the table (results ``model_evidence``, ``stability``)."""
+    out = []
+    ev = results.get("model_evidence")
+    if ev:
+        out.append(f"  model evidence: {ev['summary']}")
+        judged = {e["id"]: e for e in results["requirements"] if e["status"] not in (Status.OPEN, Status.DISABLED)}
+        rest = [f"{c['requirement']} ({c['severity']}, {_STATUS_WORD.get(judged[c['requirement']]['status'], '')}: "
+                f"{c['consequence'].split(':')[0]})" for c in ev.get("contradicted") or [] if c["requirement"] in judged]
+        if rest:
+            out.append("  verdicts resting on figures the measurements contradict: " + "; ".join(rest))
+    st = results.get("stability")
+    if st:
+        out.append(f"  stability of the linearised loop: {st['summary']}")
     return out
 
 

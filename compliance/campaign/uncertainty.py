@@ -196,6 +196,13 @@ def settle_status(e: dict) -> None:
                 w[k] = sure[k]
     elif e["status"] == Status.PASS and any(r.get("status") == Status.UNCERTAIN for r in e["rows"]):
         e["status"] = Status.UNCERTAIN
+    if e["status"] == Status.UNCERTAIN and w.get("status") != Status.UNCERTAIN:
+        # the deciding row of an uncertain requirement is its uncertain row nearest the limit
+        near = min((r for r in e["rows"] if r.get("status") == Status.UNCERTAIN),
+                   key=lambda r: abs(r["margin_pct"]) if r.get("margin_pct") is not None else abs(r.get("margin") or 0.0))
+        for k in list(w):
+            if k in near:
+                w[k] = near[k]
     e["band"] = w.get("band")
 
 

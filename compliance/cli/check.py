@@ -170,6 +170,11 @@ def run(args) -> int:
             bar.set_postfix_str("linear analysis", refresh=False)
             results["linear"] = linear_for_campaign(cfg, reqset)
             bar.update(1)
+        from compliance.linear.stability import stability_margins
+
+        # the loop's margins against govcheck's criterion, on page 1 (reusing the linear analyses when made)
+        results["stability"] = stability_margins(cfg, reqset, analyses=(results.get("linear") or {}).get("analyses"),
+                                                 workers=args.jobs)
         if args.remedies:
             from compliance.sweep.check_remedies import remedies_for_check
 

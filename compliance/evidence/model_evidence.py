@@ -17,9 +17,9 @@ from compliance.errors import InputError
 from compliance.evidence.paper_figures import PAPERS, paper_source
 from compliance.evidence.recording_fits import recording_source
 from compliance.requirements.verdict import Status
-from compliance.units.formatting import fmt_value, unit_text
+from compliance.evidence.figure_texts import direction as _direction, figure_text, miss as _miss
 
-__all__ = ["check_sources", "model_evidence"]
+__all__ = ["check_sources", "contradicted_verdicts", "model_evidence"]
 
 
 def check_sources(cfg) -> None:
@@ -32,44 +32,6 @@ def check_sources(cfg) -> None:
     if paper == "plant-a" and cfg.options.get("cylinder.arrangement") != "tandem":
         raise InputError(f"{where}: model_evidence.paper = 'plant-a': the paper's tests are of the tandem gate servo "
                          "(cylinder.arrangement = 'tandem')")
-
-
-def _unit(unit: str) -> str:
-    return "% of stroke" if unit == "% stroke" else unit_text(unit)
-
-
-def _value(v, unit: str) -> str:
-    return f"{fmt_value(v, '', 3)} {_unit(unit)}"
-
-
-def _measured_text(f: dict) -> str:
-    if f.get("measured_range"):
-        lo, hi = f["measured_range"]
-        return f"{fmt_value(lo, '', 3)}\u2013{fmt_value(hi, '', 3)} {_unit(f['unit'])}"
-    return _value(f["measured"], f["unit"])
-
-
-def _direction(f: dict) -> str | None:
-    """``above`` / ``below``: where the modelled figure lies from the measured one (or range)."""
-    m = f.get("modelled")
-    if m is None:
-        return None
-    lo, hi = f["measured_range"] if f.get("measured_range") else (f["measured"], f["measured"])
-    return "above" if m > hi else "below" if m < lo else None
-
-
-def _miss(f: dict) -> float:
-    """Size of a miss relative to the measured figure (to pick the example a reader sees)."""
-    m, ref = f.get("modelled"), (f["measured_range"][1] if f.get("measured_range") else f.get("measured"))
-    if m is None or not ref:
-        return float("inf")
-    return abs(m - ref) / abs(ref)
-
-
-def figure_text(f: dict) -> str:
-    """``steady error 0.860 mm modelled, 0.240 mm measured (fig. 10, positive step)``."""
-    got = "not measured" if f.get("modelled") is None else f"{_value(f['modelled'], f['unit'])} modelled"
-    return f"{f['metric']} {got}, {_measured_text(f)} measured ({f['test']})"
 
 
 def _contradicting(sources: list[dict]) -> list[tuple[dict, dict]]:
@@ -143,6 +105,15 @@ def _status(sources: list[dict]) -> tuple[str, int, int]:
     return ("validated" if compared else "not validated"), compared, contradict
 
 
+def _examples(sources: list[dict]) -> list[str]:
+    """The largest miss of each kind of contradicted figure, short: ``steady error 0.905 mm modelled, 0.240 mm measured``."""
+    worst: dict = {}
+    for _, f in _contradicting(sources):
+        if "test" in f and (f["metric"] not in worst or _miss(f) > _miss(worst[f["metric"]])):
+            worst[f["metric"]] = f
+    return [figure_text(f, test=False) for f in sorted(worst.values(), key=_miss, reverse=True)]
+
+
 def _summary(status: str, sources: list[dict], compared: int, contradict: int) -> str:
     if not sources:
         return "not validated: the plant file names no measurement of this servo ([model_evidence])"
@@ -183,5 +154,5 @@ def model_evidence(cfg, results: dict) -> dict:
         sources.append(recording_source(cfg, entry))
     status, compared, contradict = _status(sources)
     return {"status": status, "validated": status == "validated", "compared": compared, "contradict": contradict,
-            "summary": _summary(status, sources, compared, contradict), "sources": sources,
+            "summary": _summary(status, sources, compared, contradict), "examples": _examples(sources), "sources": sources,
             "contradicted": contradicted_verdicts(results["requirements"], sources)}

@@ -10,6 +10,7 @@ by fitting, so they are not independent evidence either.
 
 from __future__ import annotations
 
+from compliance.evidence.figure_texts import measured_text, value_text
 from compliance.papers import plant_a
 
 __all__ = ["PAPERS", "paper_source"]
@@ -53,6 +54,9 @@ def paper_source(cfg, name: str) -> dict:
     comp = plant_a.compare(cfg, explain=False)
     fitted = cfg.provenance.get("calibrated_to")
     figures = [_figure(r, _derived_metrics(cfg), bool(fitted)) for r in comp.rows]
+    for f in figures:  # the texts a reader sees (the report reads them, it does not format them again)
+        f["display"] = {"modelled": "-" if f["modelled"] is None else value_text(f["modelled"], f["unit"]),
+                        "measured": "-" if f["measured"] is None and not f["measured_range"] else measured_text(f)}
     compared = [f for f in figures if f["agreement"] is not None and not f["by_construction"] and f["independent"]]
     return {
         "kind": "paper", "name": name, "title": PAPERS[name], "command": f"govcheck reproduce {cfg.path or cfg.name}",

@@ -11,6 +11,7 @@ those sections from the results dict alone (no simulation here); the template la
 from __future__ import annotations
 
 from compliance.errors import InputError
+from compliance.linear.stability import MARGIN_CRITERION as _MARGIN_CRITERION
 from compliance.metrics import METRICS
 from compliance.metrics.catalogue import STEP_OPTION_DEFAULTS
 from compliance.presentation.values import limit_as_written, row_texts
@@ -41,10 +42,8 @@ SMALL_HYDRO = ("IEC 62006:2010, Hydraulic machines \u2013 Acceptance tests of sm
                "acceptance-test code for units of this size; its governor and load-rejection tests need the installed "
                "unit and are not covered here.")
 
-# Stability criterion of the linear section: our own choice, from common control practice (phase margin
-# 30-60 deg and gain margin 6-12 dB are the usual lower ends); no governor standard gives one for a
-# servo-positioner loop.
-MARGIN_CRITERION = {"phase_margin_deg": 30.0, "gain_margin_db": 6.0}
+# Stability criterion of the linear section and page 1: our own choice (compliance.linear.stability)
+MARGIN_CRITERION = _MARGIN_CRITERION
 
 
 def standards_cited(results: dict) -> list[str]:

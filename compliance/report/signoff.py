@@ -56,7 +56,10 @@ def basis(results: dict) -> dict:
     fitted = sum(len(e.get("params") or []) for e in plant.get("effects") or [])
     parts = [f"{n} {SOURCE_WORDS.get(s, s)}" for s, n in counts.most_common()]
     val = results.get("validation")
-    if val:
+    ev = results.get("model_evidence") or {}
+    if ev.get("sources"):
+        validated = f"{ev['status']} against the measurements the plant file names (section 6)"
+    elif val:
         ok = (val.get("summary") or {}).get("pass")
         validated = (f"validated against a recording: {'PASS' if ok else 'FAIL' if ok is False else 'not decided'} "
                      "(section 6)")
@@ -66,7 +69,7 @@ def basis(results: dict) -> dict:
     return {"model": plant["name"], "params": ", ".join(parts), "n_params": sum(counts.values()),
             "n_unused": len(params) - len(used), "assumed": counts.get("assumed", 0),
             "effects": [e.get("name") for e in plant.get("effects") or []], "fitted": fitted, "validated": validated,
-            "validation_run": bool(val), "deciding": _deciding(results, used),
+            "validation_run": bool(val) or ev.get("status") in ("validated", "contradicted"), "deciding": _deciding(results, used),
             "verdict_bases": [f"{n} {k.replace('_', ' ')}" for k, n in bases.most_common()],
             "provenance": dict(plant.get("provenance") or {})}
 
@@ -129,6 +132,9 @@ def _remedy_lines(rem) -> dict:
             out[s["requirement"]] = (f"no passing setting found; {best['path']} helps most "
                                      f"({best['delta_margin_pct']:+.1f} points per {fmt_si(best['step'], best['unit'])})".replace("-", "\u2212"))
     return out
+
+
+remedy_lines = _remedy_lines  # page 1's lines (report.page_one) read the same remedies
 
 
 def failures(results: dict) -> list[dict]:
