@@ -119,6 +119,21 @@ def check_uncertainty_option(args, cfg=None) -> None:
                              "a range (range = [low, high] with range_note, docs/requirements.md 'Uncertainty')")
 
 
+def linear_stage(cfg, reqset, results: dict, args, bar) -> None:
+    """``--linear``: the linear analysis; always: the loop's stability margins against govcheck's criterion (page 1),
+    reusing the linear analyses when made."""
+    from compliance.linear.stability import stability_margins
+
+    if args.linear:
+        from compliance.linear.operating_points import linear_for_campaign
+
+        bar.set_postfix_str("linear analysis", refresh=False)
+        results["linear"] = linear_for_campaign(cfg, reqset)
+        bar.update(1)
+    results["stability"] = stability_margins(cfg, reqset, analyses=(results.get("linear") or {}).get("analyses"),
+                                             workers=args.jobs)
+
+
 def run(args) -> int:
     """Check outputs and inputs, run the campaign, print the table, write the outputs; exit code from the verdict."""
     from compliance.campaign.results_files import summary_table, write_json, write_junit
@@ -147,7 +162,7 @@ def run(args) -> int:
 
     check_consistency(reqset, cfg.p("cylinder.stroke"), args.allow_conflicts)  # before any simulation
     check_uncertainty_option(args, cfg)
-    from compliance.evidence import check_sources, model_evidence
+    from compliance.model_evidence import check_sources, model_evidence
 
     check_sources(cfg)
     stages = 1 + bool(args.linear) + (render is not None)
@@ -159,17 +174,7 @@ def run(args) -> int:
             monte_carlo(cfg, reqset, results, args)
         results["model_evidence"] = model_evidence(cfg, results)  # on the final statuses
         bar.update(1)
-        if args.linear:
-            from compliance.linear.operating_points import linear_for_campaign
-
-            bar.set_postfix_str("linear analysis", refresh=False)
-            results["linear"] = linear_for_campaign(cfg, reqset)
-            bar.update(1)
-        from compliance.linear.stability import stability_margins
-
-        # the loop's margins against govcheck's criterion, on page 1 (reusing the linear analyses when made)
-        results["stability"] = stability_margins(cfg, reqset, analyses=(results.get("linear") or {}).get("analyses"),
-                                                 workers=args.jobs)
+        linear_stage(cfg, reqset, results, args, bar)
         if args.remedies:
             from compliance.sweep.check_remedies import remedies_for_check
 

@@ -19,10 +19,9 @@ from compliance.effects import EFFECTS
 from compliance.errors import InputError, did_you_mean
 from compliance.files.atomic import write_text_atomic
 from compliance.files.shipped import resolve_shipped
-from compliance.model.assumptions import read_assumptions
+from compliance.model.assumptions import parse_model_evidence, read_assumptions
 from compliance.model.config_fields import SECTIONS, atmosphere_of, effect_values, load_curve_field, section_values
 from compliance.model.parameters import BASE_BY_KEY, BASE_PARAMS, OPTIONS
-from compliance.model.evidence_sources import parse_model_evidence
 from compliance.model.identity import parse_identity
 from compliance.model.toml_file import read_toml
 
@@ -68,7 +67,7 @@ class PlantConfig:
     provenance: Mapping[str, str] = field(default_factory=dict)
     identity: Mapping[str, Any] = field(default_factory=dict)  # optional [identity]: site, unit, equipment (model/identity.py)
     assumptions: Mapping[str, Any] = field(default_factory=dict)  # key -> range / derived_for (model/assumptions.py)
-    # optional [model_evidence]: the paper and recordings the model answers to (model/evidence_sources.py)
+    # optional [model_evidence]: the paper and recordings the model answers to (model/assumptions.py)
     model_evidence: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({"paper": None, "recordings": ()}))
 
     def p(self, key: str) -> float:

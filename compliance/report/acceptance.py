@@ -252,3 +252,35 @@ def parties(identity: dict) -> list[dict]:
             {"role": "Supplier of the servo-positioner", "name": identity.get("supplier")},
             {"role": "Prepared by (test engineer)", "name": identity.get("author")},
             {"role": "Witness", "name": identity.get("witness")}]
+
+
+# --------------------------------------------------------------------------- 6. model validation
+def _figure_cells(f: dict) -> dict:
+    if f["agreement"] is None:
+        word, css = "no measured figure", "neutral"
+    elif f["by_construction"]:
+        word, css = "by construction", "neutral"
+    elif not f["independent"]:
+        word, css = f"{f['agreement']} (fitted to it)", "neutral"
+    else:
+        word, css = f["agreement"], "pass" if f["agreement"] == "agrees" else "fail"
+    shown = f.get("display") or {}
+    return {"test": f["test"], "metric": f["metric"], "modelled": shown.get("modelled", "\u2013"),
+            "measured": shown.get("measured", "\u2013"), "agreement": word, "css": css}
+
+
+def evidence_sections(results: dict) -> tuple[list[dict], list[dict]]:
+    """Section 6's tables: each source of the model evidence with its figures, and the verdicts on contradicted figures."""
+    ev = results.get("model_evidence") or {}
+    out = []
+    for s in ev.get("sources") or []:
+        if s["kind"] == "paper":
+            out.append({"kind": "paper", "title": "Measured figures of the plant paper", "command": s["command"],
+                        "independence": s["independence"].capitalize(), "rows": [_figure_cells(f) for f in s["figures"]]})
+        else:
+            modes = "; ".join(f"{m.replace('_', ' ')}: {'every window within its limits' if d['pass'] else str(len(d['failed_windows'])) + ' of ' + str(d['windows']) + ' windows outside their limits'}"
+                              for m, d in s["modes"].items())
+            out.append({"kind": "recording", "title": f"Recording {s['path']}", "command": s["command"],
+                        "independence": "A recording of the servo, replayed with the model", "summary": modes})
+    judged = {e["id"] for e in results["requirements"] if e["status"] not in (Status.OPEN, Status.DISABLED)}
+    return out, [c for c in ev.get("contradicted") or [] if c["requirement"] in judged]

@@ -30,7 +30,6 @@ from compliance.files.display import display_path
 from compliance.files.reproducible import fixed_created, is_reproducible
 from compliance.report import acceptance as A
 from compliance.report import content as C
-from compliance.report import page_one as P
 from compliance.report import signoff as S
 from compliance.report.analysis_sections import linear_section, validation_section
 from compliance.report.requirement_pages import requirement_pages
@@ -232,12 +231,12 @@ def build_report(results: dict, workers: int | None = None, appendix: str = "sum
         "basis": S.basis(results),
         "failures": S.failures(results),
         # page 1 beyond the verdict word: what is not met, the model's evidence, stability, the requirement set
-        "not_met": P.mandatory_not_met(results, S.remedy_lines(results.get("remedies"))),
-        "advisory": P.advisory_failures(results),
-        "evidence": P.evidence_block(results),
-        "stability": P.stability_line(results),
-        "findings": P.findings_lines(results),
-        "results_findings": sorted(results.get("findings") or [], key=lambda f: not f.get("mandatory")),
+        "not_met": S.mandatory_not_met(results, S.remedy_lines(results.get("remedies"))),
+        "advisory": S.advisory_failures(results),
+        "evidence": S.evidence_block(results),
+        "stability": S.stability_line(results),
+        "findings": S.findings_lines(results),
+        "results_findings": S.finding_groups(results.get("findings") or []),
         "not_evaluated": S.not_evaluated(results),
         "assumptions": S.assumptions(results),
         "doc": S.document_control(results, document),
@@ -254,7 +253,7 @@ def build_report(results: dict, workers: int | None = None, appendix: str = "sum
         "sections": sections,
         "linear": lin_ctx,
         "validation": val_ctx,
-        **dict(zip(("evidence_sources", "evidence_contradicted"), P.evidence_sections(results))),
+        **dict(zip(("evidence_sources", "evidence_contradicted"), A.evidence_sections(results))),
         "parameters": C.parameter_rows(results),
         "options": sorted((plant.get("options") or {}).items()),
         "effects": plant.get("effects") or [],

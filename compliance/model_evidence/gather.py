@@ -2,8 +2,8 @@
 the measurements contradict (results key ``model_evidence``, docs/results-schema.md).
 
 The sources are the ones the plant file names in ``[model_evidence]``: the plant paper's measured
-figures (:mod:`compliance.evidence.paper_figures`) and recordings of the servo
-(:mod:`compliance.evidence.recording_fits`). The model is **validated** when at least one
+figures (:mod:`compliance.model_evidence.paper_figures`) and recordings of the servo
+(:mod:`compliance.model_evidence.recording_fits`). The model is **validated** when at least one
 independent measured figure was compared and every one agrees; **contradicted** when one does not;
 **not validated** when nothing independent was compared (no source, or only figures the model was
 fitted or derived to give). A verdict rests on a contradicted figure when its metric is one the
@@ -14,10 +14,10 @@ from the limit.
 from __future__ import annotations
 
 from compliance.errors import InputError
-from compliance.evidence.paper_figures import PAPERS, paper_source
-from compliance.evidence.recording_fits import recording_source
+from compliance.model_evidence.paper_figures import PAPERS, paper_source
+from compliance.model_evidence.recording_fits import recording_source
 from compliance.requirements.verdict import Status
-from compliance.evidence.figure_texts import direction as _direction, figure_text, miss as _miss
+from compliance.model_evidence.figure_texts import direction as _direction, figure_text, miss as _miss
 
 __all__ = ["check_sources", "contradicted_verdicts", "model_evidence"]
 
