@@ -1,4 +1,4 @@
-"""Time the README's main command in one process, phase by phase: campaign, linear analysis, report.
+"""Time the README's main command in one process, phase by phase: campaign (with its bands), model evidence, linear analysis, report.
 
     python benchmarks/main_command.py [--repeat 3] [--appendix summary]
 
@@ -32,6 +32,8 @@ def _cpu() -> float:
 def once(appendix: str, out: Path) -> dict:
     from compliance.campaign.run import run_campaign
     from compliance.linear.operating_points import linear_for_campaign
+    from compliance.linear.stability import stability_margins
+    from compliance.model_evidence import model_evidence
     from compliance.model.config import load_plant
     from compliance.report.render import render_report
     from compliance.requirements.loading import load_requirements
@@ -45,7 +47,11 @@ def once(appendix: str, out: Path) -> dict:
         res = job()
         phases[name] = (time.perf_counter() - t, _cpu() - c)
     t, c = time.perf_counter(), _cpu()
+    res["model_evidence"] = model_evidence(cfg, res)  # the paper's measured figures beside the model's
+    phases["evidence"] = (time.perf_counter() - t, _cpu() - c)
+    t, c = time.perf_counter(), _cpu()
     res["linear"] = linear_for_campaign(cfg, rs)
+    res["stability"] = stability_margins(cfg, rs, analyses=res["linear"]["analyses"])  # reused, as check does
     phases["linear"] = (time.perf_counter() - t, _cpu() - c)
     t, c = time.perf_counter(), _cpu()
     render_report(res, out / "r.html", out / "r.pdf", appendix=appendix)
