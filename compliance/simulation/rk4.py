@@ -34,9 +34,9 @@ def output_buffer(n_rows: int, n_columns: int = N_OUT) -> np.ndarray:
     """An (n_rows, n_columns) output array for a compiled loop, stored column by column.
 
     The loops write one row per controller sample; stored by column, a pandas DataFrame takes the
-    columns without copying them (a row-major 30 s recording costs a 4 MB transposing copy, about a
-    third of the loop's own time), and every caller passes this one layout, so each loop is
-    compiled once. Not initialised: a loop that returns success has written every cell.
+    columns without copying them (row by row, a 30 s run would need a 4 MB transposing copy costing
+    half the loop's own time), and every caller passes this one layout, so each loop is compiled
+    once. Not initialised: a loop that returns success has written every cell.
     """
     return np.empty((n_columns, n_rows)).T
 
