@@ -11,6 +11,7 @@ from numba import njit
 
 from compliance.errors import InputError
 from compliance.units import parse_quantity
+from compliance.units.amounts import parse_position
 
 
 @dataclass(frozen=True)
@@ -82,16 +83,6 @@ def piecewise_linear(times, values, t, out):
         out[j] = values[0] if tj < times[0] else values[a] + w * (values[b] - values[a])
 
 
-def _amount(text: str, stroke: float, where: str) -> float:
-    text = text.strip()
-    if text.endswith("%"):
-        try:
-            return float(text[:-1]) / 100.0 * stroke
-        except ValueError:
-            raise InputError(f"{where}: cannot read '{text}' as a percentage of stroke") from None
-    return parse_quantity(text, "m", where)
-
-
 def steps(spec: str, x0: float, stroke: float, where: str = "--steps") -> Profile:
     """Step sequence from a spec such as ``"2%@1s,-2%@4s"`` or ``"5 mm@1 s"``.
 
@@ -108,7 +99,7 @@ def steps(spec: str, x0: float, stroke: float, where: str = "--steps") -> Profil
         t = parse_quantity(when.strip(), "s", where)
         if t < times[-1]:
             raise InputError(f"{where}: step times must not go backwards ('{item.strip()}')")
-        level += _amount(amount, stroke, where)
+        level += parse_position(amount, stroke, where, require_unit=False)
         if not 0.0 <= level <= stroke:
             raise InputError(f"{where}: step '{item.strip()}' takes the set-point to {level*1e3:.1f} mm, outside the stroke 0..{stroke*1e3:.0f} mm")
         times += [t, t]
