@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from numba import types
 
 from compliance.diagnosis.evidence.replay_fit import prepare_replay, replay_config, run_replay
 from compliance.model.config import load_plant
@@ -62,8 +63,8 @@ def test_output_frame_columns_are_contiguous_and_each_run_owns_its_memory():
     assert simulate(cfg, sc).columns.name is None
 
 
-def test_simulate_and_the_diagnosis_replay_compile_one_output_layout():
-    """simulate and the diagnosis replay hand the loop the same output layout, so it is compiled for one."""
+def test_simulate_and_the_diagnosis_replay_compile_the_loop_once():
+    """simulate and the diagnosis replay hand the loop the same argument types, so it is compiled once."""
     cfg = load_plant("plant-a")
     simulate(cfg, Scenario(duration=0.05, initial_position=0.08))
     frame, meta = read_recording(str(PRACTICE / "practice_no_effect.csv.gz"))
@@ -71,3 +72,5 @@ def test_simulate_and_the_diagnosis_replay_compile_one_output_layout():
     run_replay(replay_config(cfg, setup), setup)
     layouts = {sig[-1].layout for sig in simulate_core.signatures}
     assert output_buffer(2).flags.f_contiguous and layouts == {"F"}
+    # nor read-only inputs (pandas' to_numpy gives read-only arrays): each would compile the loop again
+    assert all(arg.mutable for sig in simulate_core.signatures for arg in sig if isinstance(arg, types.Array))

@@ -375,8 +375,9 @@ def run_replay(cfg: PlantConfig, setup: ReplaySetup, *, noise: np.ndarray | None
             if setup.closed_loop and kp > 0.0 and ki != 0.0:
                 ref = ref + ki * setup.states["integral"][k0] / kp  # carries the integral state (see module doc)
         seg = output_buffer(k1 - k0 + 1)  # the layout the loop is compiled for
-        status = simulate_core(P, y0, np.ascontiguousarray(ref), np.ascontiguousarray(setup.command[k0:k1 + 1]),
-                               setup.closed_loop, np.ascontiguousarray(nz[k0:k1 + 1]), 0.0, lx, ly, k1 - k0, n_sub, seg)
+        # writable copies: a read-only input (pandas' to_numpy) would compile the loop once more for it
+        status = simulate_core(P, y0, np.array(ref), np.array(setup.command[k0:k1 + 1]),
+                               setup.closed_loop, np.array(nz[k0:k1 + 1]), 0.0, lx, ly, k1 - k0, n_sub, seg)
         if status >= 0:
             raise SimulationError(f"replay of {setup.source} became non-physical at t = {(k0 + status)*ts:.3f} s")
         out[k0:k1 + 1] = seg
