@@ -2,22 +2,18 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
-from numba import types
+import numba
 
-from compliance.diagnosis.evidence.replay_fit import prepare_replay, replay_config, run_replay
 from compliance.model.config import load_plant
-from compliance.recordings.reader import read_recording
-from compliance.simulation import OUTPUT_COLUMNS, Scenario, simulate
+from compliance.simulation import OUTPUT_COLUMNS, Scenario, SensorNoise, simulate
+from compliance.simulation import pid_loop
 from compliance.simulation.pid_loop import simulate_core
 from compliance.simulation.profiles import Profile, sine, steps
 from compliance.simulation.rk4 import output_buffer
 
 STROKE = 0.160
-PRACTICE = Path(__file__).resolve().parents[1] / "data" / "practice"
 
 
 def _plain_at(profile: Profile, t: np.ndarray) -> np.ndarray:
@@ -63,14 +59,24 @@ def test_output_frame_columns_are_contiguous_and_each_run_owns_its_memory():
     assert simulate(cfg, sc).columns.name is None
 
 
-def test_simulate_and_the_diagnosis_replay_compile_the_loop_once():
-    """simulate and the diagnosis replay hand the loop the same argument types, so it is compiled once."""
+def test_every_simulate_path_hands_the_loop_one_set_of_argument_types(monkeypatch):
+    """Closed loop, plant-only, seeded and given noise: one compiled loop (each variant costs seconds to compile)."""
+    seen = set()
+
+    def typed(*args):
+        seen.add(tuple(numba.typeof(a) for a in args))
+        return simulate_core(*args)
+
+    monkeypatch.setattr(pid_loop, "simulate_core", typed)
     cfg = load_plant("plant-a")
-    simulate(cfg, Scenario(duration=0.05, initial_position=0.08))
-    frame, meta = read_recording(str(PRACTICE / "practice_no_effect.csv.gz"))
-    setup = prepare_replay(cfg, frame.iloc[:2000].reset_index(drop=True), meta)
-    run_replay(replay_config(cfg, setup), setup)
-    layouts = {sig[-1].layout for sig in simulate_core.signatures}
-    assert output_buffer(2).flags.f_contiguous and layouts == {"F"}
-    # nor read-only inputs (pandas' to_numpy gives read-only arrays): each would compile the loop again
-    assert all(arg.mutable for sig in simulate_core.signatures for arg in sig if isinstance(arg, types.Array))
+    st = steps("2%@0.02s", 0.08, STROKE)
+    cmd = Profile(np.array([0.0, 0.02, 0.02]), np.array([5.0, 5.0, 6.0]))
+    for sc in (Scenario(duration=0.05, initial_position=0.08, reference=st, load=7000.0),
+               Scenario(duration=0.05, initial_position=0.08, command=cmd, load="curve"),
+               Scenario(duration=0.05, initial_position=0.08, reference=st, noise=SensorNoise(1e-5, 1e-6, 100.0, 10.0)),
+               Scenario(duration=0.05, initial_position=0.08, reference=st, position_noise=np.zeros(20))):
+        simulate(cfg, sc)
+    assert len(seen) == 1
+    (sig,) = seen
+    assert sig[-1].layout == "F" and output_buffer(2).flags.f_contiguous  # the output by column
+    assert all(arg.mutable for arg in sig if isinstance(arg, numba.types.Array))  # read-only arrays compile anew
