@@ -14,6 +14,7 @@ from pathlib import Path
 from compliance.errors import InputError
 from compliance.recordings.sidecar_schema import check_sidecar
 from compliance.recordings.instruments import instrument_facts
+from compliance.recordings.test_table import check_test_table
 from compliance.units import parse_quantity, registry
 
 __all__ = ["read_sidecar", "si_metadata", "sidecar_path"]
@@ -49,14 +50,17 @@ def read_sidecar(path) -> dict:
     Raises
     ------
     InputError
-        The sidecar is not valid TOML, holds a pressure without ``abs`` / ``gauge``, or a
-        ``[logger]`` / ``[channels.NAME]`` table that ``instruments.instrument_facts`` rejects.
+        The sidecar is not valid TOML, holds a pressure without ``abs`` / ``gauge``, a
+        ``[logger]`` / ``[channels.NAME]`` table that ``instruments.instrument_facts`` rejects, or a
+        ``[test]`` table that ``test_table.check_test_table`` rejects.
     """
     side = sidecar_path(path)
     if not side.is_file():
         return {}
     data, _ = read_toml(side, "recording sidecar")
     check_sidecar(data, str(side))
+    if "test" in data:
+        check_test_table(data["test"], str(side))
     return si_metadata(instrument_facts(data, str(side)), str(side))
 
 
