@@ -39,6 +39,8 @@ class Case:
         How the test as run differs from the standard procedure (said in the report).
     marks : dict
         Times and levels a plot marks (SI).
+    problem : str or None
+        Why the recording cannot be judged as run (every figure is then missing for this reason).
     """
 
     recording: str
@@ -48,13 +50,16 @@ class Case:
     values: dict = field(default_factory=dict)
     departures: tuple = ()
     marks: dict = field(default_factory=dict)
+    problem: str | None = None
 
     def value(self, metric: str) -> Measured:
-        """The figure of ``metric``, or a missing one saying this test does not give it."""
+        """The figure of ``metric``, or a missing one saying why this test does not give it."""
+        if self.problem:
+            return missing(self.problem)
         return self.values.get(metric) or missing(f"{self.label}: this test does not give {metric}")
 
     def as_dict(self) -> dict:
         """Plain-JSON form."""
         return {"recording": self.recording, "kind": self.kind, "label": self.label, "conditions": dict(self.conditions),
                 "values": {k: v.as_dict() for k, v in self.values.items()}, "departures": list(self.departures),
-                "marks": dict(self.marks)}
+                "marks": dict(self.marks), "problem": self.problem}

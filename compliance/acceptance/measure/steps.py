@@ -143,6 +143,8 @@ def _step_case(name: str, cond, ev, k: int, n: int, run, valve, options: dict, s
     why = _tau_reason(role, sm)
     if why is not None:
         tau, tau_ach = tau.ineligible(why) if tau.value is not None else tau, tau_ach.ineligible(why) if tau_ach.value is not None else tau_ach
+    elif tau.value is None and dead.value is not None:  # a step away from the point that never reached 63.2 %: the worst case
+        tau = Measured(None, 0.0, tau.reason, True)
     peaks = K * cond.u_position
     final_span = float(cond.time[fw][-1] - cond.time[fw][0]) if fw.stop > fw.start else 0.0
     values = {
