@@ -9,7 +9,6 @@ import math
 import os
 import tomllib
 from dataclasses import dataclass, field, replace as dc_replace
-from importlib import resources
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any, Mapping
@@ -19,6 +18,7 @@ import numpy as np
 from compliance.effects import EFFECTS
 from compliance.errors import InputError, did_you_mean
 from compliance.files.atomic import write_text_atomic
+from compliance.files.shipped import resolve_shipped
 from compliance.model.assumptions import read_assumptions
 from compliance.model.config_fields import SECTIONS, atmosphere_of, effect_values, load_curve_field, section_values
 from compliance.model.parameters import BASE_BY_KEY, BASE_PARAMS, OPTIONS
@@ -152,27 +152,6 @@ class PlantConfig:
 
 
 # ----------------------------------------------------------------------------------------------
-def reference_plants() -> list[str]:
-    """Names of the reference configurations shipped with the package."""
-    folder = resources.files("compliance") / "data" / "plants"
-    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
-
-
-def resolve_plant_path(source: str | os.PathLike) -> Path:
-    """Path of a plant given as a file path or a reference name (``plant-a``)."""
-    s = str(source)
-    p = Path(s)
-    if p.suffix == ".toml" or os.sep in s or p.exists():
-        if not p.is_file():
-            raise InputError(f"{s}: plant configuration file not found")
-        return p
-    ref = resources.files("compliance") / "data" / "plants" / f"{s}.toml"
-    if not ref.is_file():
-        raise InputError(f"plant '{s}' is not a file nor a reference plant{_suggest(s, reference_plants())} "
-                         f"(reference plants: {', '.join(reference_plants())})")
-    return Path(str(ref))
-
-
 def load_plant(source: str | os.PathLike) -> PlantConfig:
     """Load and validate a plant configuration (a TOML path or a reference plant name).
 
@@ -181,7 +160,7 @@ def load_plant(source: str | os.PathLike) -> PlantConfig:
     InputError
         With the file and key path of the first problem found.
     """
-    path = resolve_plant_path(source)
+    path = resolve_shipped(source, "plant")
     data, digest = read_toml(path, "plant configuration")
     return plant_from_dict(data, str(path), digest)
 

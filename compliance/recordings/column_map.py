@@ -33,12 +33,11 @@ from __future__ import annotations
 
 from compliance.model.toml_file import read_toml
 from dataclasses import dataclass, field
-from importlib import resources
-from pathlib import Path
 from types import MappingProxyType
 
 from compliance.errors import did_you_mean
 from compliance.errors import InputError
+from compliance.files.shipped import resolve_shipped
 
 # canonical column -> SI unit ("Pa" columns are absolute pressures); recording-format.md
 CANONICAL_UNITS = MappingProxyType(
@@ -132,15 +131,6 @@ class ColumnMap:
 _suggest = did_you_mean
 
 
-def builtin_column_maps() -> list[str]:
-    """Names of the column maps shipped in ``compliance/data/column_maps/``."""
-    folder = resources.files("compliance") / "data" / "column_maps"
-    try:
-        return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
-    except (FileNotFoundError, NotADirectoryError):
-        return []
-
-
 def load_column_map(source) -> ColumnMap:
     """Load and validate a column map.
 
@@ -164,15 +154,7 @@ def load_column_map(source) -> ColumnMap:
         return source
     if isinstance(source, dict):
         return _from_dict(source, "column map (dict)")
-    path = Path(source)
-    if not path.exists() and path.suffix == "" and str(source) in builtin_column_maps():
-        path = Path(str(resources.files("compliance") / "data" / "column_maps" / f"{source}.toml"))
-    if not path.is_file():
-        known = builtin_column_maps()
-        raise InputError(
-            f"column map {str(source)!r}: no such file, and not a shipped map "
-            f"(shipped: {', '.join(known) or 'none'}){_suggest(source, known)}"
-        )
+    path = resolve_shipped(source, "column_map", where="column map")
     data, _ = read_toml(path, "column map")
     return _from_dict(data, str(path))
 
