@@ -16,10 +16,18 @@ import time
 
 from compliance.acceptance.judge.entries import judge_requirement
 from compliance.acceptance.measure.recording import measure_test
+from compliance.acceptance.predict.agreement import attach_predictions
+from compliance.acceptance.predict.site_prediction import predict_site
 from compliance.acceptance.site.folder import read_site
 from compliance.acceptance.site.prepared import prepare
 
-__all__ = ["accept", "measure_site", "step_options_of"]
+__all__ = ["accept", "measure_site", "options_key", "step_options_of"]
+
+
+def options_key(req) -> str:
+    """The key of a requirement's step options among the measured case sets ("" for the defaults)."""
+    opts = step_options_of(req)
+    return repr(sorted(opts.items())) if opts else ""
 
 
 def step_options_of(req) -> dict:
@@ -42,7 +50,7 @@ def measure_site(prepared: list, cfg, reqset) -> dict:
     out = {"": base}
     for req in reqset.requirements:
         opts = step_options_of(req)
-        key = repr(sorted(opts.items()))
+        key = options_key(req)
         if opts and key not in out:
             out[key] = [c for p in prepared for c in (measure_test(p, cfg, step_options=opts, sine=sine)
                                                       if p.test.kind == "step_series" else [])] + \
@@ -79,10 +87,15 @@ def accept(site, reqset, cfg, *, column_map=None, predict: bool = True, diagnose
     recordings = read_site(site, column_map)
     prepared = [prepare(r, cfg) for r in recordings]
     by_options = measure_site(prepared, cfg, reqset)
-    from compliance.acceptance.measure.recording import measure_test as _unused  # noqa: F401  (kept for symmetry)
-    entries = []
-    for req in reqset.requirements:
-        key = repr(sorted(step_options_of(req).items())) if step_options_of(req) else ""
-        entries.append(judge_requirement(req, reqset, by_options[key], cfg))
+    keys = {req.id: options_key(req) for req in reqset.requirements}
+    entries = [judge_requirement(req, reqset, by_options[keys[req.id]], cfg) for req in reqset.requirements]
+    t_measure = time.perf_counter() - t0
+    predicted = {}
+    if predict:
+        option_sets = {options_key(r): step_options_of(r) for r in reqset.requirements if step_options_of(r)}
+        predicted = predict_site(cfg, prepared, sine=_sine_settings(reqset), option_sets=option_sets, workers=workers,
+                                 progress=progress)
+        attach_predictions(entries, by_options, predicted, keys.get)
     return {"site": str(site), "prepared": prepared, "cases": by_options[""], "requirements": entries,
-            "timing": {"wall": time.perf_counter() - t0}}
+            "predicted": predicted,
+            "timing": {"wall": time.perf_counter() - t0, "measure": t_measure}}
