@@ -20,6 +20,7 @@ from compliance.acceptance.predict.agreement import attach_predictions
 from compliance.acceptance.predict.site_prediction import predict_site
 from compliance.acceptance.site.folder import read_site
 from compliance.acceptance.site.prepared import prepare
+from compliance.acceptance.site_results import site_results
 
 __all__ = ["accept", "measure_site", "options_key", "step_options_of"]
 
@@ -78,6 +79,11 @@ def accept(site, reqset, cfg, *, column_map=None, predict: bool = True, diagnose
     workers : int, optional
         Worker processes of the predictions and the diagnosis.
 
+    Returns
+    -------
+    dict
+        The site results (schema ``govcheck-site/1``, ``site_results``).
+
     Raises
     ------
     InputError
@@ -96,6 +102,11 @@ def accept(site, reqset, cfg, *, column_map=None, predict: bool = True, diagnose
         predicted = predict_site(cfg, prepared, sine=_sine_settings(reqset), option_sets=option_sets, workers=workers,
                                  progress=progress)
         attach_predictions(entries, by_options, predicted, keys.get)
-    return {"site": str(site), "prepared": prepared, "cases": by_options[""], "requirements": entries,
-            "predicted": predicted,
-            "timing": {"wall": time.perf_counter() - t0, "measure": t_measure}}
+    diagnosis = None
+    if diagnose:
+        from compliance.acceptance.diagnosis import diagnose_site
+
+        diagnosis = diagnose_site(cfg, prepared, by_options[""], entries, workers=workers, sine=_sine_settings(reqset))
+    timing = {"wall": time.perf_counter() - t0, "measure": t_measure, "recordings": len(prepared)}
+    return site_results(site, prepared, by_options[""], entries, predicted, cfg, reqset, command_line=command_line,
+                        diagnosis=diagnosis, timing=timing)

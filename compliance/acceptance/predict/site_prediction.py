@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 from compliance.acceptance.predict.replay_test import predict_cases
 from compliance.campaign.uncertainty import ranged_parameters
 from compliance.errors import GovcheckError
+from compliance.model.parameters import apply, param_handle
 from compliance.processes import map_tasks
 
 __all__ = ["Predicted", "predict_site", "TRACE_POINTS"]
@@ -52,7 +53,7 @@ def _task(context, item):
     """Worker: one test with one plant variant -> {options key: [metric -> value per case]}, trace, error."""
     cfg, prepared, sine, option_sets = context
     index, variant = item
-    moved = cfg if variant is None else cfg.replace(params={variant[0]: variant[1]}, sources={variant[0]: "user"})
+    moved = cfg if variant is None else apply(cfg, [param_handle(variant[0], "prediction band")], [variant[1]])
     out, trace = {}, None
     try:
         for key, opts in option_sets.items():
@@ -86,7 +87,8 @@ def _band(nominal: list, variants: dict) -> list:
     return out
 
 
-def predict_site(cfg, prepared: list, *, sine=None, option_sets: dict | None = None, workers=None, progress=False) -> dict:
+def predict_site(cfg, prepared: list, *, sine=None, option_sets: dict | None = None, workers=None, progress=False,
+                 extra_ranges: list | None = None) -> dict:
     """Predicted figures with bands of every prepared recording: name -> :class:`Predicted`.
 
     Parameters
@@ -98,11 +100,13 @@ def predict_site(cfg, prepared: list, *, sine=None, option_sets: dict | None = N
         The requirement file's sine settings (``skip_cycles``, ``cycles``).
     option_sets : dict, optional
         Options key -> step options (SI) the requirements ask besides the defaults.
+    extra_ranges : list, optional
+        (parameter path, {"low": SI, "high": SI}) moved like the declared ranges (a fitted value's own interval).
     """
     from compliance.campaign.executor import warm_up
 
     option_sets = {"": {}, **(option_sets or {})}
-    ranged = ranged_parameters(cfg)
+    ranged = ranged_parameters(cfg) + list(extra_ranges or [])
     variants = [None] + [(k, rng[end]) for k, rng in ranged for end in ("low", "high")]
     usable = [i for i, p in enumerate(prepared) if not p.problem]
     items = [(i, v) for i in usable for v in variants]
