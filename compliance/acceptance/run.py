@@ -59,8 +59,8 @@ def measure_site(prepared: list, cfg, reqset) -> dict:
     return out
 
 
-def accept(site, reqset, cfg, *, column_map=None, predict: bool = True, diagnose: bool = False, workers=None,
-           progress: bool = False, command_line: str | None = None) -> dict:
+def accept(site, reqset, cfg, *, column_map=None, recordings=None, predict: bool = True, diagnose: bool = False,
+           workers=None, progress: bool = False, command_line: str | None = None) -> dict:
     """Judge a site's recordings by a requirement set (see the module docstring).
 
     Parameters
@@ -72,6 +72,8 @@ def accept(site, reqset, cfg, *, column_map=None, predict: bool = True, diagnose
         The plant model the predictions run (by default the sidecars' plant, chosen by the caller).
     column_map : optional
         Column map of recordings in a logger's own names and units.
+    recordings : list of SiteRecording, optional
+        The site already read (``site.folder.read_site``); read here when not given.
     predict : bool
         Run each test in simulation and set the prediction beside each measured verdict.
     diagnose : bool
@@ -90,7 +92,7 @@ def accept(site, reqset, cfg, *, column_map=None, predict: bool = True, diagnose
         A bad site, recording or sidecar (before any figure is taken).
     """
     t0 = time.perf_counter()
-    recordings = read_site(site, column_map)
+    recordings = read_site(site, column_map) if recordings is None else recordings
     prepared = [prepare(r, cfg) for r in recordings]
     by_options = measure_site(prepared, cfg, reqset)
     keys = {req.id: options_key(req) for req in reqset.requirements}

@@ -13,13 +13,13 @@ from __future__ import annotations
 import datetime as _dt
 import hashlib
 
+from compliance.campaign.results_files import SITE_SCHEMA
 from compliance.campaign.run import plant_section, summary_section, versions_section
 from compliance.files.display import display_path
 from compliance.requirements.verdict import Overall, Severity, Status
 
 __all__ = ["SITE_SCHEMA", "TRACE_POINTS", "site_results"]
 
-SITE_SCHEMA = "govcheck-site/1"
 TRACE_POINTS = 1500  # samples of a recorded trace kept for the report's figures
 
 

@@ -82,7 +82,7 @@ def _band(nominal: list, variants: dict) -> list:
                 if d:
                     lo += min(0.0, *d)
                     hi += max(0.0, *d)
-            figs[metric] = (v0, lo, hi)
+            figs[metric] = (v0, max(lo, 0.0) if v0 >= 0.0 else lo, hi)  # every metric of the catalogue is a magnitude
         out.append(figs)
     return out
 
