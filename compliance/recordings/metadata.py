@@ -12,9 +12,8 @@ from compliance.model.toml_file import read_toml
 from pathlib import Path
 
 from compliance.errors import InputError
-from compliance.recordings.sidecar_schema import check_sidecar
+from compliance.recordings.sidecar_schema import check_sidecar, check_test_table
 from compliance.recordings.instruments import instrument_facts
-from compliance.recordings.test_table import check_test_table
 from compliance.units import parse_quantity, registry
 
 __all__ = ["read_sidecar", "si_metadata", "sidecar_path"]
@@ -52,7 +51,7 @@ def read_sidecar(path) -> dict:
     InputError
         The sidecar is not valid TOML, holds a pressure without ``abs`` / ``gauge``, a
         ``[logger]`` / ``[channels.NAME]`` table that ``instruments.instrument_facts`` rejects, or a
-        ``[test]`` table that ``test_table.check_test_table`` rejects.
+        ``[test]`` table that ``sidecar_schema.check_test_table`` rejects.
     """
     side = sidecar_path(path)
     if not side.is_file():

@@ -31,6 +31,7 @@ from compliance.procedures.steps import flow_saturation_voltage
 __all__ = ["measure_steps", "step_events"]
 
 PRE_WINDOW = 0.05  # s; the position at the step is the mean over this window (metrics.step_response's pre_window)
+SUPPORT = 0.5  # a time figure whose expanded uncertainty exceeds this share of itself is not supported by the log
 REST_WINDOW = 0.2  # s; the servo is at rest before a step when the line through its position over this window
 # travels less than 1 % of the step (DETECT_FRACTION: motion the dead time would count) or K times its own scatter
 
@@ -140,6 +141,8 @@ def _step_case(name: str, cond, ev, k: int, n: int, run, valve, options: dict, s
             else combine(t1 - lag - ev.t_step, {"end of dead time": u1, "step instant": sample_uncertainty(cond.dt),
                                                 "logger filter": cond.filter_delay}))
     tau, tau_ach = _time_figures(cond, ev, x0, u_x0, xf, u_xf, None if dead.value is None else t1, u1)
+    dead = _supported(dead, "dead time", cond)
+    tau, tau_ach = _supported(tau, "time constant", cond), _supported(tau_ach, "time constant", cond)
     why = _tau_reason(role, sm)
     if why is not None:
         tau, tau_ach = tau.ineligible(why) if tau.value is not None else tau, tau_ach.ineligible(why) if tau_ach.value is not None else tau_ach
@@ -170,6 +173,14 @@ def _step_case(name: str, cond, ev, k: int, n: int, run, valve, options: dict, s
     if t1 is not None:
         marks["motion_start"] = [t1, x0 + sgn * M.DETECT_FRACTION * abs(ev.size)]
     return Case(name, "steps", label, conditions, values, (), marks)
+
+
+def _supported(m: Measured, what: str, cond) -> Measured:
+    """``m``, or a missing figure when the log cannot support it (its uncertainty beyond ``SUPPORT`` of itself)."""
+    if m.value is None or m.u <= SUPPORT * abs(m.value):
+        return m
+    return Measured(None, 0.0, f"the log cannot support this {what}: {1e3 * m.value:.1f} ms +/- {1e3 * m.u:.1f} ms "
+                               f"(logged every {1e3 * cond.dt:.1f} ms with {1e6 * cond.sigma:.0f} um of noise)", m.eligible)
 
 
 def _fraction(value, reason, u_pos: float, change: float) -> Measured:

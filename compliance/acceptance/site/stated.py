@@ -1,6 +1,6 @@
 """The test a recording holds, as its sidecar states it: kind, conditions and the kind's settings in SI.
 
-The sidecar's ``[test]`` table (declared in ``recordings/test_table.py``) and ``[conditions]``
+The sidecar's ``[test]`` table (declared in ``recordings/sidecar_schema.py``) and ``[conditions]``
 become a :class:`SiteTest`; a recording whose sidecar does not say its kind gets one from its
 trace (``site.recognise``), which the run says.
 """
@@ -11,7 +11,7 @@ import math
 from dataclasses import dataclass, field, replace
 
 from compliance.errors import InputError
-from compliance.recordings.test_table import TEST_KINDS
+from compliance.recordings.sidecar_schema import TEST_KINDS
 
 __all__ = ["PROCEDURE_KIND", "SiteTest", "site_test"]
 

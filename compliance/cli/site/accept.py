@@ -111,7 +111,7 @@ def run(args) -> int:
     table = site_table(results)
     if args.report or args.pdf:
         from compliance.campaign.results_files import results_json
-        from compliance.report.site_report import render_site_report
+        from compliance.report.site.document import render_site_report
 
         doc = document_options(args, args.json, results_json(results) if args.json else None)
         render_site_report(results, html_path=args.report, pdf_path=args.pdf, document=doc)

@@ -1,0 +1,1 @@
+"""Commands about a site's own recordings (``govcheck accept``)."""
