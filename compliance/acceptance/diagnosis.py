@@ -26,6 +26,7 @@ from compliance.acceptance.measure.uncertainty import K
 from compliance.acceptance.predict.site_prediction import predict_site
 from compliance.effects import EFFECTS
 from compliance.model.parameters import apply
+from compliance.presentation.values import metric_text
 from compliance.requirements.verdict import Status
 from compliance.units.formatting import fmt_si
 
@@ -97,7 +98,8 @@ def _physics(fit, winner: str) -> str:
     return "the model's base parameters are off (recalibration)" if winner == "base" else winner.replace("_", " ")
 
 
-def diagnose_site(cfg, prepared: list, cases: list, entries: list, *, workers=None, sine=None) -> dict:
+def diagnose_site(cfg, prepared: list, cases: list, entries: list, *, workers=None, sine=None, effects=None,
+                  recalibrate: bool = True) -> dict:
     """Diagnose the site's disagreements with the model (see the module docstring) -> the ``diagnosis`` of the site results."""
     from compliance.diagnosis.servo.joint_recordings import diagnose_joint
 
@@ -113,7 +115,8 @@ def diagnose_site(cfg, prepared: list, cases: list, entries: list, *, workers=No
     if not chosen:
         return {"status": "not_possible", "disagreements": found, "recordings": [], "refit": [],
                 "text": "no closed-loop recording at this site: the joint diagnosis replays closed-loop tests"}
-    joint = diagnose_joint(cfg, [(p.recording.frame, p.recording.meta) for p in chosen], jobs=workers)
+    joint = diagnose_joint(cfg, [(p.recording.frame, p.recording.meta) for p in chosen], jobs=workers, effects=effects,
+                           recalibrate=recalibrate)
     data = joint.to_dict()
     out = {"status": joint.verdict, "winner": joint.winner, "reason": joint.reason, "disagreements": found,
            "targets": targets, "recordings": [p.name for p in chosen], "effects": data["effects"][:5],
@@ -140,18 +143,24 @@ def diagnose_site(cfg, prepared: list, cases: list, entries: list, *, workers=No
     return out
 
 
+def _v(value, metric: str, digits: int = 3) -> str:
+    return metric_text(value, metric, digits, unicode=False)
+
+
 def _text(d: dict) -> str:
     parts = []
     for x in d["disagreements"][:3]:
-        parts.append(f"{x['run']} ({x['requirement']}): measured {x['measured']:.4g} +/- {x['u']:.2g}, predicted "
-                     f"{x['predicted']:.4g} [{x['low']:.4g} .. {x['high']:.4g}]")
+        m = x["metric"]
+        parts.append(f"{x['run']} ({x['requirement']}): measured {_v(x['measured'], m)} +/- {_v(x['u'], m, 2)}, predicted "
+                     f"{_v(x['predicted'], m)} [{_v(x['low'], m)} .. {_v(x['high'], m)}]")
     text = "The machine and the model disagree on " + "; ".join(parts) + "."
     if d.get("winner"):
         text += (f" The joint diagnosis of {', '.join(d['recordings'])} finds the model lacks: {d['physics']} "
                  f"({d['status'].replace('_', ' ')}).")
         for r in d["refit"]:
-            text += (f" Refitted, the model predicts {r['predicted']:.4g} [{r['low']:.4g} .. {r['high']:.4g}] for {r['run']} "
-                     f"against {r['measured']:.4g} measured: {'agrees' if r['agree'] else 'still disagrees'}.")
+            m = r["metric"]
+            text += (f" Refitted, the model predicts {_v(r['predicted'], m)} [{_v(r['low'], m)} .. {_v(r['high'], m)}] for "
+                     f"{r['run']} against {_v(r['measured'], m)} measured: {'agrees' if r['agree'] else 'still disagrees'}.")
     else:
         text += f" The joint diagnosis finds no explanation: {d.get('reason')}"
     return text

@@ -59,7 +59,7 @@ def measure_site(prepared: list, cfg, reqset) -> dict:
     return out
 
 
-def accept(site, reqset, cfg, *, column_map=None, recordings=None, predict: bool = True, diagnose: bool = False,
+def accept(site, reqset, cfg, *, column_map=None, recordings=None, predict: bool = True, diagnose: bool | dict = False,
            workers=None, progress: bool = False, command_line: str | None = None) -> dict:
     """Judge a site's recordings by a requirement set (see the module docstring).
 
@@ -76,8 +76,9 @@ def accept(site, reqset, cfg, *, column_map=None, recordings=None, predict: bool
         The site already read (``site.folder.read_site``); read here when not given.
     predict : bool
         Run each test in simulation and set the prediction beside each measured verdict.
-    diagnose : bool
-        Explain a disagreement with the joint diagnosis of the site's closed-loop recordings.
+    diagnose : bool or dict
+        Explain a disagreement with the joint diagnosis of the site's closed-loop recordings (a dict: its
+        options, ``effects`` and ``recalibrate``, as ``acceptance.diagnosis.diagnose_site`` takes them).
     workers : int, optional
         Worker processes of the predictions and the diagnosis.
 
@@ -108,7 +109,8 @@ def accept(site, reqset, cfg, *, column_map=None, recordings=None, predict: bool
     if diagnose:
         from compliance.acceptance.diagnosis import diagnose_site
 
-        diagnosis = diagnose_site(cfg, prepared, by_options[""], entries, workers=workers, sine=_sine_settings(reqset))
+        options = diagnose if isinstance(diagnose, dict) else {}
+        diagnosis = diagnose_site(cfg, prepared, by_options[""], entries, workers=workers, sine=_sine_settings(reqset), **options)
     timing = {"wall": time.perf_counter() - t0, "measure": t_measure, "recordings": len(prepared)}
     return site_results(site, prepared, by_options[""], entries, predicted, cfg, reqset, command_line=command_line,
                         diagnosis=diagnosis, timing=timing)

@@ -92,7 +92,7 @@ def procedure_match(proc, case, cfg, listed) -> tuple[bool, list]:
     if proc.kind == "steps":
         return _step_match(proc, case, stroke, listed), list(case.departures)
     if proc.kind == "full_stroke":
-        if case.conditions.get("direction") not in s.get("directions", ["opening", "closing"]):
+        if not case.problem and case.conditions.get("direction") not in s.get("directions", ["opening", "closing"]):
             return False, []
         dep = list(case.departures)
         wanted = s.get("flow_control", True)
