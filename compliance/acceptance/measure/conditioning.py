@@ -23,7 +23,8 @@ import numpy as np
 from scipy.signal import savgol_coeffs, savgol_filter
 
 from compliance.errors import InputError
-from compliance.validation.recorded_noise import NOISE_SMOOTHING, position_quantum, sensor_noise_std
+from compliance.validation.recorded_noise import (NOISE_SMOOTHING, position_noise_estimate, position_quantum, robust_std,
+                                                 sensor_noise_std)
 from compliance.validation.resampling import is_uniform, resample_uniform
 
 __all__ = ["Conditioned", "condition", "MIN_SMOOTHING_SAMPLES"]
@@ -117,8 +118,11 @@ def condition(frame, metadata: dict | None, where: str) -> Conditioned:
         smooth = savgol_filter(raw, n, SMOOTHING_ORDER)
         keep = math.sqrt(float(np.sum(savgol_coeffs(n, SMOOTHING_ORDER) ** 2)))
         window = n * dt
+        # the noise the smoother leaves, measured: a logger's anti-alias filter correlates the noise, which a
+        # smoother then averages less than white noise (the noise realisation of recorded_noise, smoothed alike)
+        left = robust_std(savgol_filter(position_noise_estimate(raw, dt), n, SMOOTHING_ORDER))
     else:
-        smooth, keep, window = raw.copy(), 1.0, 0.0
+        smooth, keep, window, left = raw.copy(), 1.0, 0.0, 0.0
     fc = _cutoff(metadata)
     delay = 1.0 / (2.0 * math.pi * fc) if fc else 0.0
-    return Conditioned(grid, smooth, raw, cols, dt, sigma, resolution, sigma * keep, window, delay, uneven)
+    return Conditioned(grid, smooth, raw, cols, dt, sigma, resolution, max(sigma * keep, left), window, delay, uneven)

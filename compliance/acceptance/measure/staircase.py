@@ -2,9 +2,9 @@
 
 The legs and the figure are ``metrics.staircase``'s, read on the conditioned position with a
 motion threshold of half a stair (the stair it moved on is then resolved), never below ``K``
-conditioned-noise standard deviations. The uncertainty is the staircase's own resolution (one
-stair, uniform: K x stair / sqrt(12)) and any stair the threshold crossing could fall on within
-its noise band.
+conditioned-noise standard deviations. The uncertainty is any other stair the threshold crossing
+could fall on within its noise band. The staircase's own resolution (one stair) is the figure's definition, not a
+measurement error: it is stated beside the figure (``conditions["stair"]``).
 """
 
 from __future__ import annotations
@@ -66,7 +66,7 @@ def measure_staircase(name: str, cond, run, cfg) -> list[Case]:
             per_leg.append(missing(f"leg {word} from {lg.times[0]:.1f} s: the position never moved {threshold * 1e3:.2f} mm "
                                    f"over its {len(lg.times)} stairs ({len(lg.times) * stair * 1e3:.2f} mm)"))
             continue
-        m = combine(value, {"staircase resolution": K * stair / math.sqrt(12.0), "threshold crossing": u_stairs})
+        m = combine(value, {"threshold crossing": u_stairs})
         per_leg.append(m)
         moved[word] = t_moved
         if worst is None or m.value > worst.value:

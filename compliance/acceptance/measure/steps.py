@@ -30,7 +30,7 @@ from compliance.procedures.steps import flow_saturation_voltage
 
 __all__ = ["measure_steps", "step_events"]
 
-PRE_WINDOW = 0.05  # s; the position at the step is the mean over this window (metrics.step_response's pre_window)
+PRE_WINDOW = 0.05  # s; the position and the set-point before a step: over this window (metrics.step_response's pre_window)
 SUPPORT = 0.5  # a time figure whose expanded uncertainty exceeds this share of itself is not supported by the log
 REST_WINDOW = 0.2  # s; the servo is at rest before a step when the line through its position over this window
 # travels less than 1 % of the step (DETECT_FRACTION: motion the dead time would count) or K times its own scatter
@@ -62,6 +62,17 @@ def step_events(cond, settings: dict) -> list:
         r1 = float(np.median(ref[settle])) if settle.stop > settle.start else ev.r_after
         out.append(M.StepEvent(t_step, ev.t_end, r0, r1))
     return out
+
+
+def _position_at_step(cond, t_step: float) -> tuple[float, float]:
+    """The position at the step [m] as metrics.step takes it (the mean over ``PRE_WINDOW`` before it), and its
+    standard uncertainty: the noise averaged over the window, never below the conditioned noise (a logger's filter
+    correlates the samples, so they average less than independent ones)."""
+    pre = time_window(cond.time, t_step - PRE_WINDOW, t_step)
+    n = pre.stop - pre.start
+    if n == 0:
+        return float(np.interp(t_step, cond.time, cond.position)), cond.u_position
+    return float(np.mean(cond.raw[pre])), max(cond.sigma / math.sqrt(n), cond.u_position)
 
 
 def _role(ev, x_op: float | None) -> str:
@@ -123,9 +134,7 @@ def _step_case(name: str, cond, ev, k: int, n: int, run, valve, options: dict, s
     """Measure one step (see the module docstring)."""
     role = _role(ev, run.position)
     sgn = 1 if ev.size >= 0 else -1
-    pre = time_window(cond.time, ev.t_step - PRE_WINDOW, ev.t_step)
-    x0 = float(np.mean(cond.raw[pre])) if pre.stop > pre.start else float(cond.raw[max(0, pre.start - 1)])
-    u_x0 = cond.sigma / math.sqrt(max(1, pre.stop - pre.start))
+    x0, u_x0 = _position_at_step(cond, ev.t_step)
     u = cond.column("valve_command")
     sat = valve["saturation"][sgn]
     sm = M.step_response(cond.time, cond.position, ev, valve_command=None if u is None else u - valve["centre"],
@@ -158,6 +167,9 @@ def _step_case(name: str, cond, ev, k: int, n: int, run, valve, options: dict, s
             "noise left after conditioning": peaks,
             "noise peak of a maximum": peak_bias(cond.u_position, final_span, max(cond.window, cond.dt))}),
         "steady_state_error": combine(sm.steady_state_error, {"noise": K * u_xf}),
+        # mean |reference - position| over the final window: the steady error where the position crosses the set-point
+        "mean_positioning_error": combine(float(np.mean(np.abs(ev.r_after - cond.position[fw]))) if fw.stop > fw.start else None,
+                                          {"noise": K * cond.u_position}, "no sample in the final window"),
         "overshoot": _fraction(sm.overshoot, sm.reasons.get("overshoot"), peaks, abs(xf - x0)),
         "settling_time": _time(sm.settling_time, sm.reasons.get("settling_time"), cond),
         "rise_time": _time(sm.rise_time, sm.reasons.get("rise_time"), cond),
