@@ -79,7 +79,7 @@ def _resolution(metadata: dict, position: np.ndarray) -> float:
     return position_quantum(position)
 
 
-def condition(frame, metadata: dict | None, where: str) -> Conditioned:
+def condition(frame, metadata: dict | None, where: str, *, noise_free: bool = False) -> Conditioned:
     """Measure the instruments of a recording and condition its position.
 
     Parameters
@@ -90,6 +90,8 @@ def condition(frame, metadata: dict | None, where: str) -> Conditioned:
         Its metadata (``logger``, ``channels``).
     where : str
         The recording, for messages.
+    noise_free : bool
+        A simulated trace (a prediction): no noise to measure, nothing to smooth.
 
     Raises
     ------
@@ -110,6 +112,8 @@ def condition(frame, metadata: dict | None, where: str) -> Conditioned:
     grid = resample_uniform(t, t)[0] if uneven else t
     dt = float(np.median(np.diff(grid)))
     raw = cols.pop("position")
+    if noise_free:
+        return Conditioned(grid, raw, raw, cols, dt, 0.0, 0.0, 0.0, 0.0, 0.0, uneven)
     resolution = _resolution(metadata, raw)
     noise_samples = int(round(NOISE_WINDOW / dt)) | 1
     sigma = sensor_noise_std(raw, max(noise_samples, 5), resolution=resolution)

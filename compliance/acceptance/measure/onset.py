@@ -24,6 +24,7 @@ import math
 import numpy as np
 
 from compliance.acceptance.measure.uncertainty import K, crossing_with_interval
+from compliance.metrics.trace_windows import crossing
 
 __all__ = ["FIT_REACH", "motion_onset"]
 
@@ -89,6 +90,8 @@ def motion_onset(time, raw, smooth, t_step: float, x0: float, size: float, sigma
     travel = sgn * (np.asarray(smooth) - x0)
     reach = max(NOISE_REACH * sigma, FIT_REACH * abs(size))
     k = np.nonzero(travel[i0:] >= reach)[0]
+    if sigma <= 0.0:  # a noise-free trace (a prediction): the level is read where the trace crosses it
+        return crossing(time, travel, level, i0, +1), 0.0, "noise-free trace"
     if fit and k.size >= 6:
         i1 = i0 + int(k[0]) + 1
         tt = np.asarray(time[i0:i1], float)

@@ -80,6 +80,6 @@ def predict_cases(cfg, prep: PreparedTest, *, sine: dict | None = None, step_opt
         The model became non-physical.
     """
     frame = _predicted_frame(cfg, prep)
-    sim_prep = PreparedTest(prep.recording, prep.test, condition(frame, {}, f"{prep.name} (predicted)"))
+    sim_prep = PreparedTest(prep.recording, prep.test, condition(frame, {}, f"{prep.name} (predicted)", noise_free=True))
     cases = measure_test(sim_prep, cfg, sine=sine, step_options=step_options)
     return cases, (frame if keep_trace else None)
