@@ -20,7 +20,7 @@ _COMMANDS = (
     ("simulate", "simulate"),
     ("reproduce", "reproduce"),
     ("check", "check"),
-    ("accept", "site.accept"),
+    ("accept", "accept"),
     ("gate", "gate"),
     ("sweep", "sweep"),
     ("size", "size"),

@@ -17,7 +17,6 @@ import re
 from pathlib import Path
 
 from compliance.errors import InputError
-from compliance.model.force_limit import check_load_force  # noqa: F401 - simulate's --load check
 from compliance.units import parse_quantity
 
 OUTPUT_SUFFIXES = {"json": (".json",), "junit": (".xml",), "report": (".html", ".htm"), "pdf": (".pdf",)}

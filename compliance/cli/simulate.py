@@ -7,9 +7,10 @@ import json
 import os
 from pathlib import Path
 
-from compliance.cli.common import (add_parser, add_plant_argument, check_load_force, plant_from_args, plant_source,
+from compliance.cli.common import (add_parser, add_plant_argument, plant_from_args, plant_source,
                                    quantity)
 from compliance.errors import InputError
+from compliance.model.force_limit import check_load_force
 from compliance.simulation.profiles import Profile, parse_sine, steps
 
 MAX_DURATION = 3600.0  # [s] one simulation; longer is a typo (1e9 s would need TiB of memory)

@@ -28,7 +28,6 @@ from compliance.model.toml_file import read_toml
 _TOP_KEYS = {"name", "description", "provenance", "effects", "identity"}
 
 
-_suggest = did_you_mean
 
 
 @dataclass(frozen=True)
@@ -116,13 +115,13 @@ class PlantConfig:
         new_sources = dict(self.sources)
         for k, v in (params or {}).items():
             if k not in BASE_BY_KEY:
-                raise InputError(f"parameter '{k}' is not known{_suggest(k, BASE_BY_KEY)}")
+                raise InputError(f"parameter '{k}' is not known{did_you_mean(k, BASE_BY_KEY)}")
             new_params[k] = float(v)
             new_sources[k] = (sources or {}).get(k, "user")
         new_effects = {k: dict(v) for k, v in self.effects.items()}
         for k, v in (effects or {}).items():
             if k not in EFFECTS:
-                raise InputError(f"effect '{k}' is not known{_suggest(k, EFFECTS)}")
+                raise InputError(f"effect '{k}' is not known{did_you_mean(k, EFFECTS)}")
             if v is None:
                 new_effects.pop(k, None)
             else:
@@ -133,10 +132,10 @@ class PlantConfig:
         new_options = dict(self.options)
         for k, v in (options or {}).items():
             if k not in OPTIONS:
-                raise InputError(f"option '{k}' is not known{_suggest(k, OPTIONS)}")
+                raise InputError(f"option '{k}' is not known{did_you_mean(k, OPTIONS)}")
             v = str(v).lower() if isinstance(v, bool) else str(v)
             if v not in OPTIONS[k]:
-                raise InputError(f"option {k} = '{v}' is not one of {', '.join(OPTIONS[k])}{_suggest(v, OPTIONS[k])}")
+                raise InputError(f"option {k} = '{v}' is not one of {', '.join(OPTIONS[k])}{did_you_mean(v, OPTIONS[k])}")
             new_options[k] = v
         cfg = dc_replace(
             self,
@@ -171,7 +170,7 @@ def plant_from_dict(data: dict[str, Any], where: str = "<configuration>", digest
         raise InputError(f"{where}: expected a TOML table at the top level")
     for k in data:
         if k not in _TOP_KEYS and k not in SECTIONS:
-            raise InputError(f"{where}: unknown key '{k}'{_suggest(k, list(_TOP_KEYS) + SECTIONS)}")
+            raise InputError(f"{where}: unknown key '{k}'{did_you_mean(k, list(_TOP_KEYS) + SECTIONS)}")
     name = data.get("name")
     if not isinstance(name, str) or not name.strip():
         raise InputError(f"{where}: missing 'name' (a string naming the plant)")

@@ -128,7 +128,6 @@ class ColumnMap:
         return None
 
 
-_suggest = did_you_mean
 
 
 def load_column_map(source) -> ColumnMap:
@@ -169,7 +168,7 @@ def _int_option(data, key, where, default):
 def _from_dict(data: dict, where: str) -> ColumnMap:
     for key in data:
         if key not in _TOP_KEYS:
-            raise InputError(f"{where}: unknown key '{key}'{_suggest(key, _TOP_KEYS)} (known: {', '.join(_TOP_KEYS)})")
+            raise InputError(f"{where}: unknown key '{key}'{did_you_mean(key, _TOP_KEYS)} (known: {', '.join(_TOP_KEYS)})")
     delim_text = data.get("delimiter", "auto")
     if delim_text not in _DELIMITERS:
         raise InputError(
@@ -183,7 +182,7 @@ def _from_dict(data: dict, where: str) -> ColumnMap:
         raise InputError(f"{where}: 'header' must be true or false, got {header!r}")
     fmt = data.get("format")
     if fmt is not None and fmt not in _FORMATS:
-        raise InputError(f"{where}: format {fmt!r} not known{_suggest(fmt, _FORMATS)} (known: {', '.join(_FORMATS)})")
+        raise InputError(f"{where}: format {fmt!r} not known{did_you_mean(fmt, _FORMATS)} (known: {', '.join(_FORMATS)})")
     comment = data.get("comment", "#")
     if not isinstance(comment, str) or len(comment) != 1:
         raise InputError(f"{where}: 'comment' must be one character, got {comment!r}")
@@ -222,7 +221,7 @@ def _spec(name: str, entry, where: str, header: bool, time_unit) -> ColumnSpec:
         raise InputError(f"{where}: expected a table such as {{column = \"x_mm\", unit = \"mm\"}}")
     for key in entry:
         if key not in _ENTRY_KEYS:
-            raise InputError(f"{where}: unknown key '{key}'{_suggest(key, _ENTRY_KEYS)} (known: {', '.join(_ENTRY_KEYS)})")
+            raise InputError(f"{where}: unknown key '{key}'{did_you_mean(key, _ENTRY_KEYS)} (known: {', '.join(_ENTRY_KEYS)})")
     if "column" not in entry:
         raise InputError(f"{where}: missing 'column' (a column name or a 0-based index)")
     column = entry["column"]
@@ -236,7 +235,7 @@ def _spec(name: str, entry, where: str, header: bool, time_unit) -> ColumnSpec:
             si_unit = "Pa"
         else:
             raise InputError(
-                f"{where}: '{name}' is not a canonical column{_suggest(name, CANONICAL_UNITS)}; "
+                f"{where}: '{name}' is not a canonical column{did_you_mean(name, CANONICAL_UNITS)}; "
                 f"known: {', '.join(CANONICAL_UNITS)} (or give si_unit = \"...\" for your own column)"
             )
     unit = entry.get("unit")

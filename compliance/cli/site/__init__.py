@@ -1,1 +1,0 @@
-"""Commands about a site's own recordings (``govcheck accept``)."""
