@@ -3,7 +3,7 @@
 The servomotor drift test runs with the positioner in manual and the valve at null (IEC 60308:2024
 servomotor tests; ASME PTC 29-2005 (R2020)): nothing then corrects a leak, so the position shows it.
 A closed-loop hold hides the same leak behind the controller. The drift is the simulation's
-(``metrics.position_error.hold``: |slope of the line fit| x window length), beside the largest
+(``metrics.position_error.hold`` on the conditioned position: |slope of the line fit| x window length), beside the largest
 excursion from the start of the window; the positioning error and the limit cycle are properties
 of the closed loop and are not read on an open-loop window.
 """
@@ -53,7 +53,7 @@ def measure_hold(name: str, cond, run, cfg) -> list[Case]:
         return [Case(name, "hold", label, base, {m: missing(reason) for m in ("drift", "max_positioning_error")}, tuple(notes))]
     ref = cond.column("reference")
     ref = np.full(cond.time.shape, np.nan) if ref is None else ref
-    h = M.hold(cond.time, cond.raw, ref, t0, t1 + 0.5 * cond.dt)
+    h = M.hold(cond.time, cond.position, ref, t0, t1 + 0.5 * cond.dt)
     n = w.stop - w.start
     span = cond.time[w][-1] - cond.time[w][0]
     u_fit = K * cond.sigma * math.sqrt(12.0 / n)  # a line fit's travel over n samples of white noise
@@ -75,10 +75,15 @@ def measure_hold(name: str, cond, run, cfg) -> list[Case]:
     elif not np.all(np.isfinite(ref[w])):
         for m in ("max_positioning_error", "steady_state_error"):
             values[m] = missing("no reference logged")
-        values["limit_cycle_amplitude"] = combine(h.limit_cycle_amplitude, {"noise": 2 * K * cond.sigma})
+        values["limit_cycle_amplitude"] = combine(h.limit_cycle_amplitude, {
+            "noise left after conditioning": K * cond.u_position,
+            "noise peak of a maximum": peak_bias(cond.u_position, span, max(cond.window, cond.dt))})
     else:
-        values["max_positioning_error"] = combine(h.max_positioning_error, {"noise": 2 * K * cond.sigma})
+        peak = peak_bias(cond.u_position, span, max(cond.window, cond.dt))
+        values["max_positioning_error"] = combine(h.max_positioning_error, {"noise left after conditioning": K * cond.u_position,
+                                                                           "noise peak of a maximum": peak})
         values["steady_state_error"] = combine(h.steady_state_error, {"noise": K * cond.sigma / math.sqrt(n)})
-        values["limit_cycle_amplitude"] = combine(h.limit_cycle_amplitude, {"noise": 2 * K * cond.sigma})
+        values["limit_cycle_amplitude"] = combine(h.limit_cycle_amplitude, {"noise left after conditioning": K * cond.u_position,
+                                                                           "noise peak of a maximum": peak})
     base.update(x_start=x_start, duration=span, direction="closing" if values["drift_end"].value < 0 else "opening")
     return [Case(name, "hold", label, base, values, tuple(notes), {"window": [t0, t1]})]

@@ -223,4 +223,9 @@ def measure_steps(name: str, cond, run, cfg, options: dict | None = None) -> lis
              "saturation": {s: flow_saturation_voltage(cfg, s, run.flow_control) for s in (+1, -1)}}
     opts = {k: v for k, v in (options or {}).items() if k in ("final_window", "settling_band", "settling_band_abs")}
     stated = bool(run.settings.get("step_times"))
+    if not events:
+        why = ("no set-point step in the log: the reference column never jumps" if cond.column("reference") is not None
+               else "no reference column and no step_times/setpoints_after in the sidecar: the steps are not known")
+        return [Case(name, "steps", f"{name} (no step found)", {"position": run.position, "load": run.load,
+                                                               "flow_control": run.flow_control}, {}, (), {}, why)]
     return [_step_case(name, cond, ev, k, len(events), run, valve, opts, stated) for k, ev in enumerate(events)]
