@@ -17,7 +17,18 @@ HOLD_METRICS = ("drift", "max_positioning_error", "steady_state_error", "limit_c
 
 
 def measured_key(req) -> str:
-    """The name of the measured figure a requirement judges (its metric)."""
+    """The name of the measured figure a requirement judges: its metric, read as its file says.
+
+    A stroke time read end to end (``timing = "end_to_end"``, as an option or a field of the
+    requirement) is the command-to-end-of-travel time of ``metrics.stroke.stroke_timing``
+    (``time_to_end``); the 25-75 % reading (``full_rate``, the default) is the metric itself. Every
+    other metric names its figure directly (a step's ``time_constant_achieved`` beside its
+    ``time_constant``, a stroke's ``start_delay``).
+    """
+    timing = (req.options or {}).get("timing", getattr(req, "timing", None))
+    timing = getattr(timing, "text", timing)
+    if req.metric in ("opening_time", "closing_time") and timing == "end_to_end":
+        return "time_to_end"
     return req.metric
 
 
