@@ -57,6 +57,14 @@ def resolved_limit(comparator: str, limit, metric: str, *, unicode: bool = False
     return head + " .. ".join(metric_text(v, metric, unicode=unicode) for v in limit)
 
 
+def _point_status(row: dict):
+    """The row's verdict on its point value: an uncertain row (its band straddles the limit) still has one."""
+    status = row.get("status")
+    if status == Status.UNCERTAIN and row.get("value") is not None and row.get("limit") and row.get("comparator"):
+        return evaluate(row["value"], row["comparator"], row["limit"]).status
+    return status
+
+
 def value_digits(row: dict, metric: str, digits: int = 3) -> int:
     """Significant digits that show a judged row's value on its own side of its limit.
 
@@ -66,7 +74,7 @@ def value_digits(row: dict, metric: str, digits: int = 3) -> int:
     when the row has no verdict (no value, no limit, not judged).
     """
     info = METRICS.get(metric)
-    v, lim, comparator, status = row.get("value"), row.get("limit"), row.get("comparator"), row.get("status")
+    v, lim, comparator, status = row.get("value"), row.get("limit"), row.get("comparator"), _point_status(row)
     if info is None or v is None or not lim or not comparator or status not in (Status.PASS, Status.FAIL) \
             or not math.isfinite(v) or abs(v * info.display_scale) < ZERO:
         return digits
@@ -105,7 +113,7 @@ def row_texts(row: dict, metric: str, *, unicode: bool = True) -> dict:
 
     The value carries the digits :func:`value_digits` asks for (three at least).
     """
-    status = row.get("status")
+    status = _point_status(row)
     return {
         "value": metric_text(row.get("value"), metric, value_digits(row, metric), unicode=unicode),
         "limit": None if not row.get("limit") else " .. ".join(metric_text(v, metric, unicode=unicode) for v in row["limit"]),

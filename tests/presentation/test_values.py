@@ -45,6 +45,8 @@ def test_a_failing_value_never_prints_as_its_limit():
     assert texts["margin"] == "-0.0074 mm/s"  # below the 0.01 mm/s resolution, still negative
     assert texts["margin_pct"] == "-0.023 %"  # not "-0.0 %"
     assert row_texts(row, "stroke_speed")["margin"] == "\u22120.0074 mm/s"
+    # an uncertain row (its band straddles the limit) still prints its point value on the failing side
+    assert row_texts(dict(row, status="uncertain"), "stroke_speed", unicode=False)["value"] == "32.01 mm/s"
     # a value 0.4 ms beyond a 0.25 s limit needs four digits; one far beyond keeps three
     tau = {"value": 0.2504, "limit": [0.1, 0.25], "comparator": "within", "status": "fail", "margin": -4e-4, "margin_pct": -0.16}
     assert row_texts(tau, "time_constant", unicode=False)["value"] == "0.2504 s"
