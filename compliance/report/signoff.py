@@ -324,7 +324,7 @@ def evidence_block(results: dict) -> dict:
                          "word": status_word(e["status"]), "lean": _lean(c), "text": c["text"]})
     verdicts.sort(key=lambda v: (v["severity"] != Severity.MANDATORY, v["status"] == Status.PASS))
     word = {"validated": "VALIDATED", "contradicted": "CONTRADICTED"}.get(ev["status"], "NOT VALIDATED")
-    summary = ev["summary"]
+    summary = ev["summary"].removeprefix(f"{ev['status']}: ")  # the word is printed before it
     if ev["status"] == "contradicted":
         summary = (f"{ev['contradict']} of {ev['compared']} independent measured figures disagree with the model: "
                    + "; ".join((ev.get("examples") or [])[:3]))
