@@ -85,6 +85,7 @@ def contradicted_verdicts(entries: list[dict], sources: list[dict]) -> list[dict
         parts += [f"the recording {r} (position windows outside their limits)" for r in recs]
         out.append({"requirement": e["id"], "title": e.get("title"), "severity": e["severity"], "status": e["status"],
                     "metric": e["metric"], "figures": [figure_text(f) for f in figs], "recordings": recs,
+                    "example": figure_text(worst, test=False) if worst else f"the recording {recs[0]}",
                     "direction": sorted(dirs), "consequence": _consequence(e.get("comparator", ""), dirs),
                     "text": "; ".join(parts)})
     return out

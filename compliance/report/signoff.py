@@ -268,7 +268,7 @@ def mandatory_not_met(results: dict, remedies: dict | None = None) -> list[dict]
             "where": f"{w['procedure']} at {w['operating_point']}" if w.get("procedure") else None,
             "band": _band_text(band, e["metric"]), "deciding": list(band.get("deciding") or []),
             "reason": reason, "anchor": "req-" + e["id"],
-            "contradicted": None if c is None else f"contradicted by measurement ({_lean(c)})",
+            "contradicted": None if c is None else f"contradicted by measurement ({_lean(c)}): {c.get('example') or c['text']}",
             "remedy": (remedies or {}).get(e["id"]),
         })
     order = {Status.FAIL: 0, Status.UNCERTAIN: 1, Status.NOT_EVALUATED: 2}
@@ -327,7 +327,7 @@ def evidence_block(results: dict) -> dict:
     summary = ev["summary"].removeprefix(f"{ev['status']}: ")  # the word is printed before it
     if ev["status"] == "contradicted":
         summary = (f"{ev['contradict']} of {ev['compared']} independent measured figures disagree with the model: "
-                   + "; ".join((ev.get("examples") or [])[:3]))
+                   + "; ".join((ev.get("examples") or [])[:2]))
     return {"status": ev["status"], "word": word, "summary": summary, "verdicts": verdicts,
             "sources": [s.get("title") or s.get("path") for s in ev.get("sources") or []]}
 
