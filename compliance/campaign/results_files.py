@@ -16,6 +16,7 @@ from compliance.files.atomic import write_text_atomic
 from compliance.files.jsonable import json_text, read_json
 from compliance.requirements.verdict import Basis, Severity, Status
 from compliance.presentation.values import limit_as_written
+from compliance.results.numbers import check_numbers
 from compliance.units.formatting import STATUS_WORD as _STATUS_WORD  # the one status-word table
 
 RESULTS_SCHEMA = "govcheck-results/1"
@@ -51,51 +52,6 @@ def read_results(path) -> dict:
             raise InputError(f"{p}: {key}: missing from the results file")
     check_numbers(data, str(p))
     return data
-
-
-def check_numbers(data: dict, where: str) -> None:
-    """Refuse text where the report computes with a number (``NUMERIC_KEYS``), naming the key path.
-
-    Raises
-    ------
-    InputError
-        The results file is damaged or hand-edited.
-    """
-    for key in ("requirements", "runs", "timing", "linear", "plant"):
-        _check_numbers(data.get(key), f"{where}: {key}")
-
-
-# keys whose values the report computes with: a number, null, or a list of them (text lives in "display" tables)
-NUMERIC_KEYS = frozenset({
-    "value", "margin", "margin_pct", "wall", "wall_time", "time", "position", "reference", "valve_command",
-    "pressure_a", "pressure_b", "supply_pressure", "force", "phase_margin_deg", "gain_margin_db", "time_constant",
-    "dead_time", "overshoot", "settling_time", "rise_time", "bandwidth_hz", "natural_frequency_hz", "damping_ratio",
-    "gain_crossover_hz", "phase_crossover_hz", "max_error", "rms_error", "steady_error", "peak_speed",
-})
-_TEXT_TABLES = frozenset({"display", "procedure", "operating_point", "settings", "procedures", "operating_points"})
-
-
-def _check_numbers(tree, where: str) -> None:
-    """A damaged results file (text where the report needs a number) is named, not rendered into a crash."""
-    if isinstance(tree, dict):
-        for k, v in tree.items():
-            if k in _TEXT_TABLES:
-                continue
-            if k in NUMERIC_KEYS and not _numbers(v):
-                raise InputError(f"{where}.{k}: {str(v)[:60]!r} where a number (or null) belongs; the results file is "
-                                 "damaged or hand-edited: regenerate it with govcheck check --json")
-            _check_numbers(v, f"{where}.{k}")
-    elif isinstance(tree, list):
-        for i, v in enumerate(tree):
-            _check_numbers(v, f"{where}[{i}]")
-
-
-def _numbers(v) -> bool:
-    if isinstance(v, list):
-        return all(_numbers(x) for x in v)
-    if isinstance(v, dict):
-        return True  # a table of its own: its leaves are checked by name
-    return v is None or (isinstance(v, (int, float)) and not isinstance(v, bool))
 
 
 # --------------------------------------------------------------------------- terminal
@@ -173,8 +129,9 @@ def summary_lines(results: dict) -> list[str]:
     return out
 
 
-def summary_table(results: dict) -> str:
+def summary_table(results) -> str:
     """Fixed-width table: one line per requirement with its worst case, cases evaluated and basis, then the verdict."""
+    results = _plain(results)
     head = ("requirement", "metric", "limit", "worst value", "margin", "cases", "worst case", "severity", "basis", "status")
     rows = [_table_row(e) for e in results["requirements"]]
     widths = [max(len(str(r[i])) for r in rows + [head]) for i in range(len(head))]
@@ -189,12 +146,17 @@ def summary_table(results: dict) -> str:
 
 
 # --------------------------------------------------------------------------- JUnit
-def junit_xml(results: dict) -> str:
+def _plain(results) -> dict:
+    return results.as_dict() if hasattr(results, "as_dict") else results
+
+
+def junit_xml(results) -> str:
     """JUnit XML: one testsuite per requirement, one testcase per procedure x operating point.
 
     fail -> <failure>, not evaluated -> <error> for a mandatory requirement (the check could not
     be made) and <skipped> for an advisory one, open (no limit) -> <skipped>.
     """
+    results = _plain(results)
     suites = []
     tot = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0}
     for e in results["requirements"]:

@@ -67,7 +67,7 @@ def check_results(results, where: str = "results") -> None:
     for i, r in enumerate(runs):
         for k in _RUN_KEYS:
             _need(r, k, f"{where}: runs[{i}]")
-    from compliance.campaign.results_files import check_numbers
+    from compliance.results.numbers import check_numbers
 
     check_numbers(results, where)
 

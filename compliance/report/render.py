@@ -23,7 +23,7 @@ from pathlib import Path
 
 import jinja2
 
-from compliance import __version__
+from compliance.version import __version__
 from compliance.errors import InputError
 from compliance.files.atomic import write_bytes_atomic
 from compliance.files.display import display_path
@@ -210,6 +210,8 @@ def build_report(results: dict, workers: int | None = None, appendix: str = "sum
     """
     if appendix not in APPENDIX_LEVELS:
         raise InputError(f"--appendix {appendix}: expected one of {', '.join(APPENDIX_LEVELS)}")
+    if hasattr(results, "as_dict"):
+        results = results.as_dict()
     C.check_results(results)
     pages, specs = requirement_pages(results, 1)
     sections, run_specs = C.procedure_sections(results, len(specs) + 1) if appendix == "full" else ([], [])

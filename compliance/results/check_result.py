@@ -101,6 +101,11 @@ class CheckResult(Record):
         return super().from_dict(data, where).resolved()
 
     @classmethod
+    def of(cls, results: dict) -> "CheckResult":
+        """The typed form of a results dict this process just made (``campaign.run.assemble``): no file checks."""
+        return super().from_dict(results, "results").resolved()
+
+    @classmethod
     def from_json(cls, path) -> "CheckResult":
         """Read a results file written by ``govcheck check --json`` (or ``to_json``)."""
         from compliance.files.jsonable import read_json
@@ -124,6 +129,12 @@ class CheckResult(Record):
         from compliance.files.atomic import write_text_atomic
 
         write_text_atomic(path, self.json_text())
+
+    def made_reproducible(self, command_line: str | None = None) -> "CheckResult":
+        """This result as ``--reproducible`` writes it: fixed ``created``, no timings, ``command_line`` replaced."""
+        from compliance.files.reproducible import make_reproducible
+
+        return CheckResult.of(make_reproducible(self.as_dict(), command_line))
 
     # ------------------------------------------------------------------ steps
     def with_(self, **changes) -> "CheckResult":
