@@ -52,7 +52,7 @@ def __getattr__(name: str):
     """``compliance.check`` and ``compliance.CheckResult``, imported on first use (``import compliance`` stays light:
     every worker process imports the package)."""
     if name == "check":
-        from compliance.pipeline.check import check
+        from compliance.pipeline.chain import check
 
         return check
     if name == "CheckResult":

@@ -78,7 +78,7 @@ def _check_first(args) -> None:
     """Outputs, options and SOURCE_DATE_EPOCH checked before any work (exit 2)."""
     from compliance.cli.sweep import check_remedies_options
     from compliance.files.reproducible import fixed_created, is_reproducible
-    from compliance.pipeline.check import check_uncertainty
+    from compliance.pipeline.chain import check_uncertainty
 
     check_uncertainty(args.uncertainty)
     check_args_outputs(args, (getattr(args, "save_remedy", None), "--save-remedy", (".toml",)))
@@ -107,7 +107,7 @@ def run(args) -> int:
     from compliance.cli.progress import progress
     from compliance.cli.sweep import remedies_kwargs, save_remedy
     from compliance.files.reproducible import is_reproducible
-    from compliance.pipeline.check import Check
+    from compliance.pipeline.chain import Check
 
     _check_first(args)
     cfg = plant_from_args(args)

@@ -1,7 +1,7 @@
 """A requirement set vetted once, before any simulation: loosened limits and limits that cannot hold together.
 
 Both questions depend on the set and the plant's stroke only, so they are answered once per check
-(``compliance.pipeline.check``; ``run_campaign`` for a library caller), never again downstream:
+(``compliance.pipeline.chain``; ``run_campaign`` for a library caller), never again downstream:
 
 - every inherited requirement may only be tightened unless its file says ``allow_loosen``
   (:func:`compliance.requirements.tightening.check_tightening`); an allowed loosening is a note;

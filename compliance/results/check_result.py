@@ -1,6 +1,6 @@
 """The result of ``compliance.check``: one frozen, typed object that the terminal, the files, the gate and the report read.
 
-A result is made once (``compliance.pipeline.check``) or read back from its JSON
+A result is made once (``compliance.pipeline.chain``) or read back from its JSON
 (:meth:`CheckResult.from_json`); :meth:`CheckResult.as_dict` gives the JSON object of schema
 ``govcheck-results/1`` with the keys in the order the records declare, so a file read and written
 again is byte-identical. Steps that add to a result (bands, the linear analysis, remedies) return a
