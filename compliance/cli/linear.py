@@ -45,7 +45,8 @@ def register(subparsers):
                    help="load during the governor's large moves: a force, 'curve' or 'none' (default: the load curve)")
     add_outputs(p, "json", help={"json": "write everything as JSON to FILE.json"})
     p.add_argument("--governor-json", metavar="FILE.json", help="write only the HYGOV parameters as JSON (implies --governor)")
-    p.add_argument("--plot", metavar="FILE.png", help="write Bode, Nyquist, pole-zero and step plots (.png, .svg or .pdf)")
+    p.add_argument("--plot", metavar="FILE.png", help="write the report's figures of the analysis: Bode, closed-loop poles, the "
+                   "predicted step and, with --map, the time-constant map (.png, .svg or .pdf)")
     add_quiet(p, "print only the headline figures")
     add_reproducible(p)
     return p
@@ -159,62 +160,10 @@ def run(args) -> int:
 
 
 def _plot(a, path, omap=None) -> None:
-    """Bode (loop), Nyquist, closed-loop pole-zero map, predicted step and, with --map, the time-constant map."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    import numpy as np
-
-    d = a.data
-    fig, ax = plt.subplots(2, 3, figsize=(15, 8.5))
-    fhz = np.array(d["bode"]["frequency_hz"])
-    ax[0, 0].semilogx(fhz, d["bode"]["loop_discrete_magnitude_db"], label="loop L (sampled)")
-    ax[0, 0].semilogx(fhz, d["bode"]["closed_loop_magnitude_db"], label="closed loop T")
-    ax[0, 0].axhline(0, color="k", lw=0.5)
-    ax[0, 0].axhline(-3, color="k", lw=0.5, ls=":")
-    ax[0, 0].set(xlabel="frequency [Hz]", ylabel="magnitude [dB]", title="Bode magnitude")
-    ax[0, 0].legend()
-    ax[1, 0].semilogx(fhz, d["bode"]["loop_discrete_phase_deg"], label="loop L (sampled)")
-    ax[1, 0].semilogx(fhz, d["bode"]["closed_loop_phase_deg"], label="closed loop T")
-    ax[1, 0].axhline(-180, color="k", lw=0.5)
-    ax[1, 0].set(xlabel="frequency [Hz]", ylabel="phase [deg]", title="Bode phase")
-    re, im = np.array(d["nyquist"]["loop_real"]), np.array(d["nyquist"]["loop_imag"])
-    ax[0, 1].plot(re, im, label="L(jw)")
-    ax[0, 1].plot(re, -im, ls="--", lw=0.7)
-    ax[0, 1].plot([-1], [0], "r+", ms=12)
-    ax[0, 1].set(xlim=(-3, 1), ylim=(-3, 3), xlabel="Re", ylabel="Im", title="Nyquist (sampled loop)")
-    p = np.array(d["poles"]["closed_loop"])
-    z = np.array(d["poles"]["closed_loop_zeros"]).reshape(-1, 2)
-    ax[1, 1].plot(p[:, 0], p[:, 1], "x", label="closed-loop poles")
-    if z.size:
-        ax[1, 1].plot(z[:, 0], z[:, 1], "o", mfc="none", label="zeros")
-    pp = np.array(d["poles"]["plant_minimal"])
-    ax[1, 1].plot(pp[:, 0], pp[:, 1], "k.", label="plant poles")
-    ax[1, 1].set(xlabel="Re [1/s]", ylabel="Im [rad/s]", title="pole-zero map", xlim=(min(-50, p[:, 0].min() * 1.1 if p.size else -50), 5))
-    ax[1, 1].legend(fontsize=8)
-    ax[0, 2].plot(d["step"]["time"], np.array(d["step"]["position"]) * 1e3, label="sampled loop")
-    ax[0, 2].plot(d["step"]["time_continuous"], np.array(d["step"]["position_continuous"]) * 1e3, ls="--", label="continuous")
-    ax[0, 2].set(xlabel="time [s]", ylabel="position [mm]", title=f"predicted {abs(d['step']['size'])*1e3:.0f} mm step")
-    ax[0, 2].legend()
-    if omap is not None:
-        tau = np.array([[np.nan if v is None else v * 1e3 for v in row] for row in omap.values["time_constant"]])
-        im_ = ax[1, 2].imshow(tau, aspect="auto", origin="lower", cmap="viridis")
-        ax[1, 2].set_xticks(range(len(omap.positions)), [f"{100*x/omap.positions[-1]:.0f}" for x in omap.positions])
-        ax[1, 2].set_yticks(range(len(omap.loads)), ["none" if v is None else (v if isinstance(v, str) else f"{v/1e3:.1f}") for v in omap.loads])
-        ax[1, 2].set(xlabel="stroke [%]", ylabel="load [kN]", title="time constant [ms]")
-        fig.colorbar(im_, ax=ax[1, 2])
-    else:
-        ax[1, 2].axis("off")
-    fig.suptitle(f"{a.op.position*1e3:.1f} mm, load {a.op.load_force/1e3:.2f} kN: "
-                 f"tau {a.figures['time_constant']*1e3:.0f} ms" if a.figures["time_constant"] else "")
-    fig.tight_layout()
-    import io
-
+    """The report's figures of this analysis on one page (Bode, poles, predicted step; with --map the time-constant map)."""
     from compliance.files.atomic import write_bytes_atomic
+    from compliance.report.figures_linear import analysis_page
 
-    buf = io.BytesIO()
-    fmt = path.rsplit(".", 1)[-1].lower()
-    fig.savefig(buf, format=fmt, metadata={"Date": None} if fmt == "svg" else ({"CreationDate": None} if fmt == "pdf" else {}))
-    plt.close(fig)
-    write_bytes_atomic(path, buf.getvalue())
+    label = f"{a.op.position * 1e3:.1f} mm"
+    page = analysis_page(a.to_dict(), label, omap.to_dict() if omap is not None else None, fmt=path.rsplit(".", 1)[-1].lower())
+    write_bytes_atomic(path, page)

@@ -161,8 +161,8 @@ class Check:
             result = result.with_(linear=linear_analysis(cfg, reqset, jobs=jobs))
             _stage(on_stage, "linear analysis")
         if self.remedies:
-            rem = remedy_search(cfg, reqset, self.remedies, jobs=jobs, scheduler=scheduler, progress=progress,
-                                **(remedy_options or {}))
+            options = {"scheduler": scheduler, **(remedy_options or {})}  # the search's own scheduler, if given, wins
+            rem = remedy_search(cfg, reqset, self.remedies, jobs=jobs, progress=progress, **options)
             result = result.with_(remedies=rem)
             _stage(on_stage, "remedies")
         return result

@@ -63,16 +63,16 @@ def _typeset(text: str) -> str:
     return text.replace("<=", "\u2264").replace(">=", "\u2265")
 
 
-def limit_as_written(entry: dict, *, unicode: bool = True) -> str:
+def limit_as_written(entry, *, unicode: bool = True) -> str:
     """A requirement's limit as written, with the resolved value beside a limit relative to the stroke.
 
-    ``entry`` is a results file's requirement entry (``limit_text`` as written, ``limit_display``
-    resolved, ``limit`` SI or None when open): ``<= 1 %stroke (1.60 mm)``; in the report
-    ``≤ 1 % stroke (1.60 mm)`` and an open limit in words.
+    ``entry`` is a requirement's verdict (``limit_text`` as written, ``limit_display`` resolved,
+    ``limit`` SI or None when open): ``<= 1 %stroke (1.60 mm)``; in the report ``≤ 1 % stroke (1.60 mm)``
+    and an open limit in words.
     """
-    written, shown = entry.get("limit_text") or "", entry.get("limit_display") or ""
+    written, shown = entry.limit_text or "", entry.limit_display or ""
     if unicode:
-        if entry.get("limit") is None:
+        if entry.limit is None:
             return OPEN_LIMIT
         written, shown = _typeset(written).replace(" .. ", " \u2013 "), _typeset(shown)
     text = written or shown

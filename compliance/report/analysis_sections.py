@@ -33,25 +33,13 @@ def _op_label(a: dict) -> str:
     return f"{x * 1e3:.0f} mm, {load}" if isinstance(x, (int, float)) else "operating point"
 
 
-def _op_names(results: dict | None) -> list[tuple[str, float, object]]:
-    """The requirement file's operating points as (name, position [m], load: None | N | "curve")."""
-    if not results:
+def _op_names(result) -> list[tuple[str, float, object]]:
+    """The requirement file's operating points as (name, position [m], load: None | N | "curve"), from the result's
+    SI operating points (no position is read back from its text)."""
+    if result is None:
         return []
-    from compliance.units.amounts import parse_amount
-
-    params = {p.get("key"): p.get("value") for p in results["plant"].get("parameters") or [] if isinstance(p, dict)}
-    stroke = params.get("cylinder.stroke") or 0.0
-    out = []
-    for name, op in (results["requirement_set"].get("operating_points") or {}).items():
-        if op.get("initial_position") is None:
-            continue
-        try:
-            x = parse_amount(op["initial_position"], "m", name).resolve(stroke)
-        except Exception:  # noqa: BLE001 - a position the report cannot read names no point
-            continue
-        ld = op.get("load")
-        out.append((name, x, params.get("load.nominal_force") if ld == "nominal" else ld))
-    return out
+    return [(name, op.position, "curve" if op.on_curve else op.load_force)
+            for name, op in result.requirement_set.operating_points.items() if op.position is not None]
 
 
 def _same_load(a, b) -> bool:
@@ -60,9 +48,9 @@ def _same_load(a, b) -> bool:
     return abs(float(a) - float(b)) < 1.0
 
 
-def distinct_points(analyses: list, results: dict | None = None) -> list[tuple[str, dict]]:
+def distinct_points(analyses: list, result=None) -> list[tuple[str, dict]]:
     """The analyses at distinct (position, load) points, each labelled with the operating points it stands for."""
-    names = _op_names(results)
+    names = _op_names(result)
     out, seen = [], set()
     for a in analyses:
         op = a.get("operating_point") or {}
@@ -115,7 +103,7 @@ def _crosscheck_summary(rows: list[dict]) -> str:
         + (f"; {stalled} steps stall inside the valve dead zone and reach no 63.2 % point" if stalled else "") + ".")
 
 
-def linear_section(linear: dict | None, start: int, results: dict | None = None) -> tuple[dict | None, list[dict]]:
+def linear_section(linear, start: int, result=None) -> tuple[dict | None, list[dict]]:
     """Context of the linear-analysis section and its figure specs (ids from ``start``)."""
     if not linear:
         return None, []
@@ -129,7 +117,7 @@ def linear_section(linear: dict | None, start: int, results: dict | None = None)
         return fid
 
     analyses = list(linear.get("analyses") or ([linear["analysis"]] if linear.get("analysis") else []))
-    points_named = distinct_points(analyses, results)
+    points_named = distinct_points(analyses, result)
     labelled = [(f"P{k + 1} {label}", a) for k, (label, a, _) in enumerate(points_named)]  # keys as in the table
     maps = []
     omap = linear.get("map")
@@ -177,15 +165,14 @@ def linear_section(linear: dict | None, start: int, results: dict | None = None)
         rows = [{"name": k, "value": fmt_num(v, 4), "unit": units.get(k, "")} for k, v in params.items()]
         if g.get("Tg_linear") is not None:
             rows.append({"name": "Tg (linear)", "value": fmt_num(g["Tg_linear"], 4), "unit": "s"})
-        stroke = next((p.get("value") for p in ((results or {}).get("plant") or {}).get("parameters") or []
-                       if isinstance(p, dict) and p.get("key") == "cylinder.stroke"), None)
+        stroke = result.plant.stroke if result is not None else None
         per_unit = f" (1 pu = the full stroke, {stroke * 1e3:.0f} mm)" if isinstance(stroke, (int, float)) else ""
         intro = (f"{g.get('model', 'HYGOV')} is the hydro turbine-governor model of power-system simulation tools (IEEE PES "
                  "TR 2013, hydro turbine-governor models): Tg is its gate-servomotor time constant, VELM the gate velocity "
                  "limit, GMAX and GMIN the gate limits, UO and UC the opening and closing rate limits. Gate positions are "
                  f"per unit (pu) of the stroke and rates in pu/s, per unit of stroke per second{per_unit}.")
         gov = {"model": g.get("model", "HYGOV"), "rows": rows,
-               "basis": [intro] + governor_basis(g.get("basis") or {}, (results or {}).get("plant", {}).get("load_curve"))}
+               "basis": [intro] + governor_basis(g.get("basis") or {}, result.plant.load_curve if result is not None else None)}
     notes = list((omap or {}).get("notes") or [])
     ctx = {"maps": maps, "points": points, "bode": bode, "poles": poles, "crosscheck": cross, "crosscheck_summary": summary, "governor": gov,
            "notes": notes, "window": (omap or {}).get("window"), "criterion": criterion}
@@ -196,9 +183,9 @@ def _curve_force(curve, x):
     """Closing force of the load curve at position ``x`` [m] -> N (None without a curve)."""
     import numpy as np
 
-    if not curve or not isinstance(x, (int, float)):
+    if curve is None or not isinstance(x, (int, float)):
         return None
-    return float(np.interp(x, curve["position"], curve["force"]))
+    return float(np.interp(x, curve.position, curve.force))
 
 
 def governor_basis(b: dict, curve: dict | None = None) -> list[str]:

@@ -47,13 +47,20 @@ def map_figure(omap: dict, name: str, prefix: str) -> str:
     name : str
         Key of ``MAP_QUANTITIES``.
     """
-    label, unit, scale, wkey = MAP_QUANTITIES[name]
     fig, ax = new_figure("map")
+    if draw_map(fig, ax, omap, name):
+        fig.subplots_adjust(left=0.12, right=0.93, top=0.9, bottom=0.15)
+    return to_svg(fig, prefix)
+
+
+def draw_map(fig, ax, omap: dict, name: str) -> bool:
+    """Draw the map of quantity ``name`` on ``ax`` (see :func:`map_figure`); False when the map lacks it."""
+    label, unit, scale, wkey = MAP_QUANTITIES[name]
     vals = omap.get("values", {}).get(name)
     pos = np.asarray(omap.get("positions") or [], float)
     if not vals or pos.size == 0:
         message_axes(ax, f"{label}: not in the results")
-        return to_svg(fig, prefix)
+        return False
     z = np.array([[np.nan if v is None else v * scale for v in row] for row in vals], float)
     cmap = ListedColormap(["#f7fbff", "#deebf7", "#c6dbef", "#9ecae1", "#6baed6", "#4292c6", "#2171b5", "#08519c"])
     cmap.set_bad("#e0e0e0")
@@ -86,8 +93,7 @@ def map_figure(omap: dict, name: str, prefix: str) -> str:
     if win is not None:
         ax.plot([], [], "s", mfc="none", mec=COLORS["limit"], label=f"outside {win[0] * scale:g}\u2013{win[1] * scale:g} {unit}")
         ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=2, borderaxespad=0.2)
-    fig.subplots_adjust(left=0.12, right=0.93, top=0.9, bottom=0.15)
-    return to_svg(fig, prefix)
+    return True
 
 
 def _cell(j, i, color):
@@ -107,8 +113,14 @@ def bode_figure(analyses: list, prefix: str) -> str:
         ``loop_discrete_magnitude_db`` / ``loop_magnitude_db``, ``..._phase_deg``).
     """
     fig, (am, ap) = new_figure("bode", 2, 1, sharex=True, gridspec_kw={"hspace": 0.1})
+    if draw_bode(am, ap, analyses):
+        fig.subplots_adjust(left=0.1, right=0.985, top=0.9, bottom=0.12)
+    return to_svg(fig, prefix)
+
+
+def draw_bode(am, ap, analyses: list) -> int:
+    """Draw the loop's Bode magnitude on ``am`` and phase on ``ap`` per analysis (see :func:`bode_figure`); the count drawn."""
     shown = 0
-    palette = PALETTE
     for k, (label, a) in enumerate(analyses):
         b = a.get("bode") or {}
         f = b.get("frequency_hz")
@@ -116,7 +128,7 @@ def bode_figure(analyses: list, prefix: str) -> str:
         ph = b.get("loop_discrete_phase_deg") or b.get("loop_phase_deg")
         if not f or not mag:
             continue
-        c = palette[k % len(palette)]
+        c = PALETTE[k % len(PALETTE)]
         am.semilogx(f, mag, color=c, label=plain(label))
         if ph:
             ap.semilogx(f, ph, color=c)
@@ -127,33 +139,38 @@ def bode_figure(analyses: list, prefix: str) -> str:
     if not shown:
         message_axes(am, "no Bode data in the results")
         message_axes(ap, "")
-        return to_svg(fig, prefix)
+        return 0
     am.axhline(0.0, color="#333333", lw=0.6)
     ap.axhline(-180.0, color="#333333", lw=0.6)
     am.set_ylabel("|L| [dB]")
     ap.set_ylabel("phase [deg]")
     ap.set_xlabel("frequency [Hz]")
     am.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=4, borderaxespad=0.2)
-    fig.subplots_adjust(left=0.1, right=0.985, top=0.9, bottom=0.12)
-    return to_svg(fig, prefix)
+    return shown
 
 
 @styled
 def pole_figure(analyses: list, prefix: str) -> str:
     """Closed-loop poles (continuous) at each critical point, with the 0.25 s time-constant line."""
     fig, ax = new_figure("map")
-    palette = PALETTE
+    if draw_poles(ax, analyses):
+        fig.subplots_adjust(left=0.1, right=0.985, top=0.8, bottom=0.16)
+    return to_svg(fig, prefix)
+
+
+def draw_poles(ax, analyses: list) -> int:
+    """Draw the closed-loop poles per analysis on ``ax`` (see :func:`pole_figure`); the count drawn."""
     shown = 0
     for k, (label, a) in enumerate(analyses):
         poles = (a.get("poles") or {}).get("closed_loop")
         if not poles:
             continue
         p = np.asarray(poles, float).reshape(-1, 2)
-        ax.plot(p[:, 0], p[:, 1], "x", ms=5, mew=1.2, color=palette[k % len(palette)], label=plain(label))
+        ax.plot(p[:, 0], p[:, 1], "x", ms=5, mew=1.2, color=PALETTE[k % len(PALETTE)], label=plain(label))
         shown += 1
     if not shown:
         message_axes(ax, "no pole data in the results")
-        return to_svg(fig, prefix)
+        return 0
     ax.set_xscale("symlog", linthresh=10.0)
     ax.set_yscale("symlog", linthresh=10.0)
     for tau, ls in ((0.25, (0, (4, 2))), (0.10, ":")):
@@ -162,5 +179,47 @@ def pole_figure(analyses: list, prefix: str) -> str:
     ax.set_xlabel("real part [1/s] (symmetric log)")
     ax.set_ylabel("imaginary part [rad/s]")
     ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=3, borderaxespad=0.2)
-    fig.subplots_adjust(left=0.1, right=0.985, top=0.8, bottom=0.16)
-    return to_svg(fig, prefix)
+    return shown
+
+
+def _draw_step(ax, analysis: dict) -> None:
+    """The predicted step of the linear loop (sampled and continuous) [mm against s]."""
+    st = analysis.get("step") or {}
+    if not st.get("time"):
+        message_axes(ax, "no predicted step in the analysis")
+        return
+    ax.plot(st["time"], np.asarray(st["position"], float) * 1e3, color=COLORS["position"], label="sampled loop")
+    if st.get("time_continuous"):
+        ax.plot(st["time_continuous"], np.asarray(st["position_continuous"], float) * 1e3, color=COLORS["reference"],
+                ls=(0, (4, 2)), label="continuous")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("position [mm]")
+    ax.set_title(f"predicted {abs(st.get('size') or 0.0) * 1e3:.0f} mm step")
+    ax.legend(loc="lower right")
+
+
+@styled
+def analysis_page(analysis: dict, label: str, omap: dict | None = None, fmt: str = "png") -> bytes:
+    """One linear analysis on one page in the report's figures (``govcheck linear --plot``): the loop's Bode
+    diagram, the closed-loop poles, the predicted step and, with a map, the time-constant map; bytes of ``fmt``
+    (png, svg or pdf, without a date so the same analysis gives the same file)."""
+    import io
+
+    from matplotlib.figure import Figure
+
+    from compliance.report.svg import HEIGHTS_IN, WIDTH_IN
+
+    rows = 3 if omap else 2
+    fig = Figure(figsize=(WIDTH_IN, HEIGHTS_IN["bode"] + HEIGHTS_IN["map"] * (rows - 1)))
+    grid = fig.add_gridspec(rows + 1, 2, height_ratios=[1.0, 1.0] + [1.6] * (rows - 1), hspace=0.55, wspace=0.3)
+    am, ap = fig.add_subplot(grid[0, :]), None
+    ap = fig.add_subplot(grid[1, :], sharex=am)
+    draw_bode(am, ap, [(label, analysis)])
+    draw_poles(fig.add_subplot(grid[2, 0]), [(label, analysis)])
+    _draw_step(fig.add_subplot(grid[2, 1]), analysis)
+    if omap:
+        draw_map(fig, fig.add_subplot(grid[3, :]), omap, "time_constant")
+    buf = io.BytesIO()
+    meta = {"svg": {"Date": None}, "pdf": {"CreationDate": None}}.get(fmt, {})
+    fig.savefig(buf, format=fmt, metadata=meta, bbox_inches="tight", pad_inches=0.05)
+    return buf.getvalue()

@@ -34,13 +34,6 @@ class Coverage(Record):
     unjudged: tuple[Unjudged, ...] = key(default=(), read=records(Unjudged))
 
 
-def _schema(v, where):
-    if v != RESULTS_SCHEMA:
-        raise InputError(f"{where}: '{v}' is not supported; this govcheck reads '{RESULTS_SCHEMA}' "
-                         "(re-run 'govcheck check' to regenerate the results)")
-    return v
-
-
 def _section(v, where):
     return freeze(need(v, where))
 
@@ -63,7 +56,7 @@ class CheckResult(Record):
         Sections kept as their steps wrote them.
     """
 
-    schema: str = key(default=RESULTS_SCHEMA, read=_schema)
+    schema: str = key(default=RESULTS_SCHEMA)
     created: str | None = key(default=None)
     command_line: str | None = key(default=None)
     versions: FrozenDict = key(factory=FrozenDict)
@@ -78,6 +71,7 @@ class CheckResult(Record):
     timing: Timing | None = key(omit_none=True, default=None, read=Timing.from_dict)
     linear: FrozenDict | None = key(omit_none=True, default=None, read=_section)
     sweep: FrozenDict | None = key(omit_none=True, default=None, read=_section)
+    sizing: FrozenDict | None = key(omit_none=True, default=None, read=_section)
     remedies: FrozenDict | None = key(omit_none=True, default=None, read=_section)
     tolerance_yield: FrozenDict | None = key(omit_none=True, default=None, read=_section)
     validation: FrozenDict | None = key(omit_none=True, default=None, read=_section)
@@ -97,6 +91,9 @@ class CheckResult(Record):
         need(data, where)
         if "schema" not in data:
             raise InputError(f"{where}: key 'schema' is missing (expected a govcheck results file, schema '{RESULTS_SCHEMA}')")
+        if data["schema"] != RESULTS_SCHEMA:
+            raise InputError(f"{where}: key 'schema' is '{data['schema']}'; this govcheck reads '{RESULTS_SCHEMA}' "
+                             "(re-run 'govcheck check' to regenerate the results)")
         check_numbers(data, where)
         return super().from_dict(data, where).resolved()
 
@@ -139,7 +136,7 @@ class CheckResult(Record):
     # ------------------------------------------------------------------ steps
     def with_(self, **changes) -> "CheckResult":
         """A new result with some sections replaced (a step's output; JSON sections are frozen)."""
-        sections = {"uncertainty", "linear", "sweep", "remedies", "tolerance_yield", "validation", "versions"}
+        sections = {"uncertainty", "linear", "sweep", "sizing", "remedies", "tolerance_yield", "validation", "versions"}
         return replace(self, **{k: freeze(v) if k in sections and v is not None else v for k, v in changes.items()})
 
     # ------------------------------------------------------------------ questions

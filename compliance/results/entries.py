@@ -63,6 +63,10 @@ class RequirementVerdict(Record):
     band: Band | None = key(omit_none=True, default=None, read=Band.from_dict)
     status_note: str | None = key(omit_none=True, default=None)
 
+    def __post_init__(self):
+        if self.request_key is None:  # a results file of an older govcheck: the metric with the default options
+            object.__setattr__(self, "request_key", RequestKey(self.metric))
+
     @property
     def judged_rows(self) -> tuple[VerdictRow, ...]:
         """The rows whose value was judged against the limit."""

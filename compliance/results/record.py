@@ -139,8 +139,8 @@ def from_dict(cls, data, where: str = "results"):
         known.add(k)
         if k not in data:
             if f.default is _NO and f.default_factory is _NO:
-                raise InputError(f"{where}: key '{k}' is missing (expected a govcheck results file, schema "
-                                 "'govcheck-results/1')")
+                raise InputError(f"{where}: key '{k}' is missing from the results file (expected a govcheck results "
+                                 "file, schema 'govcheck-results/1')")
             continue
         v = data[k]
         read = f.metadata.get("read")

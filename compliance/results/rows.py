@@ -22,7 +22,7 @@ class SampleRecord(Record):
 
     label: str = key()
     value: float | None = key()
-    display: str = key()
+    display: str | None = key(default=None)
     eligible: bool = key(default=True)
     reason: str | None = key(default=None)
     detail: FrozenDict = key(factory=FrozenDict)
