@@ -16,9 +16,10 @@ from pathlib import Path
 PACKAGE = Path(__file__).resolve().parents[1] / "compliance"
 
 # bottom first: a package may import from itself and from packages before it in this list
-LAYERS = ["version", "errors", "processes", "units", "files", "physics", "effects", "model", "simulation", "metrics", "linear",
-          "tracking", "procedures", "requirements", "presentation", "results", "campaign", "sweep", "recordings",
-          "validation", "characterise", "diagnosis", "report", "papers", "pipeline", "cli", "__main__"]
+LAYERS = ["version", "errors", "processes", "units", "files", "physics", "effects", "model", "simulation", "metrics",
+          "linear", "tracking", "procedures", "requirements", "presentation", "results", "campaign", "sweep",
+          "recordings", "validation", "characterise", "diagnosis", "acceptance", "report", "papers", "pipeline", "cli",
+          "__main__"]
 
 
 def _modules() -> dict[str, Path]:

@@ -34,7 +34,7 @@ def not_evaluated_reason(entry: RequirementVerdict | None) -> str | None:
     """Why a requirement could not be evaluated (the distinct reasons of its rows), or None."""
     if entry is None or entry.status != Status.NOT_EVALUATED:
         return None
-    return "; ".join(entry.not_evaluated_reasons()) or "no reason recorded"
+    return "; ".join(entry.not_evaluated_reasons() or ([entry.reason] if entry.reason else [])) or "no reason recorded"
 
 
 def _status_reasons(rid: str, b, c, why: str | None, allowed: bool):
@@ -54,19 +54,25 @@ def _status_reasons(rid: str, b, c, why: str | None, allowed: bool):
     return [], None
 
 
-def _side(result: CheckResult) -> dict:
+def _subject(result) -> dict:
+    """What a result judged: a plant configuration, or a site's recordings (``govcheck accept``)."""
+    site = getattr(result, "site", None)
+    if site is not None:
+        return {"plant": f"site {site['name']}", "digest": site.get("digest"), "path": site.get("path"),
+                "verdict": result.summary.status}
     p = result.plant
     return {"plant": p.name, "digest": p.digest, "path": p.path, "verdict": result.summary.status}
 
 
-def compare(baseline: CheckResult, candidate: CheckResult, max_margin_loss: float | None = None,
+def compare(baseline, candidate, max_margin_loss: float | None = None,
             allow_not_evaluated: tuple[str, ...] | list[str] = ()) -> dict:
     """Compare two check results.
 
     Parameters
     ----------
-    baseline, candidate : CheckResult
-        Results of ``govcheck check`` (``compliance.check``, or a results file read with ``CheckResult.from_json``).
+    baseline, candidate : CheckResult or SiteResult
+        Results of ``govcheck check`` (``compliance.check``, or a results file read with ``read_results``) or of
+        ``govcheck accept`` (schema govcheck-site/1: a re-commissioning gated against the last one).
     max_margin_loss : float, optional
         Largest allowed loss of worst-case margin [percentage points]; None: not checked.
     allow_not_evaluated : sequence of str
@@ -109,12 +115,13 @@ def compare(baseline: CheckResult, candidate: CheckResult, max_margin_loss: floa
         })
     return {
         "schema": "govcheck-gate/1",
+        "subject": "site" if "site" in candidate else "plant",
         "status": Overall.FAIL if tripped else Overall.PASS,
         "tripped": tripped,
         "max_margin_loss": max_margin_loss,
         "allow_not_evaluated": sorted(allowed),
-        "baseline": _side(baseline),
-        "candidate": _side(candidate),
+        "baseline": _subject(baseline),
+        "candidate": _subject(candidate),
         "requirements": {"name": cset.name, "path": cset.path, "digest": cset.digest},
         "rows": rows,
         "notes": notes,

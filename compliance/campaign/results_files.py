@@ -7,25 +7,42 @@ then ``os.replace``) so a CI job never reads half a file.
 
 from __future__ import annotations
 
+from pathlib import Path
 from xml.sax.saxutils import escape, quoteattr
 
 from compliance.campaign.coverage import CASES_BASIS, case_coverage_text
 from compliance.files.atomic import write_text_atomic
+from compliance.files.jsonable import json_text, read_json
 from compliance.requirements.verdict import Basis, Severity, Status
 from compliance.presentation.values import limit_as_written
 from compliance.results.check_result import CheckResult
 from compliance.results.rows import RowTexts, VerdictRow, WorstCase
+from compliance.results.site_result import SITE_SCHEMA, typed_results
 from compliance.units.formatting import STATUS_WORD as _STATUS_WORD  # the one status-word table
 
-def read_results(path) -> CheckResult:
-    """Read a results JSON written by ``govcheck check`` (``CheckResult.from_json``).
+__all__ = ["SITE_SCHEMA", "junit_xml", "read_results", "results_json", "summary_lines", "summary_table", "write_json",
+           "write_junit"]
+
+
+def results_json(results: dict) -> str:
+    """Serialise a results dict (a site's, ``govcheck accept``) with the one JSON cleaner (non-finite numbers become null)."""
+    return json_text(results, compact=True)  # compact: the traces make up most of the file; tools, not people, read it
+
+
+def write_json(results: dict, path) -> None:
+    """Write a results dict's JSON atomically (a check's result writes itself: ``CheckResult.to_json``)."""
+    write_text_atomic(path, results_json(results))
+
+
+def read_results(path):
+    """Read a results JSON written by ``govcheck check`` (a ``CheckResult``) or by ``govcheck accept`` (a ``SiteResult``).
 
     Raises
     ------
     InputError
         Not JSON, not a govcheck results file of a supported schema, or a damaged one (the key named).
     """
-    return CheckResult.from_json(path)
+    return typed_results(read_json(Path(path), "results"), str(path))
 
 
 # --------------------------------------------------------------------------- terminal
@@ -142,12 +159,14 @@ def _case(e, r) -> tuple[str, str]:
     return kind, body + f"<system-out>{escape(msg)}</system-out>"
 
 
-def junit_xml(result: CheckResult) -> str:
+def junit_xml(result) -> str:
     """JUnit XML: one testsuite per requirement, one testcase per procedure x operating point.
 
     fail -> <failure>, not evaluated -> <error> for a mandatory requirement (the check could not
-    be made) and <skipped> for an advisory one, open (no limit) -> <skipped>.
+    be made) and <skipped> for an advisory one, open (no limit) -> <skipped>. ``result``: a ``CheckResult``,
+    a ``SiteResult``, or a site's results dict (read at this edge).
     """
+    result = typed_results(result) if isinstance(result, dict) else result
     suites = []
     tot = {"tests": 0, "failures": 0, "errors": 0, "skipped": 0}
     for e in result.requirements:
@@ -167,7 +186,7 @@ def junit_xml(result: CheckResult) -> str:
             f'errors="{cnt["errors"]}" skipped="{cnt["skipped"]}">\n' + "\n".join(cases) + "\n  </testsuite>"
         )
     name = f"govcheck {result.plant.name} vs {result.requirement_set.name}"
-    wall = result.timing.wall if result.timing is not None else 0
+    wall = result.wall
     return (
         '<?xml version="1.0" encoding="UTF-8"?>\n'
         f'<testsuites name={quoteattr(name)} tests="{tot["tests"]}" failures="{tot["failures"]}" errors="{tot["errors"]}" '
@@ -175,6 +194,6 @@ def junit_xml(result: CheckResult) -> str:
     )
 
 
-def write_junit(result: CheckResult, path) -> None:
+def write_junit(result, path) -> None:
     """Write the JUnit XML atomically."""
     write_text_atomic(path, junit_xml(result))

@@ -50,11 +50,14 @@ __all__ = [
     "plant_section",
     "run_campaign",
     "run_records",
+    "summary_section",
+    "versions_section",
 ]
 
 
 # --------------------------------------------------------------------------- results
-def _versions() -> dict:
+def versions_section() -> dict:
+    """Versions of govcheck, Python and the numerical packages (a results file's ``versions``)."""
     out = {"govcheck": __version__, "python": platform.python_version()}
     for mod in ("numpy", "scipy", "pandas", "numba", "control", "pint", "pydantic"):
         try:
@@ -203,7 +206,7 @@ def assemble(cfg, reqset: RequirementSet, runs: CampaignRuns, entries: list[dict
         "schema": RESULTS_SCHEMA,
         "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         "command_line": command_line,
-        "versions": _versions(),
+        "versions": versions_section(),
         "plant": plant_section(cfg),
         "requirement_set": reqset.as_dict(),
         "summary": summary_section(entries, notes, bands),

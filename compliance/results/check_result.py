@@ -151,6 +151,11 @@ class CheckResult(Record):
         return self.summary.status == Overall.PASS
 
     @property
+    def wall(self) -> float:
+        """Wall time of the check [s] (0 in a reproducible result)."""
+        return self.timing.wall if self.timing is not None else 0.0
+
+    @property
     def verdicts(self) -> dict[str, RequirementVerdict]:
         """Requirement id -> its verdict."""
         return {e.id: e for e in self.requirements}

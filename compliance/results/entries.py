@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 from compliance.requirements.verdict import Basis, Severity, Status
 from compliance.results.keys import RequestKey
-from compliance.results.record import Record, enum_of, key, records, tuple_of
+from compliance.results.record import FrozenDict, Record, enum_of, key, records, tuple_of
 from compliance.results.rows import Band, VerdictRow, WorstCase
 
 __all__ = ["EntryCoverage", "RequirementVerdict"]
@@ -29,6 +29,7 @@ class EntryCoverage(Record):
     evaluated: int = key(default=0)
     excluded: int | None = key(omit_none=True, default=None)
     extended: int = key(default=0)
+    extra: FrozenDict = key(factory=FrozenDict)  # a site's cases asked, tested, not tested, complete
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -62,6 +63,8 @@ class RequirementVerdict(Record):
     loosened: tuple[str, ...] = key(default=(), read=tuple_of(str))
     band: Band | None = key(omit_none=True, default=None, read=Band.from_dict)
     status_note: str | None = key(omit_none=True, default=None)
+    reason: str | None = key(omit_none=True, default=None)  # why a site could not judge it at all
+    extra: FrozenDict = key(factory=FrozenDict)  # keys a site's measured verdict adds (measured_metric, prediction)
 
     def __post_init__(self):
         if self.request_key is None:  # a results file of an older govcheck: the metric with the default options

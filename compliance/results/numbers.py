@@ -28,7 +28,7 @@ def check_numbers(data: dict, where: str) -> None:
     InputError
         The results file is damaged or hand-edited.
     """
-    for key in ("requirements", "runs", "timing", "linear", "plant"):
+    for key in ("requirements", "runs", "timing", "linear", "plant", "site"):
         _check_numbers(data.get(key), f"{where}: {key}")
 
 

@@ -26,6 +26,7 @@ class SampleRecord(Record):
     eligible: bool = key(default=True)
     reason: str | None = key(default=None)
     detail: FrozenDict = key(factory=FrozenDict)
+    extra: FrozenDict = key(factory=FrozenDict)  # keys a site's measured value adds (recording, u, budget)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -82,6 +83,7 @@ class VerdictRow(Record):
     display: RowTexts = key(factory=RowTexts, read=RowTexts.from_dict)
     band: Band | None = key(omit_none=True, default=None, read=Band.from_dict)
     status_note: str | None = key(omit_none=True, default=None)
+    extra: FrozenDict = key(factory=FrozenDict)  # keys a site's measured row adds (departures, u)
 
     @property
     def judged(self) -> bool:
@@ -106,3 +108,4 @@ class WorstCase(Record):
     basis_reason: str | None = key(default=None)
     non_responding: tuple[str, ...] | None = key(default=None, read=tuple_of(str))
     band: Band | None = key(omit_none=True, default=None, read=Band.from_dict)
+    extra: FrozenDict = key(factory=FrozenDict)

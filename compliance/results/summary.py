@@ -84,3 +84,4 @@ class Summary(Record):
     top_assumptions: tuple[TopAssumption, ...] = key(default=(), read=records(TopAssumption))
     notes: tuple[str, ...] = key(default=(), read=tuple_of(str))
     qualifiers: tuple[Qualifier, ...] = key("qualifier", default=(), read=_qualifiers, write=_qualifier_text)
+    extra: FrozenDict = key(factory=FrozenDict)  # a site's partial requirements and agreement with the model
