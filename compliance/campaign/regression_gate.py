@@ -19,7 +19,7 @@ from __future__ import annotations
 from compliance.requirements.verdict import Overall, Severity, Status
 from compliance.results.check_result import CheckResult
 from compliance.results.entries import RequirementVerdict
-from compliance.units.formatting import STATUS_WORD as _STATUS_WORD
+from compliance.presentation.numbers import STATUS_WORD as _STATUS_WORD
 
 
 def _worst(entry: RequirementVerdict | None):
@@ -115,7 +115,7 @@ def compare(baseline, candidate, max_margin_loss: float | None = None,
         })
     return {
         "schema": "govcheck-gate/1",
-        "subject": "site" if "site" in candidate else "plant",
+        "subject": "site" if getattr(candidate, "site", None) is not None else "plant",
         "status": Overall.FAIL if tripped else Overall.PASS,
         "tripped": tripped,
         "max_margin_loss": max_margin_loss,

@@ -18,7 +18,7 @@ from compliance.presentation.values import limit_as_written
 from compliance.results.check_result import CheckResult
 from compliance.results.rows import RowTexts, VerdictRow, WorstCase
 from compliance.results.site_result import SITE_SCHEMA, typed_results
-from compliance.units.formatting import STATUS_WORD as _STATUS_WORD  # the one status-word table
+from compliance.presentation.numbers import STATUS_WORD as _STATUS_WORD  # the one status-word table
 
 __all__ = ["SITE_SCHEMA", "junit_xml", "read_results", "results_json", "summary_lines", "summary_table", "write_json",
            "write_junit"]

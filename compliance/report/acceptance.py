@@ -12,10 +12,11 @@ from __future__ import annotations
 
 from compliance.metrics import METRICS
 from compliance.metrics.catalogue import STEP_OPTION_DEFAULTS
+from compliance.presentation.quantities import fmt_quantity
 from compliance.presentation.values import limit_as_written, metric_text
 from compliance.requirements.verdict import Status
 from compliance.results.check_result import CheckResult
-from compliance.units.formatting import fmt_value, unit_text
+from compliance.presentation.numbers import fmt_value, unit_text
 
 # The plant paper as its own text gives it (title, laboratory, university); the copy used names no
 # authors, venue or year, so the citation says so instead of guessing them.
@@ -101,7 +102,7 @@ def scope(result: CheckResult) -> dict:
 def _position_text(op) -> str:
     """An operating point's SI position (resolved when the result was made) in mm; as written when unresolved."""
     if op.position is not None:
-        return fmt_value(op.position * 1e3, "mm", 3)
+        return fmt_quantity(op.position, "m", "mm")
     return unit_text(op.initial_position) if op.initial_position is not None else "\u2013"
 
 
@@ -111,9 +112,9 @@ def _load_text(op, curve_assumed: bool) -> str:
     if op.on_curve:
         return "gate load curve (assumed)" if curve_assumed else "gate load curve"
     if op.load == "nominal":
-        return f"nominal, {fmt_value(op.load_force / 1e3, 'kN', 3)}" if op.load_force is not None else "nominal"
+        return f"nominal, {fmt_quantity(op.load_force, 'N', 'kN')}" if op.load_force is not None else "nominal"
     if op.load_force is not None:
-        return fmt_value(op.load_force / 1e3, "kN", 3) + (" closing" if op.load_force > 0 else " opening" if op.load_force < 0 else "")
+        return fmt_quantity(op.load_force, "N", "kN") + (" closing" if op.load_force > 0 else " opening" if op.load_force < 0 else "")
     return str(op.load_text or op.load)
 
 
@@ -121,10 +122,6 @@ def _throttles(flag, configured: bool) -> str:
     if flag is None:
         return "in" if configured else "out"
     return "in" if flag else "out"
-
-
-def _measured(value, scale: float, unit: str, digits: int = 3, suffix: str = "") -> str:
-    return fmt_value(value * scale, unit, digits) + suffix if isinstance(value, (int, float)) else "\u2013"
 
 
 def conditions(result: CheckResult) -> dict:
@@ -140,11 +137,10 @@ def conditions(result: CheckResult) -> dict:
         fc = p.settings.get("flow_control")
         if fc is not None:
             procs.append(f"{name}: flow-control valves {'in' if fc else 'out'} whatever the operating point says")
-    temperature = plant.value("air.supply_temperature")
     return {
-        "supply": _measured(plant.value("air.supply_pressure"), 1e-5, "bar", 3, " abs"),
-        "temperature": fmt_value(temperature - 273.15, "\u00b0C", 3) if isinstance(temperature, (int, float)) else "\u2013",
-        "atmosphere": _measured(plant.value("air.atmospheric_pressure"), 1e-5, "bar", 4, " abs"),
+        "supply": fmt_quantity(plant.value("air.supply_pressure"), "Pa", "bar", suffix=" abs"),
+        "temperature": fmt_quantity(plant.value("air.supply_temperature"), "K", "\u00b0C"),
+        "atmosphere": fmt_quantity(plant.value("air.atmospheric_pressure"), "Pa", "bar", digits=4, suffix=" abs"),
         "throttles_configured": "in" if configured else "out",
         "operating_points": rows, "procedure_circuits": procs,
         "curve_assumed": curve_assumed,
@@ -158,13 +154,13 @@ def method_rows(result: CheckResult) -> list[dict]:
                                            "no uncertainty of measurement)"}]
     if isinstance(value("simulation.step"), (int, float)):
         rows.append({"item": "Solver", "how": f"fixed-step fourth-order Runge\u2013Kutta, step "
-                                              f"{_measured(value('simulation.step'), 1e3, 'ms')}"})
+                                              f"{fmt_quantity(value('simulation.step'), 's', 'ms')}"})
     ts = value("controller.sample_time")
     if isinstance(ts, (int, float)):
-        rows.append({"item": "Controller and recording", "how": f"sampled every {_measured(ts, 1e3, 'ms')} "
-                                                                 f"({fmt_value(1 / ts, 'Hz', 3)}), zero-order hold on the valve command"})
+        rows.append({"item": "Controller and recording", "how": f"sampled every {fmt_quantity(ts, 's', 'ms')} "
+                                                                 f"({fmt_quantity(1 / ts, 'Hz', 'Hz')}), zero-order hold on the valve command"})
     if value("controller.filter_cutoff"):
-        rows.append({"item": "Position filter", "how": f"first order, cut-off {_measured(value('controller.filter_cutoff'), 1, 'Hz')}"})
+        rows.append({"item": "Position filter", "how": f"first order, cut-off {fmt_quantity(value('controller.filter_cutoff'), 'Hz', 'Hz')}"})
     used = list(dict.fromkeys(e.metric for e in result.requirements))
     for m in used:
         info = METRICS.get(m)

@@ -1,15 +1,16 @@
 """Optional report sections: linear analysis and model validation (what exists is shown).
 
 Linear data is the document ``govcheck linear --json`` writes (schema ``govcheck-linear/1``:
-``analysis`` or ``analyses``, ``map``, ``crosscheck``, ``governor``), found in a results dict
-under ``linear``. Validation data is ``compliance.validation.validate.validate`` output (schema
+``analysis`` or ``analyses``, ``map``, ``crosscheck``, ``governor``), read from a check's result as
+records (``CheckResult.linear_section``). Validation data is ``compliance.validation.validate.validate`` output (schema
 ``govcheck.validation/1``), optionally with a ``diagnosis`` entry (``after`` overlays and the
 physics added with its fitted parameters). Missing parts are reported as "not run".
 """
 
 from __future__ import annotations
 
-from compliance.units.formatting import fmt_num, fmt_value, unit_text as pretty_unit
+from compliance.presentation.quantities import fmt_quantity
+from compliance.presentation.numbers import fmt_num, fmt_value, unit_text as pretty_unit
 from compliance.report.figures_linear import MAP_QUANTITIES
 from compliance.diagnosis.verdicts.verdict import EXPLAINED
 
@@ -22,15 +23,22 @@ SIGNAL_DISPLAY = {  # signal -> (label, unit shown, scale from SI)
 }
 
 
-def _op_label(a: dict) -> str:
-    op = a.get("operating_point") or {}
-    if a.get("label"):
-        return str(a["label"])
-    x = op.get("position")
-    ld = op.get("load")
-    load = "no load" if ld is None else (f"load curve, {(op.get('load_force') or 0) / 1e3:.1f} kN" if isinstance(ld, str)
-                                          else f"{ld / 1e3:+.1f} kN")
-    return f"{x * 1e3:.0f} mm, {load}" if isinstance(x, (int, float)) else "operating point"
+def _load_words(load, force=None) -> str:
+    """A linear point's load in words: none, the load curve (with its force there) or a constant force."""
+    if load is None:
+        return "no load"
+    if isinstance(load, str):
+        return f"load curve, {fmt_quantity(force or 0.0, 'N', 'kN', 1)}"
+    return fmt_quantity(load, "N", "kN", 1, signed=True)
+
+
+def _op_label(a) -> str:
+    if a.label:
+        return str(a.label)
+    op = a.operating_point
+    if not isinstance(op.position, (int, float)):
+        return "operating point"
+    return f"{fmt_quantity(op.position, 'm', 'mm', 0)}, {_load_words(op.load, op.load_force)}"
 
 
 def _op_names(result) -> list[tuple[str, float, object]]:
@@ -48,64 +56,80 @@ def _same_load(a, b) -> bool:
     return abs(float(a) - float(b)) < 1.0
 
 
-def distinct_points(analyses: list, result=None) -> list[tuple[str, dict]]:
+def distinct_points(analyses, result=None) -> list[tuple[str, object, list]]:
     """The analyses at distinct (position, load) points, each labelled with the operating points it stands for."""
     names = _op_names(result)
     out, seen = [], set()
     for a in analyses:
-        op = a.get("operating_point") or {}
-        x, ld = op.get("position"), op.get("load")
-        key = (round(x, 6) if isinstance(x, (int, float)) else None, ld if isinstance(ld, str) or ld is None else round(ld, 1))
-        if key in seen:
+        if a.point_key in seen:
             continue
-        seen.add(key)
+        seen.add(a.point_key)
+        x, ld = a.operating_point.position, a.operating_point.load
         which = [n for n, nx, nl in names if isinstance(x, (int, float)) and abs(nx - x) < 1e-6 and _same_load(nl, ld)]
-        label = _op_label(a)
-        out.append((label, a, which))
+        out.append((_op_label(a), a, which))
     return out
 
 
-def _stability(f: dict) -> str:
+def _stability(f) -> str:
     """Against the stated margin criterion (MARGIN_CRITERION, our choice): meets / below / unstable / unknown."""
     from compliance.report.acceptance import MARGIN_CRITERION
 
-    if f.get("stable") is False:
+    if f.stable is False:
         return "unstable"
-    pm, gm = f.get("phase_margin_deg"), f.get("gain_margin_db")
-    if f.get("stable") is None or pm is None or gm is None:
+    if f.stable is None or f.phase_margin_deg is None or f.gain_margin_db is None:
         return "unknown"
-    ok = pm >= MARGIN_CRITERION["phase_margin_deg"] and gm >= MARGIN_CRITERION["gain_margin_db"]
+    ok = f.phase_margin_deg >= MARGIN_CRITERION["phase_margin_deg"] and f.gain_margin_db >= MARGIN_CRITERION["gain_margin_db"]
     return "meets" if ok else "below"
 
 
-def _map_minimum(omap: dict | None, name: str):
-    """Smallest value of a map quantity and where (position [m], load label)."""
-    vals = ((omap or {}).get("values") or {}).get(name)
-    if not vals:
-        return None
-    best = None
-    loads = omap.get("loads") or [None] * len(vals)
-    for i, row in enumerate(vals):
-        for j, v in enumerate(row):
-            if isinstance(v, (int, float)) and (best is None or v < best[0]):
-                best = (v, omap["positions"][j], loads[i])
-    return best
-
-
-def _crosscheck_summary(rows: list[dict]) -> str:
+def _crosscheck_summary(rows) -> str:
     """One sentence on the linear vs nonlinear cross-check (the table itself goes to the appendix)."""
-    done = [r for r in rows if "skipped" not in r]
-    ratios = [r["ratio"] for r in done if r.get("ratio") is not None]
-    stalled = sum(1 for r in done if r.get("tau_linear") is not None and r.get("tau_nonlinear") is None)
+    done = [r for r in rows if r.skipped is None]
+    ratios = [r.ratio for r in done if r.ratio is not None]
+    stalled = sum(1 for r in done if r.tau_linear is not None and r.tau_nonlinear is None)
     return (f"{len(done)} small steps were simulated with the nonlinear model at the critical points" + (
         f": where the servo completes the step its time constant is {fmt_num(min(ratios), 3)} to {fmt_num(max(ratios), 3)}"
         " times the linear one (friction and the valve dead zone, which the linear model leaves out)" if ratios else "")
         + (f"; {stalled} steps stall inside the valve dead zone and reach no 63.2 % point" if stalled else "") + ".")
 
 
+def _point_row(k: int, label: str, a, which) -> dict:
+    f = a.figures
+    return {"key": f"P{k + 1}", "label": label, "names": which, "time_constant": _ms(f.time_constant),
+            "gain_margin": fmt_num(f.gain_margin_db, 3), "phase_margin": fmt_num(f.phase_margin_deg, 3),
+            "bandwidth": fmt_num(f.bandwidth_hz, 3), "damping": fmt_num(f.damping_ratio, 3),
+            "natural_frequency": fmt_num(f.natural_frequency_hz, 3), "stable": f.stable, "stability": _stability(f)}
+
+
+def _cross_row(r) -> dict:
+    if r.skipped is not None:
+        return {"position": _mm(r.position), "load": _load(r.load), "skipped": r.skipped}
+    return {"position": _mm(r.position), "load": _load(r.load, r.load_force),
+            "step": fmt_quantity(r.step, "", "%", 0, signed=True) if r.step is not None else "\u2013",
+            "tau_linear": _ms(r.tau_linear), "tau_nonlinear": _ms(r.tau_nonlinear, "stalled"), "ratio": fmt_num(r.ratio, 3),
+            "steady_error": _mm(r.steady_error, 2), "why": r.why or "agrees within 20 %"}
+
+
+def _governor(g, result) -> dict:
+    """The HYGOV table and where its figures come from."""
+    rows = [{"name": k, "value": fmt_num(v, 4), "unit": g.units.get(k, "")}
+            for k, v in {**g.parameters, **g.rate_limits}.items()]
+    if g.Tg_linear is not None:
+        rows.append({"name": "Tg (linear)", "value": fmt_num(g.Tg_linear, 4), "unit": "s"})
+    stroke = result.plant.stroke if result is not None else None
+    per_unit = f" (1 pu = the full stroke, {fmt_quantity(stroke, 'm', 'mm', 0)})" if isinstance(stroke, (int, float)) else ""
+    intro = (f"{g.model} is the hydro turbine-governor model of power-system simulation tools (IEEE PES "
+             "TR 2013, hydro turbine-governor models): Tg is its gate-servomotor time constant, VELM the gate velocity "
+             "limit, GMAX and GMIN the gate limits, UO and UC the opening and closing rate limits. Gate positions are "
+             f"per unit (pu) of the stroke and rates in pu/s, per unit of stroke per second{per_unit}.")
+    curve = result.plant.load_curve if result is not None else None
+    return {"model": g.model, "rows": rows, "basis": [intro] + governor_basis(g.basis, curve)}
+
+
 def linear_section(linear, start: int, result=None) -> tuple[dict | None, list[dict]]:
-    """Context of the linear-analysis section and its figure specs (ids from ``start``)."""
-    if not linear:
+    """Context of the linear-analysis section (a :class:`~compliance.results.linear.LinearSection`) and its
+    figure specs (ids from ``start``)."""
+    if linear is None:
         return None, []
     from compliance.report.acceptance import MARGIN_CRITERION
 
@@ -116,66 +140,28 @@ def linear_section(linear, start: int, result=None) -> tuple[dict | None, list[d
         specs.append({"id": fid, "kind": kind, **kw})
         return fid
 
-    analyses = list(linear.get("analyses") or ([linear["analysis"]] if linear.get("analysis") else []))
-    points_named = distinct_points(analyses, result)
+    points_named = distinct_points(linear.all_analyses, result)
     labelled = [(f"P{k + 1} {label}", a) for k, (label, a, _) in enumerate(points_named)]  # keys as in the table
-    maps = []
-    omap = linear.get("map")
-    if omap:
-        for name in ("time_constant", "gain_margin_db", "phase_margin_deg"):
-            if (omap.get("values") or {}).get(name):
-                maps.append({"id": add("map", omap=omap, name=name), "title": MAP_QUANTITIES[name][0],
-                             "unit": MAP_QUANTITIES[name][1]})
-    points = []
-    for k, (label, a, which) in enumerate(points_named):
-        f = a.get("figures") or {}
-        points.append({"key": f"P{k + 1}", "label": label, "names": which, "time_constant": _ms(f.get("time_constant")),
-                       "gain_margin": fmt_num(f.get("gain_margin_db"), 3), "phase_margin": fmt_num(f.get("phase_margin_deg"), 3),
-                       "bandwidth": fmt_num(f.get("bandwidth_hz"), 3), "damping": fmt_num(f.get("damping_ratio"), 3),
-                       "natural_frequency": fmt_num(f.get("natural_frequency_hz"), 3),
-                       "stable": f.get("stable"), "stability": _stability(f)})
+    omap = linear.map
+    maps = [{"id": add("map", omap=omap, name=name), "title": MAP_QUANTITIES[name][0], "unit": MAP_QUANTITIES[name][1]}
+            for name in ("time_constant", "gain_margin_db", "phase_margin_deg") if omap is not None and omap.values.get(name)]
+    points = [_point_row(k, label, a, which) for k, (label, a, which) in enumerate(points_named)]
     minima = []
     for name, unit in (("phase_margin_deg", "°"), ("gain_margin_db", " dB")):
-        m = _map_minimum(omap, name)
+        m = omap.minimum(name) if omap is not None else None
         if m is not None:
-            where = f"{m[1] * 1e3:.0f} mm, " + ("no load" if m[2] is None else "load curve" if isinstance(m[2], str)
-                                                 else f"{m[2] / 1e3:+.1f} kN")
+            where = f"{fmt_quantity(m[1], 'm', 'mm', 0)}, " + ("no load" if m[2] is None else "load curve"
+                                                                 if isinstance(m[2], str) else _load(m[2]))
             minima.append(f"{MAP_QUANTITIES[name][0]} {fmt_num(m[0], 3)}{unit} at {where}")
     criterion = {"pm": MARGIN_CRITERION["phase_margin_deg"], "gm": MARGIN_CRITERION["gain_margin_db"], "minima": minima,
                  "below": sum(1 for p in points if p["stability"] != "meets")}
-    bode = add("bode", analyses=labelled) if any(a.get("bode") for _, a in labelled) else None
-    poles = add("poles", analyses=labelled) if any((a.get("poles") or {}).get("closed_loop") for _, a in labelled) else None
-    cross = []
-    for r in linear.get("crosscheck") or []:
-        if "skipped" in r:
-            cross.append({"position": _mm(r.get("position")), "load": _load(r.get("load")), "skipped": r["skipped"]})
-            continue
-        cross.append({"position": _mm(r.get("position")), "load": _load(r.get("load"), r.get("load_force")),
-                      "step": f"{r['step'] * 100:+.0f} %" if r.get("step") is not None else "\u2013",
-                      "tau_linear": _ms(r.get("tau_linear")), "tau_nonlinear": _ms(r.get("tau_nonlinear"), "stalled"),
-                      "ratio": fmt_num(r.get("ratio"), 3), "steady_error": _mm(r.get("steady_error"), 2),
-                      "why": r.get("why") or "agrees within 20 %"})
-    gov = None
-    summary = _crosscheck_summary(linear.get("crosscheck") or [])
-    g = linear.get("governor")
-    if g:
-        units = g.get("units") or {}
-        params = dict(g.get("parameters") or {})
-        params.update({k: v for k, v in (g.get("rate_limits") or {}).items()})
-        rows = [{"name": k, "value": fmt_num(v, 4), "unit": units.get(k, "")} for k, v in params.items()]
-        if g.get("Tg_linear") is not None:
-            rows.append({"name": "Tg (linear)", "value": fmt_num(g["Tg_linear"], 4), "unit": "s"})
-        stroke = result.plant.stroke if result is not None else None
-        per_unit = f" (1 pu = the full stroke, {stroke * 1e3:.0f} mm)" if isinstance(stroke, (int, float)) else ""
-        intro = (f"{g.get('model', 'HYGOV')} is the hydro turbine-governor model of power-system simulation tools (IEEE PES "
-                 "TR 2013, hydro turbine-governor models): Tg is its gate-servomotor time constant, VELM the gate velocity "
-                 "limit, GMAX and GMIN the gate limits, UO and UC the opening and closing rate limits. Gate positions are "
-                 f"per unit (pu) of the stroke and rates in pu/s, per unit of stroke per second{per_unit}.")
-        gov = {"model": g.get("model", "HYGOV"), "rows": rows,
-               "basis": [intro] + governor_basis(g.get("basis") or {}, result.plant.load_curve if result is not None else None)}
-    notes = list((omap or {}).get("notes") or [])
-    ctx = {"maps": maps, "points": points, "bode": bode, "poles": poles, "crosscheck": cross, "crosscheck_summary": summary, "governor": gov,
-           "notes": notes, "window": (omap or {}).get("window"), "criterion": criterion}
+    bode = add("bode", analyses=labelled) if any(a.bode.frequency_hz for _, a in labelled) else None
+    poles = add("poles", analyses=labelled) if any(a.poles.closed_loop for _, a in labelled) else None
+    ctx = {"maps": maps, "points": points, "bode": bode, "poles": poles,
+           "crosscheck": [_cross_row(r) for r in linear.crosscheck], "crosscheck_summary": _crosscheck_summary(linear.crosscheck),
+           "governor": _governor(linear.governor, result) if linear.governor is not None else None,
+           "notes": list(omap.notes) if omap is not None else [], "window": omap.window if omap is not None else None,
+           "criterion": criterion}
     return ctx, specs
 
 
@@ -188,7 +174,7 @@ def _curve_force(curve, x):
     return float(np.interp(x, curve.position, curve.force))
 
 
-def governor_basis(b: dict, curve: dict | None = None) -> list[str]:
+def governor_basis(b, curve=None) -> list[str]:
     """Where the HYGOV figures come from, in sentences (never a raw dict)."""
     if b.get("sentences"):  # the governor export writes its own (compliance.linear.governor_formats)
         return [str(s) for s in b["sentences"]]
@@ -199,19 +185,19 @@ def governor_basis(b: dict, curve: dict | None = None) -> list[str]:
         ld = pt.get("load")
         if ld == "curve":
             f = _curve_force(curve, pt.get("position"))
-            load = "on the load curve" + (f" ({f / 1e3:.1f} kN there)" if f is not None else "")
+            load = "on the load curve" + (f" ({fmt_quantity(f, 'N', 'kN', 1)} there)" if f is not None else "")
         else:
             load = "" if ld is None else ", " + _load(ld) + " load"
         where = _mm(pt.get("position")) + (" " + load if ld == "curve" else load)
         out.append(f"Tg is the mean time constant of {len(samples)} nonlinear steps of "
-                   + " and ".join(f"{100 * s:+.0f} %" for s in b.get("Tg_steps") or []) + f" of stroke at {where}: "
-                   + ", ".join(fmt_value(v, "s", 3) for v in samples) + ".")
+                   + " and ".join(fmt_quantity(s, "", "%", 0, signed=True) for s in b.get("Tg_steps") or [])
+                   + f" of stroke at {where}: " + ", ".join(fmt_value(v, "s", 3) for v in samples) + ".")
     runs = b.get("stroke_runs") or {}
     if runs:
         o, c = runs.get("opening") or {}, runs.get("closing") or {}
         load = runs.get("load")
         out.append("UO and UC come from closed-loop strokes end to end (reference step, 25\u201375 % of stroke extrapolated)"
-                   + (f" at a {fmt_value(load / 1e3, 'kN', 3)} closing load" if isinstance(load, (int, float)) else "")
+                   + (f" at a {fmt_quantity(load, 'N', 'kN', digits=3)} closing load" if isinstance(load, (int, float)) else "")
                    + f": opening {fmt_value(o.get('stroke_time'), 's', 3)}, closing {fmt_value(c.get('stroke_time'), 's', 3)}. "
                    "They differ slightly from the opening and closing times of section 4, which are judged on open-loop "
                    "full strokes at the governor set-up load.")
@@ -219,19 +205,19 @@ def governor_basis(b: dict, curve: dict | None = None) -> list[str]:
 
 
 def _ms(v, none="\u2013"):
-    return none if v is None else f"{v * 1e3:.0f} ms"
+    return none if v is None else fmt_quantity(v, "s", "ms", 0)
 
 
 def _mm(v, digits=0):
-    return "\u2013" if v is None else f"{v * 1e3:.{digits}f} mm"
+    return "\u2013" if v is None else fmt_quantity(v, "m", "mm", digits)
 
 
 def _load(ld, force=None):
     if ld is None:
         return "none"
     if isinstance(ld, str):
-        return ld + (f" ({force / 1e3:.1f} kN)" if isinstance(force, (int, float)) else "")
-    return f"{ld / 1e3:+.1f} kN"
+        return ld + (f" ({fmt_quantity(force, 'N', 'kN', 1)})" if isinstance(force, (int, float)) else "")
+    return fmt_quantity(ld, "N", "kN", 1, signed=True)
 
 
 # --------------------------------------------------------------------------- validation
@@ -320,7 +306,7 @@ def diagnosis_finding(diag: dict) -> dict:
             winner = e
     params = []
     from compliance.report.fit_bounds import effect_bound
-    from compliance.units.formatting import fmt_si
+    from compliance.presentation.numbers import fmt_si
 
     for p in (winner or {}).get("parameters") or []:
         params.append({"name": p.get("name"), "text": fmt_si(p.get("value"), p.get("unit") or "", p.get("stderr")),

@@ -14,7 +14,7 @@ from compliance.presentation.values import limit_as_written, metric_text, row_te
 from compliance.report.requirement_pages import TOLERANCE_METRICS, reader_text
 from compliance.requirements.verdict import Basis, Overall, Status
 from compliance.results.check_result import CheckResult
-from compliance.units.formatting import fmt_num, unit_text
+from compliance.presentation.numbers import fmt_num, unit_text
 
 SOURCES = ("paper", "assumed", "derived", "user")
 
@@ -31,7 +31,7 @@ def as_result(results, where: str = "results") -> CheckResult:
 
 
 # --------------------------------------------------------------------------- formatting
-# the one formatter and status-word table live in compliance/units/formatting.py
+# the one formatter and status-word table live in compliance/presentation/numbers.py
 
 def setting_text(v) -> str:
     """A procedure setting as a reader reads it: units typeset, yes/no, lists joined."""

@@ -25,7 +25,7 @@ def at_bound(value, low, high, log: bool = False) -> bool:
 def effect_bound(p: dict) -> str | None:
     """"at its fit bound" for a fitted effect parameter (``effect.name``) on a bound of its declaration."""
     from compliance.effects import EFFECTS
-    from compliance.units.formatting import fmt_si
+    from compliance.presentation.numbers import fmt_si
 
     effect, _, name = str(p.get("name") or "").partition(".")
     eff = EFFECTS.get(effect)

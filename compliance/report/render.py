@@ -33,7 +33,7 @@ from compliance.report import content as C
 from compliance.report import signoff as S
 from compliance.report.analysis_sections import linear_section, validation_section
 from compliance.report.requirement_pages import requirement_pages
-from compliance.units.formatting import fmt_date, fmt_margin_pct, fmt_num, fmt_si, status_word, unit_text
+from compliance.presentation.numbers import fmt_date, fmt_margin_pct, fmt_num, fmt_si, status_word, unit_text
 
 TEMPLATES = resources.files("compliance.report") / "templates"
 VALIDATION_SCHEMA = "govcheck.validation/1"
@@ -215,7 +215,7 @@ def build_report(results, workers: int | None = None, appendix: str = "summary",
     pages, specs = requirement_pages(res, 1)
     sections, run_specs = C.procedure_sections(res, len(specs) + 1) if appendix == "full" else ([], [])
     specs += run_specs
-    lin_ctx, lin_specs = linear_section(res.linear, len(specs) + 1, res)
+    lin_ctx, lin_specs = linear_section(res.linear_section, len(specs) + 1, res)
     val_ctx, val_specs = validation_section(res.validation, len(specs) + len(lin_specs) + 1)
     svgs = draw_figures(specs + lin_specs + val_specs, C.valve_marks(res), workers, scheduler)
     plant = res.plant

@@ -19,7 +19,7 @@ from compliance.results.check_result import CheckResult
 from compliance.results.requirement_set import FileRecord
 from compliance.results.rows import WorstCase
 from compliance.results.summary import CaseCoverage, Qualifier
-from compliance.units.formatting import fmt_margin_pct, fmt_si
+from compliance.presentation.numbers import fmt_margin_pct, fmt_si
 
 SOURCE_WORDS = {"paper": "from the paper", "assumed": "assumed", "derived": "derived", "user": "set by the user",
                 "fitted": "fitted to a recording"}

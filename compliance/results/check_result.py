@@ -151,6 +151,13 @@ class CheckResult(Record):
         return self.summary.status == Overall.PASS
 
     @property
+    def linear_section(self):
+        """The linear analysis as records (:class:`~compliance.results.linear.LinearSection`), or None when not run."""
+        from compliance.results.linear import LinearSection
+
+        return LinearSection.from_dict(self.linear, "results.linear") if self.linear else None
+
+    @property
     def wall(self) -> float:
         """Wall time of the check [s] (0 in a reproducible result)."""
         return self.timing.wall if self.timing is not None else 0.0

@@ -48,12 +48,12 @@ class LoadCurve(Record):
 
     position: tuple[float, ...] = key(read=tuple_of(float))
     force: tuple[float, ...] = key(read=tuple_of(float))
-    source: str = "user"  # paper | assumed | derived | user
+    source: str | None = None  # paper | assumed | derived | user (None in an older file: taken as assumed)
 
     @property
     def assumed(self) -> bool:
         """Whether the curve is an assumption (not from the paper, a derivation or the user)."""
-        return self.source == "assumed"
+        return self.source in (None, "assumed")
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -15,7 +15,7 @@ from compliance.report import signoff as S
 from compliance.report.analysis_sections import distinct_points, linear_section
 from compliance.report.fit_bounds import at_bound
 from compliance.results import CheckResult
-from compliance.units.formatting import fmt_si
+from compliance.presentation.numbers import fmt_si
 
 FIXTURE = Path(__file__).resolve().parents[1] / "data" / "results_fixture.json"
 

@@ -105,7 +105,7 @@ def _render_partial(tolerance_yield):
            "remedy": None, "closest": {"changes": [{"path": "controller.kp", "unit": "V/m", "from": 280.0, "to": 300.0}],
                                        "change": 0.1, "binding": "TC", "binding_margin_pct": -2.0, "failed_mandatory": ["TC"]}}
     env = jinja2.Environment(loader=jinja2.FileSystemLoader(TEMPLATES), autoescape=True, undefined=jinja2.StrictUndefined)
-    from compliance.units.formatting import fmt_margin_pct, fmt_si
+    from compliance.presentation.numbers import fmt_margin_pct, fmt_si
 
     env.filters["si"] = lambda v, u: fmt_si(v, u or "")  # the report's filters: values with units, capped margins
     env.filters["margin"] = lambda v: fmt_margin_pct(v) or "\u2013"

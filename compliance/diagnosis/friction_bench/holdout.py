@@ -39,7 +39,7 @@ from compliance.diagnosis.friction_bench.fit import LawFit, fit_law, predict, st
 from compliance.diagnosis.friction_bench.position import POSITION_FRICTION
 from compliance.diagnosis.friction_bench.pressure_shape import NONLINEAR_PRESSURE, PRESSURE_FORCE
 from compliance.diagnosis.friction_bench.running_in import FRICTION_DRIFT
-from compliance.units.formatting import fmt_si
+from compliance.presentation.numbers import fmt_si
 from compliance.diagnosis.verdicts.candidate_set import CandidateSet
 
 MIN_RUNS = 3  # fit on at least two pressures, predict a third

@@ -114,7 +114,7 @@ def core_equivalent(p: dict) -> str:
     single-acting cylinder has its rod side vented, so p_mean = p_g / 2): k = 2 k_p / F_0 per level.
     """
     from compliance.diagnosis.servo.explanation import effect_words
-    from compliance.units.formatting import fmt_si
+    from compliance.presentation.numbers import fmt_si
 
     rel = [f"{fmt_si(2.0 * p['pressure_coefficient'] / p[level], '1/Pa')} on {name}"
            for level, name in (("coulomb", "F_C"), ("static", "F_S")) if p[level] > 1e-3]

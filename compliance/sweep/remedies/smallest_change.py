@@ -34,7 +34,7 @@ from compliance.sweep.candidates.results import change
 from compliance.sweep.candidates.ranking import SETTINGS_COST, candidate_passes, failing_mandatory, rank_key
 from compliance.sweep.candidates.runner import run_candidates, shortfall
 from compliance.sweep.candidates.sampling import from_normalised, to_normalised
-from compliance.units.formatting import fmt_margin_pct
+from compliance.presentation.numbers import fmt_margin_pct
 from compliance.sweep.remedies.outcome import RemedyStatus
 
 __all__ = ["STEP", "TARGET", "binding", "closeness", "describe_candidate", "find_remedy", "mandatory_margins", "unreachable"]
