@@ -10,6 +10,7 @@ physics added with its fitted parameters). Missing parts are reported as "not ru
 from __future__ import annotations
 
 from compliance.presentation.quantities import fmt_quantity
+from compliance.results.validation import DiagnosisRecord, ValidationRecord
 from compliance.presentation.numbers import fmt_num, fmt_value, unit_text as pretty_unit
 from compliance.report.figures_linear import MAP_QUANTITIES
 from compliance.diagnosis.verdicts.verdict import EXPLAINED
@@ -221,53 +222,65 @@ def _load(ld, force=None):
 
 
 # --------------------------------------------------------------------------- validation
-def validation_section(val: dict | None, start: int) -> tuple[dict | None, list[dict]]:
-    """Context of the model-validation section and its figure specs (ids from ``start``)."""
+def _mode_figures(mode, after, start: int, specs: list) -> list[dict]:
+    """One overlay figure per signal of a replay (with the replay after the diagnosis, when there is one)."""
+    figs = []
+    for sig, ov in mode.overlays.items():
+        label, unit, scale = SIGNAL_DISPLAY.get(sig, (sig, ov.unit, 1.0))
+        series = [("recorded", ov.time, ov.recorded, "recorded"),
+                  ("simulated" + (" (before)" if after else ""), ov.time, ov.simulated, "before")]
+        aov = after.overlays.get(sig) if after else None
+        if aov:
+            series.append(("simulated (after)", aov.time, aov.simulated, "after"))
+        fid = f"fig-{start + len(specs)}"
+        specs.append({"id": fid, "kind": "waveform", "series": series, "scale": scale, "ylabel": f"{label} [{unit}]",
+                      "windows": _shaded(mode.located_windows, sig, ov.time), "smooth": sig == "valve_command"})
+        figs.append({"id": fid, "signal": label, "role": ov.role, "shaded": bool(specs[-1]["windows"])})
+    return figs
+
+
+def _mode_context(name: str, mode, after, start: int, specs: list) -> dict:
+    """A replay mode of the validation section: figures, fits (before and after), windowed errors, located misses."""
+    figs = _mode_figures(mode, after, start, specs)
+    fits = [{"signal": SIGNAL_DISPLAY.get(s, (s,))[0], "fit": fmt_num(f.fit_percent, 3), "nrmse": fmt_num(f.nrmse, 3),
+             "rms": _sig(f.rms_error, s), "max": _sig(f.max_abs_error, s),
+             "fit_after": fmt_num(after.fits[s].fit_percent if s in after.fits else None, 3) if after else None}
+            for s, f in mode.fits.items()]
+    located = [{"signal": SIGNAL_DISPLAY.get(w.signal, (w.signal,))[0], "start": fmt_num(w.start, 4), "end": fmt_num(w.end, 4),
+                "peak_ratio": fmt_num(w.peak_ratio, 3), "regimes": ", ".join(regime_text(r) for r in w.dominant)}
+               for w in mode.located_windows]
+    return {"name": name, "pass": mode.passed, "figures": figs, "fits": fits, "rows": _window_table(mode.window_metrics),
+            "located": located, "has_after": bool(after)}
+
+
+def _added_physics(diag) -> list[dict]:
+    return [{"name": eff.name, "meaning": eff.meaning or "",
+             "params": [{"name": p.name, "value": fmt_num(p.value, 4), "unit": pretty_unit(p.unit),
+                         "bounds": " .. ".join(fmt_num(b, 3) for b in p.bounds or ())} for p in eff.params]}
+            for eff in (diag.physics_added if diag is not None else ())]
+
+
+def validation_section(val, start: int) -> tuple[dict | None, list[dict]]:
+    """Context of the model-validation section and its figure specs (ids from ``start``).
+
+    ``val``: a :class:`~compliance.results.validation.ValidationRecord` (a validation document is read into one here).
+    """
     if not val:
         return None, []
+    if isinstance(val, dict):
+        val = ValidationRecord.from_dict(val, "validation")
     specs = []
-    modes = []
-    diag = val.get("diagnosis") or {}
-    after_modes = (diag.get("after") or {}).get("modes") or {}
-    for mode, m in (val.get("modes") or {}).items():
-        windows = m.get("located_windows") or []
-        after = after_modes.get(mode) or {}
-        figs = []
-        for sig, ov in (m.get("overlays") or {}).items():
-            label, unit, scale = SIGNAL_DISPLAY.get(sig, (sig, ov.get("unit", ""), 1.0))
-            series = [("recorded", ov.get("time"), ov.get("recorded"), "recorded"),
-                      ("simulated" + (" (before)" if after else ""), ov.get("time"), ov.get("simulated"), "before")]
-            aov = (after.get("overlays") or {}).get(sig)
-            if aov:
-                series.append(("simulated (after)", aov.get("time"), aov.get("simulated"), "after"))
-            fid = f"fig-{start + len(specs)}"
-            specs.append({"id": fid, "kind": "waveform", "series": series, "scale": scale, "ylabel": f"{label} [{unit}]",
-                          "windows": _shaded(windows, sig, ov.get("time")), "smooth": sig == "valve_command"})
-            figs.append({"id": fid, "signal": label, "role": ov.get("role"), "shaded": bool(specs[-1]["windows"])})
-        fits = [{"signal": SIGNAL_DISPLAY.get(s, (s,))[0], "fit": fmt_num(f.get("fit_percent"), 3),
-                 "nrmse": fmt_num(f.get("nrmse"), 3), "rms": _sig(f.get("rms_error"), s), "max": _sig(f.get("max_abs_error"), s),
-                 "fit_after": fmt_num(((after.get("fits") or {}).get(s) or {}).get("fit_percent"), 3) if after else None}
-                for s, f in (m.get("fits") or {}).items()]
-        rows = _window_table(m.get("window_metrics") or [])
-        located = [{"signal": SIGNAL_DISPLAY.get(w.get("signal"), (w.get("signal"),))[0], "start": fmt_num(w.get("start"), 4),
-                    "end": fmt_num(w.get("end"), 4), "peak_ratio": fmt_num(w.get("peak_ratio"), 3),
-                    "regimes": ", ".join(regime_text(r) for r in w.get("dominant") or [])} for w in windows]
-        modes.append({"name": mode, "pass": m.get("pass"), "figures": figs, "fits": fits, "rows": rows, "located": located,
-                      "has_after": bool(after)})
-    added = []
-    for eff in diag.get("added") or diag.get("effects") or []:
-        added.append({"name": eff.get("name"), "meaning": eff.get("meaning") or "",
-                      "params": [{"name": p.get("name"), "value": fmt_num(p.get("value"), 4), "unit": pretty_unit(p.get("unit", "")),
-                                  "bounds": " .. ".join(fmt_num(b, 3) for b in (p.get("bounds") or []))}
-                                 for p in eff.get("params") or []]})
-    rec = val.get("recording") or {}
-    first = modes[0] if modes else {}
-    pos = next((f for f in first.get("fits") or [] if f["signal"] == "position"), {})
+    diag = val.diagnosis
+    after_modes = diag.after.modes if diag is not None and diag.after is not None else {}
+    modes = [_mode_context(name, m, after_modes.get(name), start, specs) for name, m in val.modes.items()]
+    first = modes[0]["fits"] if modes else []
+    pos = next((f for f in first if f["signal"] == "position"), {})
     ctx = {"fit_before": pos.get("fit") if pos.get("fit") not in (None, "\u2013") else None,
            "fit_after": pos.get("fit_after") if pos.get("fit_after") not in (None, "\u2013") else None,
-           "finding": diagnosis_finding(diag) if diag else None, "recording": rec, "plant": val.get("plant") or {}, "conditions": val.get("conditions") or {},
-           "modes": modes, "added": added, "diagnosis": bool(diag), "explanation": diag.get("explanation"),
-           "warnings": val.get("warnings") or [], "pass": (val.get("summary") or {}).get("pass")}
+           "finding": diagnosis_finding(diag) if diag is not None else None, "recording": val.recording,
+           "plant": val.plant, "conditions": val.conditions, "modes": modes, "added": _added_physics(diag),
+           "diagnosis": diag is not None, "explanation": diag.explanation if diag is not None else None,
+           "warnings": list(val.warnings), "pass": val.passed}
     return ctx, specs
 
 
@@ -296,64 +309,57 @@ NEXT_STEP = {
 }
 
 
-def diagnosis_finding(diag: dict) -> dict:
+def diagnosis_finding(diag) -> dict:
     """The finding of a diagnosis for the top of its report: verdict, effect, parameters with uncertainty, next step."""
-    verdict = diag.get("verdict")
-    ranked = diag.get("effects_ranked") or []
-    winner = ranked[0] if ranked else None
-    for e in ranked:
-        if e.get("name") == diag.get("winner"):
-            winner = e
-    params = []
     from compliance.report.fit_bounds import effect_bound
     from compliance.presentation.numbers import fmt_si
 
-    for p in (winner or {}).get("parameters") or []:
-        params.append({"name": p.get("name"), "text": fmt_si(p.get("value"), p.get("unit") or "", p.get("stderr")),
-                       "meaning": p.get("meaning") or "", "bound": effect_bound(p)})
-    runner = ranked[1] if len(ranked) > 1 else None
+    if isinstance(diag, dict):
+        diag = DiagnosisRecord.from_dict(diag, "diagnosis")
+    verdict, winner = diag.verdict, diag.ranked_winner
+    params = [{"name": p.name, "text": fmt_si(p.value, p.unit or "", p.stderr), "meaning": p.meaning or "",
+               "bound": effect_bound(p.name, p.value, p.unit)} for p in (winner.parameters if winner else ())]
+    runner = diag.effects_ranked[1] if len(diag.effects_ranked) > 1 else None
     step = NEXT_STEP.get(verdict, "")
-    if runner is not None and runner.get("delta_bic") is not None and winner is not None and verdict in NEXT_STEP:
-        gap = (runner.get("delta_bic") or 0.0) - (winner.get("delta_bic") or 0.0)
+    if runner is not None and runner.delta_bic is not None and winner is not None and verdict in NEXT_STEP:
+        gap = (runner.delta_bic or 0.0) - (winner.delta_bic or 0.0)
         if 0 <= gap < 10:  # BIC difference under 10: the data do not decide between the two
-            step = (f"Ambiguous between {winner.get('name')} and {runner.get('name')} (BIC differs by {gap:.1f}, under 10): "
+            step = (f"Ambiguous between {winner.name} and {runner.name} (BIC differs by {gap:.1f}, under 10): "
                     "run a test that separates them before changing the model. " + step)
     return {"verdict": verdict, "word": VERDICT_TEXT.get(verdict, str(verdict or "\u2013").upper()),
-            "effect": (winner or {}).get("name") if verdict in EXPLAINED else None,
-            "params": params if verdict in EXPLAINED else [],
-            "explanation": diag.get("explanation"), "next": step}
+            "effect": winner.name if verdict in EXPLAINED and winner else None,
+            "params": params if verdict in EXPLAINED else [], "explanation": diag.explanation, "next": step}
 
 
-def _shaded(windows: list, sig: str, time) -> list:
+def _shaded(windows, sig: str, time) -> list:
     """The located mismatch windows worth shading on a plot: the three strongest, none longer than 40 % of the record."""
     span = (max(time) - min(time)) if time else None
-    ws = [w for w in windows if w.get("signal") == sig and w.get("start") is not None and w.get("end") is not None]
+    ws = [w for w in windows if w.signal == sig and w.start is not None and w.end is not None]
     if span:
-        ws = [w for w in ws if (w["end"] - w["start"]) <= 0.4 * span]
-    ws.sort(key=lambda w: -(w.get("peak_ratio") or 0.0))
-    return [(w["start"], w["end"]) for w in ws[:3]]
+        ws = [w for w in ws if (w.end - w.start) <= 0.4 * span]
+    ws.sort(key=lambda w: -(w.peak_ratio or 0.0))
+    return [(w.start, w.end) for w in ws[:3]]
 
 
-def _window_table(metrics: list) -> dict:
+def _window_table(metrics) -> dict:
     """Windowed errors pivoted: one row per window, one cell per signal (max / mean |error| [pu])."""
     signals, rows, index = [], [], {}
     for r in metrics:
-        sig = r.get("signal")
-        if sig not in signals:
-            signals.append(sig)
-        key = (r.get("window"), r.get("kind"), r.get("start"))
+        if r.signal not in signals:
+            signals.append(r.signal)
+        key = (r.window, r.kind, r.start)
         if key not in index:
-            index[key] = {"window": r.get("window"), "kind": r.get("kind"), "cells": {}, "pass": True}
+            index[key] = {"window": r.window, "kind": r.kind, "cells": {}, "pass": True}
             rows.append(index[key])
         row = index[key]
-        row["cells"][sig] = {"text": f"{_pct(r.get('max_error'))} / {_pct(r.get('mean_absolute_error'))}",
-                             "pass": r.get("pass"), "failed": ", ".join(r.get("failed") or [])}
-        row["pass"] = row["pass"] and bool(r.get("pass"))
+        row["cells"][r.signal] = {"text": f"{_pct(r.max_error)} / {_pct(r.mean_absolute_error)}", "pass": r.passed,
+                                  "failed": ", ".join(r.failed)}
+        row["pass"] = row["pass"] and bool(r.passed)
     for row in rows:
         row["cells"] = [row["cells"].get(sig) for sig in signals]
     limits = {}
     for r in metrics:
-        limits.setdefault((r.get("signal"), r.get("kind")), r.get("limits") or {})
+        limits.setdefault((r.signal, r.kind), r.limits)
     lim_rows = [{"signal": SIGNAL_DISPLAY.get(sg, (sg,))[0], "kind": k,
                  "text": ", ".join(f"{name.replace('_', ' ')} {_pct(v)} %" for name, v in lim.items() if v is not None)}
                 for (sg, k), lim in limits.items()]

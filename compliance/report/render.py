@@ -33,6 +33,7 @@ from compliance.report import content as C
 from compliance.report import signoff as S
 from compliance.report.analysis_sections import linear_section, validation_section
 from compliance.report.requirement_pages import requirement_pages
+from compliance.results.validation import ValidationRecord
 from compliance.presentation.numbers import fmt_date, fmt_margin_pct, fmt_num, fmt_si, status_word, unit_text
 
 TEMPLATES = resources.files("compliance.report") / "templates"
@@ -216,7 +217,8 @@ def build_report(results, workers: int | None = None, appendix: str = "summary",
     sections, run_specs = C.procedure_sections(res, len(specs) + 1) if appendix == "full" else ([], [])
     specs += run_specs
     lin_ctx, lin_specs = linear_section(res.linear_section, len(specs) + 1, res)
-    val_ctx, val_specs = validation_section(res.validation, len(specs) + len(lin_specs) + 1)
+    validation = ValidationRecord.from_dict(res.validation, "results.validation") if res.validation else None
+    val_ctx, val_specs = validation_section(validation, len(specs) + len(lin_specs) + 1)
     svgs = draw_figures(specs + lin_specs + val_specs, C.valve_marks(res), workers, scheduler)
     plant = res.plant
     ctx = {
@@ -347,21 +349,21 @@ def render_validation_report(result: dict, html_path, pdf_path=None, *, workers:
     if pdf_path:
         _check_target(pdf_path, "--pdf")
     check_validation(result)
-    ctx, specs = validation_section(result, 1)
+    val = ValidationRecord.from_dict(result, "validation results")
+    ctx, specs = validation_section(val, 1)
     svgs = draw_figures(specs, None, workers, scheduler)
-    plant = dict(result.get("plant") or {})
-    plant["path"] = display_path(plant.get("path"))  # never an installation's absolute path
-    ctx["recording"] = dict(ctx["recording"], path=display_path(ctx["recording"].get("path")))
-    rec = ctx["recording"]
-    digest = rec.get("digest") or rec.get("sha256") or file_sha256(result.get("recording", {}).get("path"))
+    plant = dict(val.plant, path=display_path(val.plant.get("path")))  # never an installation's absolute path
+    rec = dict(val.recording, path=display_path(val.recording.get("path")))
+    ctx["recording"] = rec
+    digest = rec.get("digest") or rec.get("sha256") or file_sha256(val.recording.get("path"))
     files = [{"what": "Plant configuration", "path": plant.get("path") or plant.get("name"), "digest": plant.get("digest")},
              {"what": "Recording", "path": rec.get("path"), "digest": digest}]
     document = document or {}
-    ctx = {**_common({"govcheck": (result.get("tool") or {}).get("version", __version__)}),
-           "v": ctx, "plant": plant, "settings": C.readable_settings(result.get("settings") or {}),
-           "conditions": C.readable_settings(ctx.get("conditions") or {}), "windows": result.get("windows") or [],
-           "created": fmt_date(result.get("created")), "identity": document.get("identity") or {},
-           "doc": S.document_block(document.get("identity") or {}, files, document)}
+    identity = document.get("identity") or {}
+    ctx = {**_common({"govcheck": val.tool.get("version", __version__)}),
+           "v": ctx, "plant": plant, "settings": C.readable_settings(val.settings), "conditions": C.readable_settings(val.conditions),
+           "windows": val.windows, "created": fmt_date(val.created), "identity": identity,
+           "doc": S.document_block(identity, files, document)}
     _emit("validation.html.j2", ctx, svgs, html_path, pdf_path)
 
 

@@ -51,12 +51,12 @@ def test_deciding_parameters_of_verdict_bands_are_named_first():
 
 
 def test_linear_points_are_distinct_named_and_judged_against_the_stated_criterion():
-    res = _results()
-    lin = res["linear"]
-    pts = distinct_points(lin.get("analyses") or [], _typed(res))
-    keys = [(round(a["operating_point"]["position"], 6), str(a["operating_point"]["load"])) for _, a, _ in pts]
+    res = _typed(_results())
+    lin = res.linear_section
+    pts = distinct_points(lin.all_analyses, res)
+    keys = [(round(a.operating_point.position, 6), str(a.operating_point.load)) for _, a, _ in pts]
     assert len(keys) == len(set(keys))
-    ctx, _ = linear_section(lin, 1, _typed(res))
+    ctx, _ = linear_section(lin, 1, res)
     assert ctx["criterion"]["pm"] == 30.0 and ctx["criterion"]["gm"] == 6.0
     for p in ctx["points"]:
         pm, gm = float(p["phase_margin"]), float(p["gain_margin"])
