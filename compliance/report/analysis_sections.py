@@ -15,7 +15,7 @@ from compliance.presentation.numbers import fmt_num, fmt_value, unit_text as pre
 from compliance.report.figures_linear import MAP_QUANTITIES
 from compliance.diagnosis.verdicts.verdict import EXPLAINED
 
-SIGNAL_DISPLAY = {  # signal -> (label, unit shown, scale from SI)
+SIGNAL_DISPLAY = {  # signal -> (label, unit shown, scale from SI for the plots)
     "position": ("position", "mm", 1e3),
     "valve_command": ("valve command", "V", 1.0),
     "pressure_a": ("chamber A pressure", "bar abs", 1e-5),
@@ -31,6 +31,11 @@ def _load_words(load, force=None) -> str:
     if isinstance(load, str):
         return f"load curve, {fmt_quantity(force or 0.0, 'N', 'kN', 1)}"
     return fmt_quantity(load, "N", "kN", 1, signed=True)
+
+
+def _signal(name, unit: str = "") -> tuple:
+    """(label, unit shown, plot scale from SI) of a recorded signal; an unknown one as named, in ``unit``."""
+    return SIGNAL_DISPLAY.get(name, (name, unit, 1.0))
 
 
 def _op_label(a) -> str:
@@ -176,30 +181,27 @@ def _curve_force(curve, x):
 
 
 def governor_basis(b, curve=None) -> list[str]:
-    """Where the HYGOV figures come from, in sentences (never a raw dict)."""
-    if b.get("sentences"):  # the governor export writes its own (compliance.linear.governor_formats)
-        return [str(s) for s in b["sentences"]]
+    """Where the HYGOV figures come from (a :class:`~compliance.results.linear.GovernorBasis`), in sentences."""
+    if b.sentences:  # the governor export writes its own (compliance.linear.governor_formats)
+        return list(b.sentences)
     out = []
-    pt = b.get("Tg_point") or {}
-    samples = [v for v in b.get("Tg_nonlinear_samples") or [] if isinstance(v, (int, float))]
+    pt = b.Tg_point
+    samples = [v for v in b.Tg_nonlinear_samples if isinstance(v, (int, float))]
     if samples:
-        ld = pt.get("load")
-        if ld == "curve":
-            f = _curve_force(curve, pt.get("position"))
+        if pt.load == "curve":
+            f = _curve_force(curve, pt.position)
             load = "on the load curve" + (f" ({fmt_quantity(f, 'N', 'kN', 1)} there)" if f is not None else "")
         else:
-            load = "" if ld is None else ", " + _load(ld) + " load"
-        where = _mm(pt.get("position")) + (" " + load if ld == "curve" else load)
+            load = "" if pt.load is None else ", " + _load(pt.load) + " load"
+        where = _mm(pt.position) + (" " + load if pt.load == "curve" else load)
         out.append(f"Tg is the mean time constant of {len(samples)} nonlinear steps of "
-                   + " and ".join(fmt_quantity(s, "", "%", 0, signed=True) for s in b.get("Tg_steps") or [])
+                   + " and ".join(fmt_quantity(s, "", "%", 0, signed=True) for s in b.Tg_steps)
                    + f" of stroke at {where}: " + ", ".join(fmt_value(v, "s", 3) for v in samples) + ".")
-    runs = b.get("stroke_runs") or {}
-    if runs:
-        o, c = runs.get("opening") or {}, runs.get("closing") or {}
-        load = runs.get("load")
+    if b.stroke_runs:
+        load = b.stroke_runs.get("load")
         out.append("UO and UC come from closed-loop strokes end to end (reference step, 25\u201375 % of stroke extrapolated)"
                    + (f" at a {fmt_quantity(load, 'N', 'kN', digits=3)} closing load" if isinstance(load, (int, float)) else "")
-                   + f": opening {fmt_value(o.get('stroke_time'), 's', 3)}, closing {fmt_value(c.get('stroke_time'), 's', 3)}. "
+                   + f": opening {fmt_value(b.stroke_time('opening'), 's', 3)}, closing {fmt_value(b.stroke_time('closing'), 's', 3)}. "
                    "They differ slightly from the opening and closing times of section 4, which are judged on open-loop "
                    "full strokes at the governor set-up load.")
     return out
@@ -226,7 +228,7 @@ def _mode_figures(mode, after, start: int, specs: list) -> list[dict]:
     """One overlay figure per signal of a replay (with the replay after the diagnosis, when there is one)."""
     figs = []
     for sig, ov in mode.overlays.items():
-        label, unit, scale = SIGNAL_DISPLAY.get(sig, (sig, ov.unit, 1.0))
+        label, unit, scale = _signal(sig, ov.unit)
         series = [("recorded", ov.time, ov.recorded, "recorded"),
                   ("simulated" + (" (before)" if after else ""), ov.time, ov.simulated, "before")]
         aov = after.overlays.get(sig) if after else None
@@ -242,11 +244,11 @@ def _mode_figures(mode, after, start: int, specs: list) -> list[dict]:
 def _mode_context(name: str, mode, after, start: int, specs: list) -> dict:
     """A replay mode of the validation section: figures, fits (before and after), windowed errors, located misses."""
     figs = _mode_figures(mode, after, start, specs)
-    fits = [{"signal": SIGNAL_DISPLAY.get(s, (s,))[0], "fit": fmt_num(f.fit_percent, 3), "nrmse": fmt_num(f.nrmse, 3),
+    fits = [{"signal": _signal(s)[0], "fit": fmt_num(f.fit_percent, 3), "nrmse": fmt_num(f.nrmse, 3),
              "rms": _sig(f.rms_error, s), "max": _sig(f.max_abs_error, s),
              "fit_after": fmt_num(after.fits[s].fit_percent if s in after.fits else None, 3) if after else None}
             for s, f in mode.fits.items()]
-    located = [{"signal": SIGNAL_DISPLAY.get(w.signal, (w.signal,))[0], "start": fmt_num(w.start, 4), "end": fmt_num(w.end, 4),
+    located = [{"signal": _signal(w.signal)[0], "start": fmt_num(w.start, 4), "end": fmt_num(w.end, 4),
                 "peak_ratio": fmt_num(w.peak_ratio, 3), "regimes": ", ".join(regime_text(r) for r in w.dominant)}
                for w in mode.located_windows]
     return {"name": name, "pass": mode.passed, "figures": figs, "fits": fits, "rows": _window_table(mode.window_metrics),
@@ -360,10 +362,10 @@ def _window_table(metrics) -> dict:
     limits = {}
     for r in metrics:
         limits.setdefault((r.signal, r.kind), r.limits)
-    lim_rows = [{"signal": SIGNAL_DISPLAY.get(sg, (sg,))[0], "kind": k,
+    lim_rows = [{"signal": _signal(sg)[0], "kind": k,
                  "text": ", ".join(f"{name.replace('_', ' ')} {_pct(v)} %" for name, v in lim.items() if v is not None)}
                 for (sg, k), lim in limits.items()]
-    return {"signals": [SIGNAL_DISPLAY.get(sg, (sg,))[0] for sg in signals], "rows": rows, "limits": lim_rows}
+    return {"signals": [_signal(sg)[0] for sg in signals], "rows": rows, "limits": lim_rows}
 
 
 def _pct(v) -> str:
@@ -375,5 +377,5 @@ def _sig(v, signal):
     """An error of a signal in its display unit; an error of an absolute pressure is a difference (bar, not bar abs)."""
     if v is None:
         return "\u2013"
-    label, unit, scale = SIGNAL_DISPLAY.get(signal, (signal, "", 1.0))
+    label, unit, scale = _signal(signal)
     return f"{fmt_num(v * scale, 3)} {unit.replace(' abs', '')}"

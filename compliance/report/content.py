@@ -149,7 +149,7 @@ def _run_item(result: CheckResult, run, start: int, specs: list) -> dict:
     for tr in run.traces:
         fid = f"fig-{start + len(specs)}"
         specs.append({"id": fid, "kind": "trace", "trace": tr, "marks": run.marks, "run_kind": run.kind, "tolerance": tol})
-        figs.append({"id": fid, "label": tr.get("label") or run.id, "points": tr.get("points"), "samples": tr.get("samples")})
+        figs.append({"id": fid, "label": tr.label or run.id, "points": tr.points, "samples": tr.samples})
     op = result.requirement_set.operating_points.get(run.operating_point)
     return {"id": run.id, "anchor": "run-" + _slug(run.id), "operating_point": run.operating_point,
             "op_title": op and op.title, "initial_position": op and op.initial_position,

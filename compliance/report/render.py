@@ -46,7 +46,7 @@ def _draw(spec: dict, valve: dict | None = None) -> str:
     from compliance.report import figures, figures_linear
 
     k = spec["kind"]
-    if k == "trace" and spec["trace"].get("kind") == "path3d":
+    if k == "trace" and spec["trace"].kind == "path3d":
         from compliance.report.figures_tracking import path_figure  # plant B's 3-D path overlay and per-axis errors
 
         return path_figure(spec["trace"], spec["id"])

@@ -113,10 +113,6 @@ def _grouped(rows: list[dict]) -> list[dict]:
     return out
 
 
-def _label(trace) -> str:
-    return str(trace.get("label") or "")
-
-
 def _pick_trace(run, which: str | None):
     """The trace of ``run`` that the worst case ``which`` was measured on.
 
@@ -132,14 +128,14 @@ def _pick_trace(run, which: str | None):
         if m and words:
             want = f" {m.group(1)} {m.group(2)} {words[0]}"
             for tr in traces:
-                if _label(tr).endswith(want):
+                if tr.label.endswith(want):
                     return tr
         for tr in traces:
-            tail = _label(tr).rsplit(" ", 1)[-1]
+            tail = tr.label.rsplit(" ", 1)[-1]
             if tail and words and tail == words[0]:
                 return tr
         for tr in traces:
-            tail = _label(tr).rsplit(" ", 1)[-1]
+            tail = tr.label.rsplit(" ", 1)[-1]
             if tail and tail in which:
                 return tr
     return traces[0]
@@ -162,11 +158,11 @@ def _stroke_partner(run, tr, entries: list):
     """The other direction's stroke when a page judges both opening and closing times on the same run."""
     if not {"opening_time", "closing_time"} <= {e.metric for e in entries}:
         return None
-    label = _label(tr)
+    label = tr.label
     for a, b in (("opening", "closing"), ("closing", "opening")):
         if label.endswith(" " + a):
             want = label[: -len(a)] + b
-            return next((t for t in run.traces if _label(t) == want), None)
+            return next((t for t in run.traces if t.label == want), None)
     return None
 
 
@@ -174,7 +170,7 @@ def _speed_excess(trace, limit: float) -> dict | None:
     """How far and how long the speed exceeds ``limit`` [m/s] in a trace (what matters for water hammer)."""
     import numpy as np
 
-    t, x = trace.get("time"), trace.get("position")
+    t, x = trace.signal("time"), trace.signal("position")
     if not t or not x or len(t) < 3:
         return None
     t = np.asarray(t, float)
@@ -226,10 +222,10 @@ def _figure(result, lead, entries, reqs, page, specs, start) -> None:
     if tr is None:
         return
     fid = f"fig-{start + len(specs)}"
-    if tr.get("kind") == "path3d":
+    if tr.kind == "path3d":
         specs.append({"id": fid, "kind": "trace", "trace": tr, "marks": (), "run_kind": run.kind})
         page["figure"] = {"id": fid, "run": run.id, "procedure": run.procedure, "operating_point": run.operating_point,
-                          "which": w.which, "trace": tr.get("label"), "limit_drawn": False}
+                          "which": w.which, "trace": tr.label, "limit_drawn": False}
         return
     lim = lead.rows[0].limit if lead.rows else None
     spec = {"id": fid, "kind": "trace", "trace": tr, "marks": run.marks, "run_kind": run.kind,
@@ -243,9 +239,9 @@ def _figure(result, lead, entries, reqs, page, specs, start) -> None:
     elif lead.metric == "dead_band" and run.kind == "dead_band":  # the loop, with the width allowed
         spec = {"id": fid, "kind": "dead_band", "trace": tr, "limit": max(lim) if lim else None}
     specs.append(spec)
-    shown = [trace_words(t.get("label"), run) for t in ([tr, partner] if partner is not None else [tr])]
+    shown = [trace_words(t.label, run) for t in ([tr, partner] if partner is not None else [tr])]
     page["figure"] = {"id": fid, "run": run.id, "procedure": run.procedure, "operating_point": run.operating_point,
-                      "which": " and ".join(x for x in shown if x), "trace": tr.get("label"),
+                      "which": " and ".join(x for x in shown if x), "trace": tr.label,
                       "limit_drawn": any(spec.get(k) is not None for k in ("tolerance", "speed_limit", "limit")),
                       "kind": spec["kind"], "tau": spec.get("tau_window") is not None,
                       "band_scaled": spec.get("tolerance") is not None}
@@ -290,12 +286,13 @@ def requirement_pages(result, start: int = 1) -> tuple[list[dict], list[dict]]:
 def _linear_contrast(result) -> str | None:
     """Why the linear time constant and HYGOV Tg can pass while the simulated steps fail."""
     lin = [e for e in result.requirements if e.metric == "time_constant" and e.source == "linear"]
-    gov = ((result.linear or {}).get("governor") or {}).get("parameters") or {}
+    linear = result.linear_section
+    tg = linear.governor.parameters.get("Tg") if linear is not None and linear.governor is not None else None
     parts = []
     if lin and lin[0].worst is not None and lin[0].worst.value is not None:
         parts.append(f"the linearised loop gives {metric_text(lin[0].worst.value, 'time_constant')} ({lin[0].id})")
-    if gov.get("Tg") is not None:
-        parts.append(f"the HYGOV fit gives Tg = {fmt_value(gov['Tg'], 's', 3)}")
+    if tg is not None:
+        parts.append(f"the HYGOV fit gives Tg = {fmt_value(tg, 's', 3)}")
     if not parts:
         return None
     return ("Why a smaller time constant appears elsewhere: " + " and ".join(parts) + ". Both are small-signal figures "

@@ -16,6 +16,7 @@ from compliance.model.parameters import used_by_model
 from compliance.presentation.values import limit_as_written, metric_text
 from compliance.requirements.verdict import Overall, Status
 from compliance.results.check_result import CheckResult
+from compliance.results.remedies import RemedySection
 from compliance.results.requirement_set import FileRecord
 from compliance.results.rows import WorstCase
 from compliance.results.summary import CaseCoverage, Qualifier
@@ -111,21 +112,17 @@ def _remedy_lines(rem) -> dict:
     """Requirement id -> one line on what would fix it, from a ``remedies`` section (docs/results-schema.md)."""
     if not rem:
         return {}
-    out = {}
-    fix = rem.get("remedy")
-    if fix:
-        changes = ", ".join(f"{c['path']} from {fmt_si(c['from'], c['unit'])} to {fmt_si(c['to'], c['unit'])}"
-                            for c in fix.get("changes", []))
-        for rid in rem.get("failed", []):
-            out[rid] = f"passes with {changes} (verified by a full campaign: {fix.get('verified', {}).get('status', 'not run')})"
-        return out
-    for rid in rem.get("out_of_reach", []):
-        out[rid] = "out of reach of every adjustable setting searched; needs a hardware or design change"
-    for s in rem.get("sensitivities", []):
-        best = next((b for b in s.get("by_parameter", []) if b.get("delta_margin_pct", 0) > 0), None)
-        if s["requirement"] not in out and best:
-            out[s["requirement"]] = (f"no passing setting found; {best['path']} helps most "
-                                     f"({best['delta_margin_pct']:+.1f} points per {fmt_si(best['step'], best['unit'])})".replace("-", "\u2212"))
+    rem = RemedySection.from_dict(rem, "results.remedies")
+    if rem.remedy is not None:
+        changes = ", ".join(f"{c.path} from {fmt_si(c.start, c.unit)} to {fmt_si(c.end, c.unit)}" for c in rem.remedy.changes)
+        verified = rem.remedy.verified.get("status", "not run")
+        return {rid: f"passes with {changes} (verified by a full campaign: {verified})" for rid in rem.failed}
+    out = {rid: "out of reach of every adjustable setting searched; needs a hardware or design change" for rid in rem.out_of_reach}
+    for s in rem.sensitivities:
+        best = s.most_helpful
+        if s.requirement not in out and best:
+            out[s.requirement] = (f"no passing setting found; {best.path} helps most "
+                                  f"({best.delta_margin_pct:+.1f} points per {fmt_si(best.step, best.unit)})".replace("-", "\u2212"))
     return out
 
 

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 from compliance.results.record import FrozenDict, Record, key, records, tuple_of
 
-__all__ = ["Bode", "CrossCheckRow", "GovernorRecord", "LinearAnalysisRecord", "LinearFigures", "LinearPoint",
+__all__ = ["Bode", "CrossCheckRow", "GovernorBasis", "GovernorRecord", "LinearAnalysisRecord", "LinearFigures", "LinearPoint",
            "LinearSection", "OperatingMapRecord", "Poles", "PredictedStep"]
 
 
@@ -155,6 +155,23 @@ class CrossCheckRow(Record):
 
 
 @dataclass(frozen=True, kw_only=True)
+class GovernorBasis(Record):
+    """Where the HYGOV figures come from: the Tg steps (at ``Tg_point``, their fractions of the stroke and
+    nonlinear time constants [s]) and the strokes behind UO and UC, or the export's own sentences."""
+
+    sentences: tuple[str, ...] = key(default=(), read=tuple_of(str))
+    Tg_point: LinearPoint = key(factory=LinearPoint, read=LinearPoint.from_dict)
+    Tg_steps: tuple[float, ...] = ()
+    Tg_nonlinear_samples: tuple = ()
+    stroke_runs: FrozenDict = key(factory=FrozenDict)  # {opening: {stroke_time, ...}, closing: {...}, load}
+    extra: FrozenDict = key(factory=FrozenDict)
+
+    def stroke_time(self, direction: str):
+        """The closed-loop stroke time [s] of ``direction`` (opening / closing), None when not run."""
+        return (self.stroke_runs.get(direction) or {}).get("stroke_time")
+
+
+@dataclass(frozen=True, kw_only=True)
 class GovernorRecord(Record):
     """The equivalent HYGOV gate-servo parameters and where they come from."""
 
@@ -163,7 +180,7 @@ class GovernorRecord(Record):
     rate_limits: FrozenDict = key(factory=FrozenDict)
     units: FrozenDict = key(factory=FrozenDict)
     Tg_linear: float | None = None
-    basis: FrozenDict = key(factory=FrozenDict)
+    basis: GovernorBasis = key(factory=GovernorBasis, read=GovernorBasis.from_dict)
     extra: FrozenDict = key(factory=FrozenDict)
 
 

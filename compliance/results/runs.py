@@ -11,7 +11,7 @@ from compliance.results.keys import RequestKey
 from compliance.results.record import FrozenDict, Record, key, records, tuple_of
 from compliance.results.rows import SampleRecord
 
-__all__ = ["Finding", "RunRecord", "Timing", "Unjudged"]
+__all__ = ["Finding", "Mark", "RunRecord", "Timing", "Trace", "Unjudged"]
 
 
 def _metrics(v, where) -> FrozenDict:
@@ -22,6 +22,37 @@ def _metrics(v, where) -> FrozenDict:
 
 def _metrics_json(v) -> dict:
     return {str(k): [s.as_dict() for s in samples] for k, samples in v.items()}
+
+
+@dataclass(frozen=True, kw_only=True)
+class Trace(Record):
+    """One simulation's signals for plots: at most 2000 evenly chosen samples per signal (SI: s, m, V, Pa abs)."""
+
+    label: str = ""
+    kind: str | None = key(omit_none=True, default=None)  # "path3d": plant B's path in space (per-axis signals)
+    points: int = 0  # samples kept per signal
+    samples: int = 0  # samples simulated
+    extra: FrozenDict = key(factory=FrozenDict)  # the signals by name: time, reference, position, valve_command, ...
+
+    def signal(self, name: str) -> tuple | None:
+        """The samples of signal ``name`` (None when the trace does not carry it)."""
+        return self.extra.get(name)
+
+    @property
+    def direction(self) -> str:
+        """The last word of the label (``opening`` / ``closing`` for a stroke)."""
+        return self.label.rsplit(" ", 1)[-1]
+
+
+@dataclass(frozen=True, kw_only=True)
+class Mark(Record):
+    """A point, band or window drawn on a trace (``value`` SI; ``[t, x]`` pairs are time [s] and position [m])."""
+
+    trace: str | None = None  # the label of the trace it belongs to
+    step: int | None = key(omit_none=True, default=None)  # which step of a sequence (1-based)
+    type: str = ""
+    value: object = None
+    extra: FrozenDict = key(factory=FrozenDict)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -36,8 +67,8 @@ class RunRecord(Record):
     error: str | None = None  # why the run failed (its rows are not evaluated)
     notes: tuple[str, ...] = key(default=(), read=tuple_of(str))
     metrics: FrozenDict = key(factory=FrozenDict, read=_metrics, write=_metrics_json)
-    traces: tuple[FrozenDict, ...] = key()  # {label, points, samples, time, position, ...} (SI)
-    marks: tuple[FrozenDict, ...] = ()  # {trace, type, value[, step]} (SI)
+    traces: tuple[Trace, ...] = key(read=records(Trace))
+    marks: tuple[Mark, ...] = key(default=(), read=records(Mark))
     wall_time: float | None = key(omit_none=True, default=None)  # [s]; absent in a reproducible file
 
     def samples(self, request: RequestKey | str) -> tuple[SampleRecord, ...]:
