@@ -45,6 +45,7 @@ EFFECT = Effect(
     name="position_dependent_friction",
     meaning="the seal's friction level changes along the stroke (squeeze varying with the bore)",
     short="xf",
+    slot=P_XF_ON,
     # +-10 /m moves the level by +-0.8 at the ends of a 0.16 m stroke: the bench's +-40 /m over its 40 mm travel
     params=(Param("position_gradient", "1/m", "relative change of both friction levels per metre of travel at mid-stroke",
                   0.0, (-10.0, 10.0), slot="grad"),),

@@ -19,9 +19,8 @@ from compliance.effects import EFFECTS
 from compliance.model.config import PlantConfig
 from compliance.model.pid_controller import pid_sample, saturate
 from compliance.errors import InputError, SimulationError
-from compliance.effects.valve_dynamics import P_VD_ON, S_SP
 from compliance.model.vector_slots import N_STATES, P_UCEN, P_ULIM, S_PA, S_PB, S_V, S_X
-from compliance.model.assembly import plant_rhs, valve_lag_input
+from compliance.model.assembly import plant_rhs, settle_valve
 from compliance.model.plant_vector import load_curve_arrays, parameter_vector
 from compliance.model.rest_state import initial_state
 from compliance.simulation.rk4 import OUTPUT_COLUMNS, measured_position, non_physical, record_sample, rk4_step, rk4_workspace
@@ -156,8 +155,7 @@ def tracking_core(P, C, y0, ref, dref, ddref, pos_noise, pos_quantum, pa_noise, 
     x_filt = 0.0
     integral = 0.0
     u_rel = 0.0
-    if P[P_VD_ON] != 0.0:
-        y[S_SP] = valve_lag_input(P, P[P_UCEN])
+    settle_valve(P, y, P[P_UCEN])  # the valve's lag at rest on the centre command
     for k in range(n_samples + 1):
         # --- measurements and estimates at t_k
         xm = measured_position(y[S_X], pos_noise[k], pos_quantum)
@@ -257,8 +255,8 @@ def simulate_axis(cfg: PlantConfig, reference: AxisReference, *, mode: str | Non
         Non-physical state.
     """
     where = cfg.path or cfg.name
-    for e, values in cfg.effects.items():  # the declarations say what this loop can run (Effect.plant_b, input_delay)
-        if not EFFECTS[e].plant_b:
+    for e, values in cfg.effects.items():  # the declarations say what this loop can run (Effect.loop_states, input_delay)
+        if EFFECTS[e].loop_states:  # this loop differentiates the raw position: it holds no sampled filter of its own
             raise InputError(f"{where}: effect {e} is not supported by the tracking loop (use govcheck simulate)")
         if EFFECTS[e].input_delay and values.get(EFFECTS[e].input_delay, 0.0) > 0.0:
             raise InputError(f"{where}: a {e} delay is not supported by the tracking loop")
