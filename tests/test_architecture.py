@@ -11,6 +11,7 @@ a lazy import inside a function counts like any other.
 from __future__ import annotations
 
 import ast
+import re
 from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parents[1] / "compliance"
@@ -269,3 +270,55 @@ def test_one_process_pool_implementation():
             elif isinstance(node, ast.Attribute) and node.attr in _POOL_NAMES:
                 found.append(f"{name}: uses .{node.attr}")
     assert not found, "process pools outside compliance/processes (use compliance.processes.map_tasks):\n" + "\n".join(found)
+
+
+# an effect's slot constants (P_<SHORT>_..., S_<slot>) are read outside effects/ only by the one composition module
+# (plant_rhs composes the structural effects' kernels) and two simulator modules (the sampled loop holds sensor_lag's
+# filter and the delay lines, the recorder writes the effects' states); everything else goes through the declarations
+SLOT_READERS = {"compliance.model.assembly", "compliance.simulation.rk4", "compliance.simulation.pid_loop"}
+_SLOT_NAME = re.compile(r"^[PS]_[A-Z0-9_]+$")
+
+
+def _effect_slot_reads(tree: ast.Module, effect_modules: set[str]) -> list[str]:
+    """Slot constants of an effect module that ``tree`` imports or reads through a module alias."""
+    found, aliases = [], set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            if node.module in effect_modules:
+                found += [f"{node.module}.{a.name}" for a in node.names if _SLOT_NAME.match(a.name)]
+            aliases |= {a.asname or a.name for a in node.names if f"{node.module}.{a.name}" in effect_modules}
+        elif isinstance(node, ast.Import):
+            aliases |= {a.asname for a in node.names if a.name in effect_modules and a.asname}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Attribute) and _SLOT_NAME.match(node.attr):
+            base = ast.unparse(node.value)
+            if base in aliases or base in effect_modules:
+                found.append(f"{base}.{node.attr}")
+    return found
+
+
+def _effect_module_names() -> set[str]:
+    return {m for m in _modules() if m.startswith("compliance.effects.")}
+
+
+def test_effect_slots_are_read_by_at_most_three_modules_outside_effects():
+    effect_modules = _effect_module_names()
+    readers = {}
+    for name, path in _modules().items():
+        if _layer(name) == "effects":
+            continue
+        reads = _effect_slot_reads(ast.parse(path.read_text()), effect_modules)
+        if reads:
+            readers[name] = reads
+    assert len(SLOT_READERS) <= 3
+    stray = {m: r for m, r in readers.items() if m not in SLOT_READERS}
+    assert not stray, ("effect slot constants read outside effects/ (use the declarations and the hooks of "
+                       "compliance.effects.structure instead):\n" + "\n".join(f"{m}: {', '.join(r)}" for m, r in stray.items()))
+
+
+def test_the_slot_rule_sees_imports_and_module_aliases():
+    src = ("from compliance.effects.heat_transfer import S_TA, wall_heat_flow\n"
+           "from compliance.effects import supply_droop\nimport compliance.effects.sensor_lag as sl\n"
+           "a = supply_droop.P_SD_ON + sl.P_SL_TAU + supply_droop.reservoir_pressure_rate\n")
+    found = _effect_slot_reads(ast.parse(src), _effect_module_names())
+    assert sorted(found) == ["compliance.effects.heat_transfer.S_TA", "sl.P_SL_TAU", "supply_droop.P_SD_ON"]
