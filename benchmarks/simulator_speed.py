@@ -17,7 +17,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from compliance.model.config import load_plant  # noqa: E402
 from compliance.simulation.profiles import Profile, steps  # noqa: E402
-from compliance.simulation import Scenario, simulate  # noqa: E402
+from compliance.simulation import Scenario  # noqa: E402
+from compliance.plants import simulate  # noqa: E402
 from tests.simulation import reference_model as ref  # noqa: E402
 
 

@@ -17,8 +17,8 @@ from pathlib import Path
 PACKAGE = Path(__file__).resolve().parents[1] / "compliance"
 
 # bottom first: a package may import from itself and from packages before it in this list
-LAYERS = ["errors", "processes", "units", "files", "physics", "effects", "model", "simulation", "metrics", "linear",
-          "tracking", "procedures", "requirements", "presentation", "campaign", "sweep", "recordings", "validation",
+LAYERS = ["errors", "processes", "units", "files", "physics", "effects", "model", "simulation", "plants", "metrics",
+          "linear", "tracking", "procedures", "requirements", "presentation", "campaign", "sweep", "recordings", "validation",
           "characterise", "diagnosis", "report", "papers", "cli", "__main__"]
 
 
@@ -322,3 +322,52 @@ def test_the_slot_rule_sees_imports_and_module_aliases():
            "a = supply_droop.P_SD_ON + sl.P_SL_TAU + supply_droop.reservoir_pressure_rate\n")
     found = _effect_slot_reads(ast.parse(src), _effect_module_names())
     assert sorted(found) == ["compliance.effects.heat_transfer.S_TA", "sl.P_SL_TAU", "supply_droop.P_SD_ON"]
+
+
+# a plant kind is a room (compliance/plants, docs/internals.md "Adding a plant kind"): nothing outside it reads
+# controller.type, and the package switches on a kind's name in at most MAX_KIND_SWITCHES places
+KIND_NAMES = {"pid", "state_feedback"}
+MAX_KIND_SWITCHES = 6
+
+
+def _constants(node: ast.AST) -> set:
+    if isinstance(node, ast.Constant):
+        return {node.value}
+    if isinstance(node, (ast.Tuple, ast.List, ast.Set)):
+        return {e.value for e in node.elts if isinstance(e, ast.Constant)}
+    return set()
+
+
+def _kind_switches(tree: ast.Module) -> list[tuple[int, str]]:
+    """(line, what) of every plant-kind switch: a read of ``controller.type``, a comparison with a kind's name,
+    a table keyed by the kinds' names, an effect flag for one plant."""
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Subscript) and "controller.type" in _constants(node.slice):
+            found.append((node.lineno, "reads controller.type"))
+        elif (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr == "get"
+              and node.args and "controller.type" in _constants(node.args[0])):
+            found.append((node.lineno, "reads controller.type"))
+        elif isinstance(node, ast.Compare) and KIND_NAMES & set().union(*map(_constants, [node.left, *node.comparators])):
+            found.append((node.lineno, "compares with a kind's name"))
+        elif isinstance(node, ast.Dict) and KIND_NAMES <= {k.value for k in node.keys if isinstance(k, ast.Constant)}:
+            found.append((node.lineno, "a table keyed by the kinds"))
+        elif (isinstance(node, ast.Attribute) and node.attr == "plant_b") or (isinstance(node, ast.keyword) and node.arg == "plant_b"):
+            found.append((node.lineno, "an effect flag for one plant"))
+    return found
+
+
+def test_plant_kinds_are_switched_in_their_room_only():
+    switches = {name: _kind_switches(ast.parse(path.read_text())) for name, path in _modules().items()}
+    outside = [f"{name}:{line}: {what}" for name, found in switches.items() if not name.startswith("compliance.plants")
+               for line, what in found if what == "reads controller.type"]
+    assert not outside, "controller.type read outside compliance/plants (ask plants.kind_of(cfg)):\n" + "\n".join(outside)
+    total = [f"{name}:{line}: {what}" for name, found in switches.items() for line, what in found]
+    assert len(total) <= MAX_KIND_SWITCHES, "plant-kind switches (give the kind a method instead):\n" + "\n".join(total)
+
+
+def test_the_kind_rule_sees_reads_comparisons_and_tables():
+    src = ('a = cfg.options["controller.type"]\nb = o.get("controller.type", "pid")\nif m == "pid": pass\n'
+           'if m in ("state_feedback",): pass\nT = {"pid": 1, "state_feedback": 2}\nS = {"pid": True}\n'
+           'E = Effect(plant_b=False)\nname = "pid"\n')
+    assert sorted(line for line, _ in _kind_switches(ast.parse(src))) == [1, 2, 3, 4, 5, 7]

@@ -225,7 +225,7 @@ def simulate_axis(cfg: PlantConfig, reference: AxisReference, *, mode: str | Non
         Sampled at ``controller.sample_time``; the run lasts ``len - 1`` samples and starts at
         rest at ``reference.position[0]``.
     mode : {"state_feedback", "pid"}, optional
-        Default ``controller.type``.
+        The seed 001 state feedback (default), or the configuration's PID on the same loop (comparison).
     compensation, feedforward : bool, optional
         Default from the configuration.
     load : float, optional
@@ -295,7 +295,7 @@ def simulate_axis(cfg: PlantConfig, reference: AxisReference, *, mode: str | Non
 def simulate_state_feedback(cfg: PlantConfig, scenario: Scenario) -> pd.DataFrame:
     """Closed loop under the seed 001 state-feedback controller (plant B), seed 001 figs. 5-6."""
     if isinstance(scenario.load, str):
-        raise InputError(f"{cfg.name}: a load curve is not supported with controller.type = '{cfg.options['controller.type']}'")
+        raise InputError(f"{cfg.name}: a load curve is not supported by the state-feedback loop (a constant load is)")
     ts = cfg.p("controller.sample_time")
     n = int(round(scenario.duration / ts))
     t = np.arange(n + 1) * ts
