@@ -3,7 +3,7 @@
 The plant is ``compliance.model.assembly.plant_rhs`` integrated by ``compliance.simulation.rk4.rk4_step``
 (the same physics and integrator as ``govcheck simulate``); the controller
 (:mod:`compliance.model.state_feedback`) runs every ``controller.sample_time`` with a
-zero-order hold. In PID mode the loop reproduces ``compliance.simulation.simulate`` sample for
+zero-order hold. In PID mode the loop reproduces the PID loop (``compliance.simulation.pid_loop``) sample for
 sample (tests), so the two controllers are compared on one footing.
 """
 
