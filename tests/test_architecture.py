@@ -19,7 +19,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "compliance"
 # bottom first: a package may import from itself and from packages before it in this list
 LAYERS = ["errors", "processes", "units", "files", "physics", "effects", "model", "simulation", "plants", "metrics",
           "linear", "tracking", "procedures", "requirements", "presentation", "campaign", "sweep", "recordings", "validation",
-          "characterise", "diagnosis", "report", "papers", "cli", "__main__"]
+          "characterise", "diagnosis", "acceptance", "report", "papers", "cli", "__main__"]
 
 
 def _modules() -> dict[str, Path]:
