@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 from compliance.effects.param import Param
 
@@ -40,8 +41,7 @@ class State:
     shadows: str | None = None
 
 
-@dataclass(frozen=True)
-class Rest:
+class Rest(NamedTuple):  # a tuple: built at every restart of a replay, where a frozen dataclass costs microseconds
     """A servo held at rest, as the effects' rest hooks read it (SI, absolute pressures).
 
     Attributes
@@ -101,8 +101,7 @@ class Balance:
     piston_force: Callable[[float, float], float]
 
 
-@dataclass(frozen=True)
-class ReplayPoint:
+class ReplayPoint(NamedTuple):
     """What a replay knows where it restarts a segment from a recording.
 
     Attributes

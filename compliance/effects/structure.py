@@ -16,18 +16,25 @@ from compliance.effects.catalogue import ALL_EFFECTS
 __all__ = ["at_rest", "hold_at_rest", "reading_lags", "reset_for_replay", "trim_balance", "trim_null", "trim_states"]
 
 
+def _declared(hook: str) -> tuple:
+    """The effects' ``hook`` functions, in declared order (a replay restarts many times: looked up once)."""
+    return tuple(getattr(e, hook) for e in ALL_EFFECTS if getattr(e, hook) is not None)
+
+
+_REST, _HOLD, _TRIM_BALANCE, _TRIM_NULL, _TRIM = map(_declared, ("rest", "hold", "trim_balance", "trim_null", "trim"))
+_REPLAY_RESET, _READING_LAG = _declared("replay_reset"), _declared("reading_lag")
+
+
 def at_rest(P, y, rest: Rest) -> None:
     """Every effect's states in a servo at rest (in place)."""
-    for e in ALL_EFFECTS:
-        if e.rest is not None:
-            e.rest(P, y, rest)
+    for rest_state in _REST:
+        rest_state(P, y, rest)
 
 
 def hold_at_rest(P, y, rest: Rest) -> None:
     """The states that share the load in a servo held at rest, of the effects switched on (in place)."""
-    for e in ALL_EFFECTS:
-        if e.hold is not None:
-            e.hold(P, y, rest)
+    for hold in _HOLD:
+        hold(P, y, rest)
 
 
 def trim_balance(P, balance: Balance):
@@ -38,27 +45,24 @@ def trim_balance(P, balance: Balance):
     tuple or None
         (closing force on the actuator [N], ``balance.pressures`` of it, {state index: value}).
     """
-    for e in ALL_EFFECTS:
-        if e.trim_balance is not None:
-            found = e.trim_balance(P, balance)
-            if found is not None:
-                return found
+    for share in _TRIM_BALANCE:
+        found = share(P, balance)
+        if found is not None:
+            return found
     return None
 
 
 def trim_null(P, null: float) -> float:
     """The valve command at the trim [V], from the core's ``null`` through the effects' ``trim_null`` hooks."""
-    for e in ALL_EFFECTS:
-        if e.trim_null is not None:
-            null = e.trim_null(P, null)
+    for shift in _TRIM_NULL:
+        null = shift(P, null)
     return null
 
 
 def trim_states(P, y, null: float) -> None:
     """The effects' states at the trim with the valve command at ``null`` [V] (in place)."""
-    for e in ALL_EFFECTS:
-        if e.trim is not None:
-            e.trim(P, y, null)
+    for trim in _TRIM:
+        trim(P, y, null)
 
 
 def reset_for_replay(P, y, point: ReplayPoint) -> None:
@@ -67,9 +71,8 @@ def reset_for_replay(P, y, point: ReplayPoint) -> None:
     Call it after the core's states are set from the recording and before the load-sharing
     states are (``compliance.model.rest_state.set_rest_internal_states``).
     """
-    for e in ALL_EFFECTS:
-        if e.replay_reset is not None:
-            e.replay_reset(P, y, point)
+    for reset in _REPLAY_RESET:
+        reset(P, y, point)
 
 
 def reading_lags(P) -> tuple[float, ...]:
@@ -79,7 +82,6 @@ def reading_lags(P) -> tuple[float, ...]:
     position at the recorded time plus each of them.
     """
     lags: tuple[float, ...] = ()
-    for e in ALL_EFFECTS:
-        if e.reading_lag is not None:
-            lags += tuple(e.reading_lag(P))
+    for lag in _READING_LAG:
+        lags += tuple(lag(P))
     return lags

@@ -40,9 +40,9 @@ def pneumatic_forces(P: np.ndarray, pa: float, pb: float) -> tuple[float, float]
 
 def rest_of(P: np.ndarray, y: np.ndarray, lx: np.ndarray, ly: np.ndarray) -> Rest:
     """The servo at rest as the effects' rest hooks read it: position, pressures, forces and load of ``y``."""
-    return Rest(position=float(y[S_X]), pressure_a=float(y[S_PA]), pressure_b=float(y[S_PB]), supply_pressure=float(P[P_PS]),
-                supply_temperature=float(P[P_TS]), stroke=float(P[P_STROKE]), tandem=bool(P[P_ARR] == 0.0),
-                piston_forces=pneumatic_forces(P, y[S_PA], y[S_PB]), load=lambda at: load_force(P, at, lx, ly))
+    # positional and unconverted: a replay builds one at every restart
+    return Rest(y[S_X], y[S_PA], y[S_PB], P[P_PS], P[P_TS], P[P_STROKE], P[P_ARR] == 0.0,
+                pneumatic_forces(P, y[S_PA], y[S_PB]), lambda at: load_force(P, at, lx, ly))
 
 
 def set_rest_internal_states(P: np.ndarray, y: np.ndarray, lx: np.ndarray, ly: np.ndarray, v: float = 0.0) -> None:

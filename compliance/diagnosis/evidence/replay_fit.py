@@ -333,7 +333,8 @@ def _reset_state(cfg, P, setup: ReplaySetup, k: int, previous: np.ndarray, lx, l
     y = initial_state(cfg, P, min(max(x, 0.0), P[P_STROKE]), (pa, pb))
     y[S_V] = v
     # the effects' states at the restart: measured ones from the recording, the others carried over
-    reset_for_replay(P, y, ReplayPoint(v, {s: float(a[k]) for s, a in st.items()}, {c: previous[k, i] for c, i in _OUT.items()}))
+    measured = {s: float(st[s][k]) for s in SIGNALS if s in st}
+    reset_for_replay(P, y, ReplayPoint(v, measured, dict(zip(OUTPUT_COLUMNS, previous[k].tolist()))))
     set_rest_internal_states(P, y, lx, ly, v)  # bristles carry the net force, the link its share
     return y
 
