@@ -390,13 +390,15 @@ def test_failed_render_leaves_previous_report_intact(tmp_path, monkeypatch):
 
 
 def test_cli_report_rerenders_without_simulating(tmp_path, monkeypatch, capsys):
-    import compliance.simulation.dispatch as sim  # every simulation passes through its two loops
-    import compliance.simulation.state_feedback_loop as sf  # (imported by dispatch when a run needs it)
+    import compliance.plants.kind as sim  # every simulation passes through its two loops
+    import compliance.plants.pid_servo as pid
+    import compliance.simulation.state_feedback_loop as sf  # (imported by the state-feedback drive when a run needs it)
 
     def no_sim(*a, **k):
         raise AssertionError("govcheck report must not simulate")
 
     monkeypatch.setattr(sim, "simulate_pid", no_sim)
+    monkeypatch.setattr(pid, "simulate_pid", no_sim)
     monkeypatch.setattr(sf, "simulate_state_feedback", no_sim)
     res = _results()
     res["runs"] = res["runs"][:1]

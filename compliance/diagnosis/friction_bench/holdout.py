@@ -172,7 +172,7 @@ def prove_out_of_sample(runs, fits: dict, law: str, try_effects: bool, *, jobs: 
     """The held-out table of ``law`` and, when ``try_effects``, which declared bench effects earn their place.
 
     The bench effects (``fit.BENCH_EFFECTS``: nonlinear_pressure_friction, pressure_force_curvature,
-    position_dependent_friction, friction_drift, in that order) are tried one after another on the law kept so far;
+    friction_along_stroke, friction_drift, in that order) are tried one after another on the law kept so far;
     one is kept when it earns its parameters on held-out runs (``earns``) *and* lowers the BIC by
     ``selection.SIGNIFICANCE`` over all runs.
 
