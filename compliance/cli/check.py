@@ -111,8 +111,9 @@ def run(args) -> int:
 
     _check_first(args)
     cfg = plant_from_args(args)
-    prepared = Check.of(cfg, args.requirements, linear=args.linear, remedies=args.remedies, allow_conflicts=args.allow_conflicts,
-                        uncertainty="local" if args.uncertainty is None else args.uncertainty)  # every input, before any work
+    uncertainty = "local" if args.uncertainty is None else args.uncertainty
+    prepared = Check.of(cfg, args.requirements, linear=args.linear, remedies=args.remedies, uncertainty=uncertainty,
+                        allow_conflicts=args.allow_conflicts)  # every input checked before any work
     render = args.report or args.pdf
     stages = ["campaign"] + ["linear analysis"] * bool(args.linear) + ["report"] * bool(render)
     # the campaign reports its runs itself on a terminal; in a CI log these stage lines (and a heartbeat) show progress

@@ -50,7 +50,8 @@ def check_uncertainty(uncertainty, cfg=None) -> None:
     if uncertainty in (None, "local", 0):
         return
     if isinstance(uncertainty, bool) or not isinstance(uncertainty, int):
-        raise InputError(f"uncertainty={uncertainty!r}: expected 'local', 0 (point values) or a number of plants (>= 2)")
+        raise InputError(f"uncertainty={uncertainty!r}: expected 'local', 0 (point values) or a number of plants "
+                         "(>= 2)")
     if uncertainty < 2:
         raise InputError(f"--uncertainty {uncertainty}: expected at least 2 plants (or 0 for point values)")
     if cfg is not None:
@@ -168,9 +169,9 @@ class Check:
         return result
 
 
-def check(plant, requirements, *, linear: bool = False, remedies=None, uncertainty="local", scheduler: str | None = None,
-          jobs: int | None = None, allow_conflicts: bool = False, progress: bool = False, command_line: str | None = None,
-          remedy_options: dict | None = None, on_stage=None) -> CheckResult:
+def check(plant, requirements, *, linear: bool = False, remedies=None, uncertainty="local",
+          scheduler: str | None = None, jobs: int | None = None, allow_conflicts: bool = False, progress: bool = False,
+          command_line: str | None = None, remedy_options: dict | None = None, on_stage=None) -> CheckResult:
     """Judge ``plant`` against ``requirements``, with evidence, in one call.
 
     Parameters

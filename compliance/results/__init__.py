@@ -20,8 +20,9 @@ from compliance.results.runs import Finding, Mark, RunRecord, Timing, Trace, Unj
 from compliance.results.site_result import SITE_SCHEMA, SiteResult, typed_results
 from compliance.results.summary import Counts, Qualifier, Summary
 
-__all__ = ["RESULTS_SCHEMA", "SITE_SCHEMA", "Band", "CheckResult", "Counts", "Coverage", "EffectRecord", "EntryCoverage", "Finding",
-           "LoadCurve", "Mark", "OperatingPointRecord", "ParameterRecord", "PlantRecord", "ProcedureRecord", "Qualifier",
+__all__ = ["RESULTS_SCHEMA", "SITE_SCHEMA", "Band", "CheckResult", "Counts", "Coverage", "EffectRecord", "EntryCoverage",
+           "Finding", "LoadCurve", "Mark", "OperatingPointRecord", "ParameterRecord", "PlantRecord", "ProcedureRecord",
+           "Qualifier",
            "RequestKey", "RequirementSetRecord", "RequirementSpec", "RequirementVerdict", "RowTexts", "RunRecord",
            "SampleRecord", "SiteResult", "Summary", "Timing", "Trace", "Unjudged", "VerdictRow", "WorstCase",
            "typed_results"]

@@ -1,4 +1,4 @@
-"""The result of ``compliance.check``: one frozen, typed object that the terminal, the files, the gate and the report read.
+"""The result of ``compliance.check``: one frozen, typed object the terminal, the files, the gate and the report read.
 
 A result is made once (``compliance.pipeline.chain``) or read back from its JSON
 (:meth:`CheckResult.from_json`); :meth:`CheckResult.as_dict` gives the JSON object of schema
@@ -90,7 +90,8 @@ class CheckResult(Record):
         """
         need(data, where)
         if "schema" not in data:
-            raise InputError(f"{where}: key 'schema' is missing (expected a govcheck results file, schema '{RESULTS_SCHEMA}')")
+            raise InputError(f"{where}: key 'schema' is missing (expected a govcheck results file, schema "
+                             f"'{RESULTS_SCHEMA}')")
         if data["schema"] != RESULTS_SCHEMA:
             raise InputError(f"{where}: key 'schema' is '{data['schema']}'; this govcheck reads '{RESULTS_SCHEMA}' "
                              "(re-run 'govcheck check' to regenerate the results)")

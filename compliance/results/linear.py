@@ -9,15 +9,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from compliance.results.record import FrozenDict, Record, key, records, tuple_of
+from compliance.results.record import FrozenDict, Record, key, optional, records, tuple_of
 
-__all__ = ["Bode", "CrossCheckRow", "GovernorBasis", "GovernorRecord", "LinearAnalysisRecord", "LinearFigures", "LinearPoint",
-           "LinearSection", "OperatingMapRecord", "Poles", "PredictedStep"]
-
-
-def _optional(cls):
-    """Reader of an optional section: an empty object is no section."""
-    return lambda v, where: cls.from_dict(v, where) if v else None
+__all__ = ["Bode", "CrossCheckRow", "GovernorBasis", "GovernorRecord", "LinearAnalysisRecord", "LinearFigures",
+           "LinearPoint", "LinearSection", "OperatingMapRecord", "Poles", "PredictedStep"]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -105,7 +100,7 @@ class LinearAnalysisRecord(Record):
     figures: LinearFigures = key(factory=LinearFigures, read=LinearFigures.from_dict)
     bode: Bode = key(factory=Bode, read=Bode.from_dict)
     poles: Poles = key(factory=Poles, read=Poles.from_dict)
-    step: PredictedStep | None = key(default=None, read=_optional(PredictedStep))
+    step: PredictedStep | None = key(default=None, read=optional(PredictedStep))
     extra: FrozenDict = key(factory=FrozenDict)
 
     @property
@@ -190,10 +185,10 @@ class LinearSection(Record):
 
     schema: str = "govcheck-linear/1"
     analyses: tuple[LinearAnalysisRecord, ...] = key(default=(), read=records(LinearAnalysisRecord))
-    analysis: LinearAnalysisRecord | None = key(default=None, read=_optional(LinearAnalysisRecord))
-    map: OperatingMapRecord | None = key(default=None, read=_optional(OperatingMapRecord))
+    analysis: LinearAnalysisRecord | None = key(default=None, read=optional(LinearAnalysisRecord))
+    map: OperatingMapRecord | None = key(default=None, read=optional(OperatingMapRecord))
     crosscheck: tuple[CrossCheckRow, ...] = key(default=(), read=records(CrossCheckRow))
-    governor: GovernorRecord | None = key(default=None, read=_optional(GovernorRecord))
+    governor: GovernorRecord | None = key(default=None, read=optional(GovernorRecord))
     notes: tuple[str, ...] = key(default=(), read=tuple_of(str))
     extra: FrozenDict = key(factory=FrozenDict)
 

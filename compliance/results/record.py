@@ -21,7 +21,8 @@ from typing import Any, Callable
 from compliance.errors import InputError
 from compliance.results.keys import RequestKey
 
-__all__ = ["FrozenDict", "Record", "as_dict", "derived", "enum_of", "freeze", "from_dict", "key", "need", "records", "tuple_of"]
+__all__ = ["FrozenDict", "Record", "as_dict", "derived", "enum_of", "freeze", "from_dict", "key", "need", "optional",
+           "records", "tuple_of"]
 
 _NO = dataclasses.MISSING
 
@@ -160,6 +161,11 @@ def enum_of(cls) -> Callable:
         except ValueError:
             raise InputError(f"{where}: {v!r} is not one of {', '.join(repr(m.value) for m in cls)}") from None
     return read
+
+
+def optional(cls) -> Callable:
+    """Reader of an optional section of ``cls``: an empty object (or null) is no section."""
+    return lambda v, where: cls.from_dict(v, where) if v else None
 
 
 def records(cls) -> Callable:

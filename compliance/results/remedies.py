@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from compliance.results.record import FrozenDict, Record, key, records, tuple_of
+from compliance.results.record import FrozenDict, Record, key, optional, records, tuple_of
 
 __all__ = ["Change", "ParameterEffect", "RemedyCandidate", "RemedySection", "Sensitivity"]
 
@@ -67,6 +67,6 @@ class RemedySection(Record):
     status: str | None = None
     failed: tuple[str, ...] = key(default=(), read=tuple_of(str))
     out_of_reach: tuple[str, ...] = key(default=(), read=tuple_of(str))
-    remedy: RemedyCandidate | None = key(default=None, read=lambda v, where: RemedyCandidate.from_dict(v, where) if v else None)
+    remedy: RemedyCandidate | None = key(default=None, read=optional(RemedyCandidate))
     sensitivities: tuple[Sensitivity, ...] = key(default=(), read=records(Sensitivity))
     extra: FrozenDict = key(factory=FrozenDict)

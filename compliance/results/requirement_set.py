@@ -41,7 +41,8 @@ class OperatingPointRecord(Record):
         x = None
         if self.initial_position is not None and stroke is not None:
             x = parse_position(self.initial_position, stroke, f"operating_points.{self.name}.initial_position")
-        force = nominal_force if self.load == "nominal" else (self.load if isinstance(self.load, (int, float)) else None)
+        constant = self.load if isinstance(self.load, (int, float)) else None
+        force = nominal_force if self.load == "nominal" else constant
         return replace(self, position=x, load_force=force)
 
 

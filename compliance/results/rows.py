@@ -77,7 +77,7 @@ class VerdictRow(Record):
     non_responding: tuple[str, ...] | None = key(omit_none=True, default=None, read=tuple_of(str))
     flag: str | None = key(omit_none=True, default=None)
     excluded: str | None = key(omit_none=True, default=None)
-    extended: str | None = key(omit_none=True, default=None)  # why it is judged at a point the requirement does not list
+    extended: str | None = key(omit_none=True, default=None)  # why it is judged at a point it does not list
     basis: Basis | None = key(default=None, read=_basis)
     basis_reason: str | None = key(default=None)
     display: RowTexts = key(factory=RowTexts, read=RowTexts.from_dict)

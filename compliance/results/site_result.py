@@ -1,4 +1,4 @@
-"""A site's measured verdicts as the gate and JUnit read them: ``govcheck accept``'s results (schema ``govcheck-site/1``).
+"""A site's measured verdicts as the gate and JUnit read them: ``govcheck accept``'s results (``govcheck-site/1``).
 
 Its ``requirements[]`` are check's verdicts (:class:`~compliance.results.RequirementVerdict` with basis
 ``measured``; the measured value's uncertainty and the model's prediction in each record's ``extra``),
@@ -69,6 +69,6 @@ def typed_results(data, where: str = "results"):
         raise InputError(f"{where}: key 'schema' is missing; expected a govcheck results file ('{RESULTS_SCHEMA}' or "
                          f"'{SITE_SCHEMA}')")
     if schema != RESULTS_SCHEMA:
-        raise InputError(f"{where}: key 'schema' is '{schema}'; this govcheck reads '{RESULTS_SCHEMA}' or '{SITE_SCHEMA}' "
-                         "(re-run 'govcheck check' to regenerate the results)")
+        raise InputError(f"{where}: key 'schema' is '{schema}'; this govcheck reads '{RESULTS_SCHEMA}' or "
+                         f"'{SITE_SCHEMA}' (re-run 'govcheck check' to regenerate the results)")
     return CheckResult.from_dict(data, where)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from compliance.results.record import FrozenDict, Record, key, records, tuple_of
+from compliance.results.record import FrozenDict, Record, key, optional, records, tuple_of
 
 __all__ = ["DiagnosisRecord", "FittedEffect", "FittedParameter", "LocatedWindow", "Overlay", "RankedEffect",
            "ReplayMode", "SignalFit", "ValidationRecord", "WindowMetric"]
@@ -133,7 +133,7 @@ class ValidationRecord(Record):
     modes: FrozenDict = key(factory=FrozenDict, read=_map_of(ReplayMode))
     summary: FrozenDict = key(factory=FrozenDict)
     warnings: tuple[str, ...] = key(default=(), read=tuple_of(str))
-    diagnosis: "DiagnosisRecord | None" = key(default=None, read=lambda v, where: DiagnosisRecord.from_dict(v, where) if v else None)
+    diagnosis: "DiagnosisRecord | None" = key(default=None, read=lambda v, where: optional(DiagnosisRecord)(v, where))
     extra: FrozenDict = key(factory=FrozenDict)
 
     @property
@@ -152,7 +152,7 @@ class DiagnosisRecord(Record):
     added: tuple[FittedEffect, ...] = key(default=(), read=records(FittedEffect))
     effects: tuple[FittedEffect, ...] = key(default=(), read=records(FittedEffect))
     explanation: str | None = None
-    after: ValidationRecord | None = key(default=None, read=lambda v, where: ValidationRecord.from_dict(v, where) if v else None)
+    after: ValidationRecord | None = key(default=None, read=optional(ValidationRecord))
     extra: FrozenDict = key(factory=FrozenDict)
 
     @property
