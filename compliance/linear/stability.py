@@ -103,11 +103,12 @@ def stability_margins(cfg, reqset, *, analyses: list | None = None, workers: int
         stable, meets, reason}], "below": [names], "summary"}``; for a plant the linear analysis does
         not cover, ``points`` is empty and ``summary`` says why.
     """
+    from compliance.plants import kind_of
+
     criterion = dict(MARGIN_CRITERION, basis=CRITERION_BASIS)
-    if cfg.options.get("controller.type", "pid") != "pid":
-        return {"criterion": criterion, "points": [], "below": [],
-                "summary": f"not analysed: the linear closed-loop analysis covers PID plants ({cfg.name} uses "
-                           f"controller.type = '{cfg.options['controller.type']}')"}
+    why = kind_of(cfg).linear_support(cfg)
+    if why is not None:
+        return {"criterion": criterion, "points": [], "below": [], "summary": f"not analysed: {why}"}
     points = _points(cfg, reqset)
     if analyses:
         got = _from_analyses(analyses, points)

@@ -17,7 +17,8 @@ from compliance.errors import InputError
 from compliance.model_evidence.paper_figures import PAPERS, paper_source
 from compliance.model_evidence.recording_fits import recording_source
 from compliance.requirements.verdict import Status
-from compliance.model_evidence.figure_texts import direction as _direction, figure_text, miss as _miss
+from compliance.results.evidence import ModelEvidence
+from compliance.presentation.measured_figures import direction as _direction, figure_text, miss as _miss
 
 __all__ = ["check_sources", "contradicted_verdicts", "model_evidence"]
 
@@ -63,14 +64,17 @@ def _consequence(comparator: str, directions: set) -> str:
     return "the measured figure differs from the modelled one: the verdict may move either way"
 
 
-def contradicted_verdicts(entries: list[dict], sources: list[dict]) -> list[dict]:
-    """Every judged requirement whose metric a contradicting figure is evidence for, with those figures."""
+def contradicted_verdicts(verdicts, sources: list[dict]) -> list[dict]:
+    """Every judged requirement whose metric a contradicting figure is evidence for, with those figures.
+
+    ``verdicts``: the result's ``RequirementVerdict`` records.
+    """
     bad = _contradicting(sources)
     out = []
-    for e in entries:
-        if e["status"] in (Status.DISABLED,):
+    for e in verdicts:
+        if e.status in (Status.DISABLED,):
             continue
-        hits = [(s, f) for s, f in bad if e["metric"] in f.get("bears_on", ())]
+        hits = [(s, f) for s, f in bad if e.metric in f.get("bears_on", ())]
         if not hits:
             continue
         figs = [f for _, f in hits if "test" in f]
@@ -78,15 +82,15 @@ def contradicted_verdicts(entries: list[dict], sources: list[dict]) -> list[dict
         kinds = sorted({f["metric"] for f in figs})
         worst = max(figs, key=_miss) if figs else None
         dirs = {d for d in (_direction(f) for f in figs) if d}
-        n = sum(1 for s in sources if s["kind"] == "paper" for f in s["figures"] if e["metric"] in f["bears_on"]
+        n = sum(1 for s in sources if s["kind"] == "paper" for f in s["figures"] if e.metric in f["bears_on"]
                 and f["agreement"] is not None and f["independent"] and not f["by_construction"])
         parts = [f"{len(figs)} of {n} measured figures of the paper ({', '.join(kinds)}) disagree, e.g. "
                  f"{figure_text(worst)}"] if figs else []
         parts += [f"the recording {r} (position windows outside their limits)" for r in recs]
-        out.append({"requirement": e["id"], "title": e.get("title"), "severity": e["severity"], "status": e["status"],
-                    "metric": e["metric"], "figures": [figure_text(f) for f in figs], "recordings": recs,
+        out.append({"requirement": e.id, "title": e.title, "severity": e.severity, "status": e.status,
+                    "metric": e.metric, "figures": [figure_text(f) for f in figs], "recordings": recs,
                     "example": figure_text(worst, test=False) if worst else f"the recording {recs[0]}",
-                    "direction": sorted(dirs), "consequence": _consequence(e.get("comparator", ""), dirs),
+                    "direction": sorted(dirs), "consequence": _consequence(e.comparator or "", dirs),
                     "text": "; ".join(parts)})
     return out
 
@@ -136,15 +140,19 @@ def _summary(status: str, sources: list[dict], compared: int, contradict: int) -
     return text
 
 
-def model_evidence(cfg, results: dict) -> dict:
-    """The ``model_evidence`` section of a check's results (docs/results-schema.md).
+def model_evidence(cfg, result) -> ModelEvidence:
+    """The ``model_evidence`` section of a check's result (docs/results-schema.md).
 
     Parameters
     ----------
     cfg : PlantConfig
         Its ``[model_evidence]`` table names the sources.
-    results : dict
-        The campaign's results (their final statuses: after any Monte Carlo bands).
+    result : CheckResult
+        The check's verdicts (their final statuses: after the bands).
+
+    Returns
+    -------
+    ModelEvidence
     """
     check_sources(cfg)
     declared = cfg.model_evidence or {}
@@ -154,6 +162,7 @@ def model_evidence(cfg, results: dict) -> dict:
     for entry in declared.get("recordings") or ():
         sources.append(recording_source(cfg, entry))
     status, compared, contradict = _status(sources)
-    return {"status": status, "validated": status == "validated", "compared": compared, "contradict": contradict,
-            "summary": _summary(status, sources, compared, contradict), "examples": _examples(sources), "sources": sources,
-            "contradicted": contradicted_verdicts(results["requirements"], sources)}
+    return ModelEvidence.from_dict({
+        "status": status, "validated": status == "validated", "compared": compared, "contradict": contradict,
+        "summary": _summary(status, sources, compared, contradict), "examples": _examples(sources), "sources": sources,
+        "contradicted": contradicted_verdicts(result.requirements, sources)}, "results.model_evidence")

@@ -10,7 +10,7 @@ by fitting, so they are not independent evidence either.
 
 from __future__ import annotations
 
-from compliance.model_evidence.figure_texts import measured_text, value_text
+from compliance.presentation.measured_figures import measured_text, value_text
 from compliance.papers import plant_a
 
 __all__ = ["PAPERS", "paper_source"]

@@ -17,13 +17,14 @@ the report's (typographic minus, ``≤``, units typeset).
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 
 from compliance.metrics.catalogue import METRICS
+from compliance.presentation.numbers import fmt_margin_pct, fmt_value, unit_text
 from compliance.requirements.verdict import Status, evaluate
-from compliance.units.formatting import fmt_margin_pct, fmt_value, unit_text
 
 __all__ = ["OPEN_LIMIT", "band_pct_text", "limit_as_written", "metric_text", "resolved_limit", "row_texts",
-           "value_digits"]
+           "value_digits", "verdict_texts"]
 
 OPEN_LIMIT = "open (purchaser's data sheet)"  # the report's words for a limit the file leaves open
 ZERO = 1e-9  # [display unit] below: a numerical zero (a body at rest in stiction), not a measurement
@@ -57,27 +58,40 @@ def resolved_limit(comparator: str, limit, metric: str, *, unicode: bool = False
     return head + " .. ".join(metric_text(v, metric, unicode=unicode) for v in limit)
 
 
-def _point_status(row: dict):
+def _getter(obj):
+    """Field reader of a verdict row, a worst case or a band: a typed record (``compliance.results``) or its JSON dict."""
+    if obj is None:
+        return lambda k: None
+    return obj.get if isinstance(obj, Mapping) else lambda k: getattr(obj, k, None)
+
+
+def _point_status(row, limit=None, comparator=None):
     """The row's verdict on its point value: an uncertain row (its band straddles the limit) still has one."""
-    status = row.get("status")
-    if status == Status.UNCERTAIN and row.get("value") is not None and row.get("limit") and row.get("comparator"):
-        return evaluate(row["value"], row["comparator"], row["limit"]).status
+    get = _getter(row)
+    status, value = get("status"), get("value")
+    limit, comparator = get("limit") or limit, get("comparator") or comparator
+    if status == Status.UNCERTAIN and value is not None and limit and comparator:
+        return evaluate(value, comparator, tuple(limit)).status
     return status
 
 
-def value_digits(row: dict, metric: str, digits: int = 3) -> int:
+def value_digits(row, metric: str, digits: int = 3, *, limit=None, comparator=None) -> int:
     """Significant digits that show a judged row's value on its own side of its limit.
 
     The printed value, read back as a number, is judged as the row is (a failing value prints
     beyond the limit, a passing one inside it), and a failing value never prints as its limit
     prints: 32.007 mm/s against ``<= 32.0 mm/s`` is "32.007 mm/s", not "32.0 mm/s". ``digits``
-    when the row has no verdict (no value, no limit, not judged).
+    when the row has no verdict (no value, no limit, not judged). ``row`` is a ``VerdictRow`` /
+    ``WorstCase`` or its dict; ``limit`` and ``comparator`` stand in when the row does not carry them.
     """
+    get = _getter(row)
     info = METRICS.get(metric)
-    v, lim, comparator, status = row.get("value"), row.get("limit"), row.get("comparator"), _point_status(row)
+    v, status = get("value"), _point_status(row, limit, comparator)
+    lim, comparator = get("limit") or limit, get("comparator") or comparator
     if info is None or v is None or not lim or not comparator or status not in (Status.PASS, Status.FAIL) \
             or not math.isfinite(v) or abs(v * info.display_scale) < ZERO:
         return digits
+    lim = tuple(lim)
     limit_texts = {metric_text(x, metric, unicode=False) for x in lim}
     for d in range(digits, MAX_DIGITS + 1):
         shown = float(f"{v * info.display_scale:.{d}g}") / info.display_scale  # the number the text reads
@@ -108,26 +122,43 @@ def _margin_pct_text(pct, status, *, unicode: bool) -> str | None:
     return text
 
 
-def row_texts(row: dict, metric: str, *, unicode: bool = True) -> dict:
+def row_texts(row, metric: str, *, unicode: bool = True, limit=None, comparator=None) -> dict:
     """``value``, ``limit`` (None when open), ``margin`` and ``margin_pct`` of a verdict row, formatted from its SI numbers.
 
-    The value carries the digits :func:`value_digits` asks for (three at least).
+    ``row`` is a ``VerdictRow`` / ``WorstCase`` or its dict (``limit``/``comparator`` stand in when it
+    carries none). The value carries the digits :func:`value_digits` asks for (three at least).
     """
-    status = _point_status(row)
+    get = _getter(row)
+    status = _point_status(row, limit, comparator)
+    lim = get("limit") or limit
     return {
-        "value": metric_text(row.get("value"), metric, value_digits(row, metric), unicode=unicode),
-        "limit": None if not row.get("limit") else " .. ".join(metric_text(v, metric, unicode=unicode) for v in row["limit"]),
-        "margin": _margin_text(row.get("margin"), metric, status, unicode=unicode),
-        "margin_pct": _margin_pct_text(row.get("margin_pct"), status, unicode=unicode),
+        "value": metric_text(get("value"), metric, value_digits(row, metric, limit=limit, comparator=comparator),
+                             unicode=unicode),
+        "limit": None if not lim else " .. ".join(metric_text(v, metric, unicode=unicode) for v in lim),
+        "margin": _margin_text(get("margin"), metric, status, unicode=unicode),
+        "margin_pct": _margin_pct_text(get("margin_pct"), status, unicode=unicode),
     }
 
 
-def band_pct_text(band: dict | None, margin_pct=None, *, unicode: bool = False) -> str | None:
+def verdict_texts(entry, *, unicode: bool = True) -> dict:
+    """:func:`row_texts` of a requirement's deciding (worst) case, judged against the requirement's limit
+    (``entry``: a ``RequirementVerdict``); the texts of "no value" when it has none."""
+    w = entry.worst
+    if w is None:
+        return {"value": "\u2013" if unicode else "-", "limit": None, "margin": "-", "margin_pct": None}
+    row = next((r for r in entry.rows if r.run == w.run and r.which == w.which), None)  # its own limit
+    limit = (row.limit if row is not None else None) or entry.limit
+    return row_texts(w, entry.metric, unicode=unicode, limit=limit, comparator=entry.comparator)
+
+
+def band_pct_text(band, margin_pct=None, *, unicode: bool = False) -> str | None:
     """``[-28..-26 %]``: a band's margins in per cent, rounded outwards to whole per cent so the printed
-    band contains the printed point margin (``margin_pct``, widened to it if a band missed it)."""
-    if not isinstance(band, dict) or band.get("margin_low_pct") is None or band.get("margin_high_pct") is None:
+    band contains the printed point margin (``margin_pct``, widened to it if a band missed it).
+    ``band``: a ``Band`` record, its dict or None."""
+    get = _getter(band)
+    lo, hi = get("margin_low_pct"), get("margin_high_pct")
+    if lo is None or hi is None:
         return None
-    lo, hi = band["margin_low_pct"], band["margin_high_pct"]
     if margin_pct is not None:
         lo, hi = min(lo, margin_pct), max(hi, margin_pct)
     text = f"[{math.floor(lo):+d}..{math.ceil(hi):+d} %]"
@@ -138,16 +169,17 @@ def _typeset(text: str) -> str:
     return text.replace("<=", "\u2264").replace(">=", "\u2265")
 
 
-def limit_as_written(entry: dict, *, unicode: bool = True) -> str:
+def limit_as_written(entry, *, unicode: bool = True) -> str:
     """A requirement's limit as written, with the resolved value beside a limit relative to the stroke.
 
-    ``entry`` is a results file's requirement entry (``limit_text`` as written, ``limit_display``
-    resolved, ``limit`` SI or None when open): ``<= 1 %stroke (1.60 mm)``; in the report
-    ``≤ 1 % stroke (1.60 mm)`` and an open limit in words.
+    ``entry`` is a requirement's verdict (a ``RequirementVerdict``, or a site's entry as its JSON
+    has it) with ``limit_text`` as written, ``limit_display`` resolved and ``limit`` SI or None when
+    open: ``<= 1 %stroke (1.60 mm)``; in the report ``≤ 1 % stroke (1.60 mm)`` and an open limit in words.
     """
-    written, shown = entry.get("limit_text") or "", entry.get("limit_display") or ""
+    get = entry.get if isinstance(entry, Mapping) else lambda k: getattr(entry, k)
+    written, shown = get("limit_text") or "", get("limit_display") or ""
     if unicode:
-        if entry.get("limit") is None:
+        if get("limit") is None:
             return OPEN_LIMIT
         written, shown = _typeset(written).replace(" .. ", " \u2013 "), _typeset(shown)
     text = written or shown

@@ -1,8 +1,9 @@
-"""Texts of a compared figure: the modelled and measured values with their units, and the sentence a reader sees."""
+"""Texts of a measured figure beside the model's (model evidence): both values with their units, and the sentence
+a reader sees."""
 
 from __future__ import annotations
 
-from compliance.units.formatting import fmt_value, unit_text
+from compliance.presentation.numbers import fmt_value, unit_text
 
 __all__ = ["direction", "figure_text", "measured_text", "miss", "value_text"]
 
