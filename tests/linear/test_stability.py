@@ -76,4 +76,4 @@ def test_linear_analyses_already_made_are_reused(margins):
 def test_a_state_feedback_plant_is_not_analysed_and_says_why(margins):
     _, reqset, _ = margins
     st = stability_margins(load_plant("plant-b"), reqset)
-    assert st["points"] == [] and "covers PID plants" in st["summary"]
+    assert st["points"] == [] and "cover the PID only" in st["summary"] and st["summary"].startswith("not analysed")

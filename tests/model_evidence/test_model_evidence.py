@@ -9,8 +9,9 @@ whose valve dead zone is twice as wide must not.
 from __future__ import annotations
 
 import dataclasses
+import json
 from pathlib import Path
-from types import MappingProxyType
+from types import MappingProxyType, SimpleNamespace
 
 import pytest
 
@@ -19,10 +20,11 @@ from compliance.model.config import load_plant, plant_from_dict
 from compliance.model.toml_file import read_toml
 from compliance.model_evidence import check_sources, model_evidence
 from compliance.recordings.synth import synthesise, write_recording
+from compliance.results import ModelEvidence
 
 ROOT = Path(__file__).resolve().parents[2]
 # the judged requirements of a check as model_evidence reads them (id, metric, comparator, status, severity)
-ENTRIES = [
+_ENTRIES = [
     {"id": "POS", "title": "positioning error", "metric": "max_positioning_error", "comparator": "<=", "status": "pass",
      "severity": "mandatory"},
     {"id": "TRACK", "title": "tracking error", "metric": "tracking_max_error", "comparator": "<=", "status": "uncertain",
@@ -30,12 +32,21 @@ ENTRIES = [
     {"id": "TOPEN", "title": "opening time", "metric": "opening_time", "comparator": "within", "status": "pass",
      "severity": "mandatory"},
 ]
+RESULT = SimpleNamespace(requirements=[SimpleNamespace(**e) for e in _ENTRIES])  # the verdicts' fields it reads
+
+
+def _evidence(cfg) -> dict:
+    """The section as its JSON has it, read back into its record and written again (it survives the round trip)."""
+    ev = model_evidence(cfg, RESULT)
+    data = json.loads(json.dumps(ev.as_dict()))
+    assert ModelEvidence.from_dict(data) == ev
+    return data
 
 
 @pytest.fixture(scope="module")
 def plant_a_evidence():
     cfg = load_plant(ROOT / "models" / "plant-a.toml")
-    return model_evidence(cfg, {"requirements": ENTRIES})
+    return _evidence(cfg)
 
 
 def test_plant_a_is_contradicted_by_its_papers_steady_errors(plant_a_evidence):
@@ -66,7 +77,7 @@ def test_the_verdicts_resting_on_contradicted_figures_say_which_way_the_model_er
 
 def test_a_calibrated_plant_counts_only_the_figures_it_was_not_fitted_to():
     cfg = load_plant(ROOT / "models" / "plant-a-calibrated.toml")
-    ev = model_evidence(cfg, {"requirements": ENTRIES})
+    ev = _evidence(cfg)
     paper = ev["sources"][0]
     fitted = [f for f in paper["figures"] if not f["independent"]]
     assert fitted and all(f["metric"] not in ("max tracking error", "max steady error") for f in fitted)
@@ -93,7 +104,7 @@ def recordings(tmp_path_factory):
 
 def test_a_recording_the_model_made_validates_it(recordings):
     cfg = _plant_naming(recordings, ["same.csv"])  # relative to the plant file's folder
-    ev = model_evidence(cfg, {"requirements": ENTRIES})
+    ev = _evidence(cfg)
     rec = ev["sources"][0]
     assert ev["status"] == "validated" and ev["compared"] == 1 and ev["contradicted"] == []
     assert rec["agreement"] == "agrees" and all(m["pass"] for m in rec["modes"].values())
@@ -102,7 +113,7 @@ def test_a_recording_the_model_made_validates_it(recordings):
 
 def test_a_recording_of_a_wider_dead_zone_contradicts_the_positioning_verdicts(recordings):
     cfg = _plant_naming(recordings, ["same.csv", "wide-dead-zone.csv"])
-    ev = model_evidence(cfg, {"requirements": ENTRIES})
+    ev = _evidence(cfg)
     wide = ev["sources"][1]
     assert ev["status"] == "contradicted" and ev["compared"] == 2 and ev["contradict"] == 1
     assert wide["agreement"] == "contradicts" and "max_positioning_error" in wide["bears_on"]
@@ -114,7 +125,7 @@ def test_a_recording_of_a_wider_dead_zone_contradicts_the_positioning_verdicts(r
 def test_no_declared_source_is_not_validated_and_bad_declarations_are_refused(tmp_path):
     cfg = load_plant("plant-a")
     bare = dataclasses.replace(cfg, model_evidence=MappingProxyType({"paper": None, "recordings": ()}))
-    ev = model_evidence(bare, {"requirements": ENTRIES})
+    ev = _evidence(bare)
     assert ev["status"] == "not validated" and ev["sources"] == [] and "names no measurement" in ev["summary"]
     with pytest.raises(InputError, match=r"model_evidence.recordings\[0\].path: .*missing.csv: file not found"):
         _plant_naming(tmp_path, ["missing.csv"])

@@ -14,12 +14,12 @@ from pathlib import Path
 
 import pytest
 
-from compliance.linear.stability import stability_margins
 from compliance.model.config import load_plant
-from compliance.model_evidence import model_evidence
+from compliance.pipeline.chain import evidence, stability
 from compliance.report.render import render_report
 from compliance.requirements.consistency import consistency_findings
 from compliance.requirements.loading import load_requirements
+from compliance.results import CheckResult
 from tests.report.test_report import _pdf_pages
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -31,11 +31,14 @@ def page_one(tmp_path_factory):
     res = json.loads(FIXTURE.read_text(encoding="utf-8"))
     cfg, reqset = load_plant(ROOT / "models" / "plant-a.toml"), load_requirements(ROOT / "requirements" / "shpp-400kw.toml")
     res["findings"] = consistency_findings(reqset, cfg.p("cylinder.stroke"))
-    res["model_evidence"] = model_evidence(cfg, res)
-    res["stability"] = stability_margins(cfg, reqset, workers=1)
+    result = CheckResult.from_dict(res)
+    result = result.with_(model_evidence=evidence(cfg, result), stability=stability(cfg, reqset, jobs=1))
     out = tmp_path_factory.mktemp("p1") / "r.pdf"
-    render_report(res, pdf_path=out)
+    render_report(result, pdf_path=out)
     pages = _pdf_pages(out)
+    # the record read back from its JSON, as a reader of the results file gets it (the sections survive)
+    res = json.loads(result.json_text())
+    assert CheckResult.from_dict(res).json_text() == result.json_text()
     return res, " ".join(pages[0].split()), pages
 
 
