@@ -307,37 +307,54 @@ def _ids(ids: list[str]) -> str:
     return ", ".join(dict.fromkeys(ids))
 
 
+def _of(ids: list[str], v_max: float) -> str:
+    """``IEEE125-NOFASTER's 32.0 mm/s`` or, for several limits alike, ``the 32.0 mm/s of A, B``."""
+    ids = list(dict.fromkeys(ids))
+    speed = f"{v_max * 1e3:.1f} mm/s"
+    return f"{ids[0]}'s {speed}" if len(ids) == 1 else f"the {speed} of {', '.join(ids)}"
+
+
 def finding_groups(findings) -> list[dict]:
-    """Findings that say the same thing of several requirements, grouped: ``{line, text, mandatory, kind}`` each,
-    ``line`` in a few words with the figures, ``text`` the first finding's full explanation (``findings``: the
-    result's ``Finding`` records, their arithmetic's SI figures read by ``Finding.figure``)."""
+    """Findings that say the same thing of several requirements, grouped: ``{line, text, mandatory, kind, count,
+    explain}`` each, ``line`` in a few words with the figures (every requirement the group involves), ``text`` the
+    first finding's full explanation, shown (``explain``) for the first group of each kind whose line does not
+    already say it; a group is mandatory when one of its findings is (``findings``: the result's ``Finding``
+    records, their arithmetic's SI figures read by ``Finding.figure``)."""
     groups: dict = {}
     for f in findings:
-        t_min, step = f.figure("t_min"), f.figure("step")
-        if f.kind == "narrowing" and t_min is not None:
-            key = ("narrowing figures", f.requirements[1], round(t_min, 6), f.figure("t_max"))
-        elif f.kind == "rate_split" and step is not None:
-            key = ("rate_split figures", tuple(f.requirements), round(step, 6))
+        t_min, step, v_max = f.figure("t_min"), f.figure("step"), f.figure("v_max")
+        if f.kind == "narrowing" and t_min is not None and v_max is not None:
+            key = ("narrowing figures", round(t_min, 6), f.figure("t_max"), round(v_max, 6))
+        elif f.kind == "rate_split" and step is not None and v_max is not None:
+            key = ("rate_split figures", f.requirements[0], round(step, 6), round(v_max, 6))
         else:
             key = (f.kind, f.text)
         groups.setdefault(key, []).append(f)
     out = []
     for key, fs in groups.items():
         f = fs[0]
+        partners = [g.requirements[1] for g in fs if len(g.requirements) > 1]
         if key[0] == "narrowing figures":
             t_max = f.figure("t_max")
             hi = "" if t_max is None else f"\u2013{t_max:.3g} s"
-            line = (f"narrowing: {_ids([g.requirements[0] for g in fs])} with {f.requirements[1]} "
+            line = (f"narrowing: {_ids([g.requirements[0] for g in fs])} with {_ids(partners)} "
                     f"(\u2264 {f.figure('v_max') * 1e3:.1f} mm/s) admit only strokes of {f.figure('t_min'):.3g}"
                     f"{hi or ' s or longer'}")
         elif key[0] == "rate_split figures":
             line = (f"rate split: {f.requirements[0]} (\u2264 {f.figure('tau_max'):.3g} s on {f.figure('step') * 1e3:.1f} mm "
-                    f"steps) needs {f.figure('mean_speed') * 1e3:.1f} mm/s, above {f.requirements[1]}'s "
-                    f"{f.figure('v_max') * 1e3:.1f} mm/s (met only with the speed-limiting devices not acting)")
+                    f"steps) needs {f.figure('mean_speed') * 1e3:.1f} mm/s, above {_of(partners, f.figure('v_max'))} "
+                    "(met only with the speed-limiting devices not acting)")
         else:
             line = f"{f.kind.replace('_', ' ')}: {f.text}"
-        out.append({"line": line, "text": f.text, "mandatory": f.mandatory, "kind": f.kind, "count": len(fs)})
-    return sorted(out, key=lambda g: not g["mandatory"])
+        out.append({"line": line, "text": f.text, "mandatory": any(g.mandatory for g in fs), "kind": f.kind,
+                    "count": len(fs), "advisory": sorted({r for g in fs if not g.mandatory for r in g.requirements}
+                                                         - {r for g in fs if g.mandatory for r in g.requirements})})
+    out.sort(key=lambda g: not g["mandatory"])
+    seen = set()
+    for g in out:  # the arithmetic once per kind of finding: the next groups of that kind repeat it with other ids
+        g["explain"] = g["kind"] not in seen and g["line"] != f"{g['kind'].replace('_', ' ')}: {g['text']}"
+        seen.add(g["kind"])
+    return out
 
 
 def findings_lines(result: CheckResult) -> dict:
