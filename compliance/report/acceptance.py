@@ -245,7 +245,7 @@ def _figure_cells(f) -> dict:
     elif not f.independent:
         word, css = f"{f.agreement} (fitted to it)", "neutral"
     else:
-        word, css = f.agreement, "pass" if f.agreement == "agrees" else "fail"
+        word, css = f.agreement, Status.PASS if f.agreement == "agrees" else Status.FAIL  # the row colour of its word
     return {"test": f.test, "metric": f.metric, "modelled": f.display.modelled, "measured": f.display.measured,
             "agreement": word, "css": css}
 

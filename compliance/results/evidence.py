@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from compliance.requirements.verdict import Severity
 from compliance.results.record import FrozenDict, Record, key, records, tuple_of
 
 __all__ = ["ComparedFigure", "ContradictedVerdict", "EvidenceSource", "FigureTexts", "MarginCriterion", "ModelEvidence",
@@ -93,7 +94,7 @@ class ContradictedVerdict(Record):
 
     requirement: str
     title: str | None = None
-    severity: str = "mandatory"
+    severity: str = Severity.MANDATORY
     status: str = ""
     metric: str = ""
     figures: tuple[str, ...] = key(default=(), read=_texts)
