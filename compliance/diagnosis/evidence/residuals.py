@@ -19,8 +19,8 @@ import numpy as np
 from compliance.model.config import PlantConfig
 from compliance.errors import InputError, SimulationError
 from compliance.validation.recorded_noise import QUANTISED_SHARE, sensor_noise_std
-from compliance.diagnosis.evidence.operating_point import load_at_start
-from compliance.diagnosis.evidence.replay_fit import ReplaySetup, run_replay
+from compliance.validation.replay_conditions import load_at_start
+from compliance.validation.replay import ReplaySetup, prepare_replay, run_replay
 from compliance.validation.fit_metrics import nrmse
 
 # lowest floors we accept (instrument resolution a logger rarely beats): keeps one signal from
@@ -122,9 +122,7 @@ def null_recording(cfg: PlantConfig, setup: ReplaySetup, sensor: dict, seed: int
     """The same test recorded by the nominal model with sensors like the recording's, prepared for replay."""
     import pandas as pd
 
-    from compliance.simulation.profiles import Profile
-    from compliance.simulation import Scenario, SensorNoise, simulate
-    from compliance.diagnosis.evidence.replay_fit import prepare_replay
+    from compliance.simulation import SensorNoise
 
     rec, res = setup.recorded, setup.resolution
     qx, qp = res.get("position", 0.0), max(res.get("pressure_a", 0.0), res.get("pressure_b", 0.0))
@@ -137,31 +135,64 @@ def null_recording(cfg: PlantConfig, setup: ReplaySetup, sensor: dict, seed: int
     t = setup.time
     ts = float(np.median(np.diff(t)))
     pre = int(round(NULL_PRE_ROLL / ts))
-    # the null bench settles first (a hold before the test), like a real recording does
-    tt = np.concatenate([t[:pre] , t + pre * ts]) if pre else t
-    if setup.closed_loop:
-        ref = np.concatenate([np.full(pre, setup.reference[0]), setup.reference])
-        sc = Scenario(duration=float(tt[-1]), initial_position=setup.initial_position, reference=Profile(tt, ref),
-                      load=load_at_start(cfg, setup.load, setup.initial_position), noise=noise, seed=seed)
-    else:
-        cmd = np.concatenate([np.full(pre, setup.command[0]), setup.command])
-        sc = Scenario(duration=float(tt[-1]), initial_position=setup.initial_position, command=Profile(tt, cmd),
-                      load=load_at_start(cfg, setup.load, setup.initial_position), noise=noise, seed=seed)
-    syn = simulate(cfg, sc).iloc[pre:].reset_index(drop=True)
-    n = min(len(syn), t.size)
-    frame = pd.DataFrame({"time": t[:n], "position": syn["position"].to_numpy()[:n], "valve_command": syn["valve_command"].to_numpy()[:n]})
+    load = load_at_start(cfg, setup.load, setup.initial_position)
+    syn = _null_run(cfg, setup, pre, load, noise, seed)
+    n = min(len(syn["position"]), t.size)
+    frame = pd.DataFrame({"time": t[:n], "position": syn["position"][:n], "valve_command": syn["valve_command"][:n]})
     if setup.closed_loop:
         frame["reference"] = setup.reference[:n]
     for s_ in ("pressure_a", "pressure_b", "supply_pressure"):
         if s_ in rec:
-            frame[s_] = syn[s_].to_numpy()[:n]
+            frame[s_] = syn[s_][:n]
     if setup.logger is not None:  # through the recording's instruments (filter, delays, calibration) ...
         logged = setup.logger.apply({c: frame[c].to_numpy() for c in frame.columns}, ts)
         frame = pd.DataFrame({c: logged[c] for c in frame.columns})
     if setup.logged is not None:  # ... at the instants it logged
         frame = frame.iloc[setup.logged[setup.logged < n]].reset_index(drop=True)
-    meta = {"conditions": {"load_force": setup.load}, "source_path": "<null replay>"}
+    test = {} if setup.flow_control is None else {"flow_control": "set" if setup.flow_control else "open"}
+    if setup.closed_loop and setup.command_from < t.size:
+        test["valve_null_from"] = float(t[setup.command_from])
+    meta = {"conditions": {"load_force": setup.load}, "source_path": "<null replay>"} | ({"test": test} if test else {})
     return dataclasses.replace(prepare_replay(cfg, frame, meta), logger=setup.logger)
+
+
+def _null_run(cfg: PlantConfig, setup: ReplaySetup, pre: int, load, noise, seed: int) -> dict:
+    """The nominal model run through the recorded test with sensors like the recording's (signal -> array from t = 0).
+
+    The bench settles first (``pre`` samples of hold before the test, like a real recording). A
+    test whose valve command drives the plant from ``command_from`` (a hold test's switch to manual)
+    is recorded in two runs: the closed loop up to the switch, then the command from the state the
+    loop left the servo in (at rest: its position and pressures).
+    """
+    from compliance.simulation.profiles import Profile
+    from compliance.simulation import Scenario, simulate
+
+    t = setup.time
+    ts = float(np.median(np.diff(t)))
+    switch = setup.command_from if setup.closed_loop else 0
+    tt = np.concatenate([t[:pre], t + pre * ts]) if pre else t
+    common = dict(load=load, noise=noise, seed=seed, flow_control=setup.flow_control)
+    if switch == 0:
+        cmd = np.concatenate([np.full(pre, setup.command[0]), setup.command])
+        sc = Scenario(duration=float(tt[-1]), initial_position=setup.initial_position, command=Profile(tt, cmd), **common)
+        syn = simulate(cfg, sc).iloc[pre:]
+        return {c: syn[c].to_numpy() for c in syn.columns}
+    last = min(switch, t.size - 1)
+    ref = np.concatenate([np.full(pre, setup.reference[0]), setup.reference[:last + 1]])
+    sc = Scenario(duration=float(tt[pre + last]), initial_position=setup.initial_position, reference=Profile(tt[:pre + last + 1], ref),
+                  **common)
+    first = simulate(cfg, sc).iloc[pre:]
+    out = {c: first[c].to_numpy() for c in first.columns}
+    if switch >= t.size:
+        return out
+    held = (float(first["pressure_a"].iloc[-1]), float(first["pressure_b"].iloc[-1]))
+    x_held = min(max(float(first["position_true"].iloc[-1]), 0.0), cfg.p("cylinder.stroke"))
+    rest = setup.command[switch:]
+    tr = t[switch:] - t[switch]
+    sc2 = Scenario(duration=float(tr[-1]), initial_position=x_held, command=Profile(tr, rest), initial_pressures=held,
+                   **dict(common, seed=seed + 1))
+    second = simulate(cfg, sc2)
+    return {c: np.concatenate([out[c][:switch], second[c].to_numpy()]) for c in out}
 
 
 def _beyond_quantisation(std: float, q: float) -> float:

@@ -37,7 +37,7 @@ from compliance.diagnosis.servo.instrument_candidates import (PREFIX, instrument
                                                        is_instrument)
 from compliance.diagnosis.servo.lag_split import adopted_fit, split_scan
 from compliance.diagnosis.servo.friction_form import OPTION as FORM_OPTION, form_after_effects, friction_form_check
-from compliance.diagnosis.evidence.replay_fit import ReplaySetup, run_replay
+from compliance.validation.replay import ReplaySetup, run_replay
 from compliance.diagnosis.evidence.residuals import UNITS, null_recording, own_floor_objective, signal_fit
 from compliance.diagnosis.servo.selection import (AMBIGUOUS_BIC, EXPLAINED_ENOUGH, NOISE_TOLERANCE, RESIDUAL_LIMIT, ambiguity_set, honest,
                                          score_all, signals_left, verdict)

@@ -38,7 +38,7 @@ from compliance.effects import EFFECTS
 from compliance.errors import InputError
 from compliance.diagnosis.servo.candidates import Candidate
 from compliance.diagnosis.servo.instrument_candidates import instrumented
-from compliance.diagnosis.evidence.replay_fit import ReplaySetup
+from compliance.validation.replay import ReplaySetup
 from compliance.diagnosis.evidence.residuals import ResidualModel, evaluate
 
 DIFF_STEP = 0.01  # forward-difference step, 1 % of each parameter's (log) range

@@ -19,7 +19,7 @@ from compliance.diagnosis.servo.fit import FitContext, FitResult, fit_candidate,
 from compliance.diagnosis.servo.recalibration import forward_select_base
 from compliance.diagnosis.servo.effect_sets import SET_SIMPLEX_FEV, extend_fit, screen_addition
 from compliance.diagnosis.servo.lag_split import valley_point
-from compliance.diagnosis.evidence.replay_fit import ReplaySetup
+from compliance.validation.replay import ReplaySetup
 from compliance.processes import PerProcess, map_tasks
 
 

@@ -1,0 +1,61 @@
+"""The state a replay segment starts from: the recording's measured states, the rest carried over or set by physics.
+
+The one place outside ``effects/`` where the replay reads effect states (gas temperatures, the
+second cylinder's speed, the reservoir pressure, the sensor's lag).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from compliance.effects.heat_transfer import S_TA, S_TB
+from compliance.effects.linkage_compliance import S_V2
+from compliance.effects.sensor_lag import P_SL_ON, P_SL_TAU, P_SL_TD
+from compliance.effects.supply_droop import P_SD_ON, S_PSUP
+from compliance.model.rest_state import initial_state, set_rest_internal_states
+from compliance.model.vector_slots import P_STROKE, S_V
+from compliance.simulation.rk4 import OUTPUT_COLUMNS
+
+OUT = {name: i for i, name in enumerate(OUTPUT_COLUMNS)}
+
+
+def start_state(cfg, P: np.ndarray, setup) -> np.ndarray:
+    """State where the recording starts: at rest at its start position and pressures (``ReplaySetup``).
+
+    A settled servo sits off its set-point by its steady error, which the piston, stuck, keeps
+    until it moves; the bristles carry the net force (``initial_state``).
+    """
+    return initial_state(cfg, P, min(max(setup.initial_position, 0.0), P[P_STROKE]), setup.initial_pressures)
+
+
+def reset_state(cfg, P: np.ndarray, setup, k: int, previous: np.ndarray, lx, ly) -> np.ndarray:
+    """State at sample ``k`` read from the recording (measured) and the previous segment (the rest).
+
+    Measured states (position, its smoothed velocity, chamber and supply pressures) are reset;
+    unmeasured ones are carried over from the previous segment (gas temperatures) or set by
+    physics (LuGre bristle deflection from the force balance, the spool at the command, hoses at
+    the chamber pressures).
+    """
+    st = setup.states
+    x = float(st["position"][k])
+    v = float(st["velocity"][k])
+    if P[P_SL_ON]:
+        # the recorded position is the sensor's, which trails the piston by its total lag (exactly for a
+        # delay, to first order for the lag): the piston is where the reading arrives that much later
+        later = setup.time[k] + P[P_SL_TAU] + P[P_SL_TD]
+        x = float(np.interp(later, setup.time, st["position"]))
+        v = float(np.interp(later, setup.time, st["velocity"]))
+    pa = float(st["pressure_a"][k]) if "pressure_a" in st else float(previous[k, OUT["pressure_a"]])
+    pb = float(st["pressure_b"][k]) if "pressure_b" in st else float(previous[k, OUT["pressure_b"]])
+    y = initial_state(cfg, P, min(max(x, 0.0), P[P_STROKE]), (pa, pb))
+    y[S_V] = v
+    y[S_V2] = v
+    y[S_TA] = previous[k, OUT["temperature_a"]]  # gas temperatures are not measured: carried over
+    y[S_TB] = previous[k, OUT["temperature_b"]]
+    if P[P_SD_ON]:
+        y[S_PSUP] = float(st["supply_pressure"][k]) if "supply_pressure" in st else previous[k, OUT["supply_pressure"]]
+    set_rest_internal_states(P, y, lx, ly, v)  # bristles carry the net force, the link its share
+    return y
+
+
+__all__ = ["OUT", "reset_state", "start_state"]
