@@ -19,7 +19,8 @@ runs it hundreds of times on candidate configurations. Both see the same test:
   (``recorded_noise.replay_noise``) is added to the model's measured position, so the replayed
   controller sees the noise the real one saw (on the practice no-effect recording the command
   residual falls from ~0.15 V to ~0.015 V);
-- **start**: at rest at the medians of the first 50 ms;
+- **start**: at rest at the recorded position smoothed at the first sample and the chamber pressures' medians
+  over the first 50 ms;
 - **segments** (``replay_segments``): the diagnosis re-synchronises with the recorded state at each
   set-point change and every 2 s (multiple shooting); measured states are reset, unmeasured ones
   carried over or set by physics (``replay_reset``), and the controller's integral state is carried
@@ -138,7 +139,8 @@ def prepare_replay(cfg: PlantConfig, frame: pd.DataFrame, meta: dict | None, *, 
     tt = t - t[0]
     states = recorded_states(rec, reference if closed else None, ts)
     resets = plan_segments(tt, reference, command, states["velocity"], command_from, segmented, max_segment)
-    conditions = replay_conditions(run_cfg, meta, init, load, load_source, overrides, fc, switch)
+    start = min(max(float(states["position"][0]), 0.0), run_cfg.p("cylinder.stroke"))
+    conditions = replay_conditions(run_cfg, meta, init, start, load, load_source, overrides, fc, switch)
     return ReplaySetup(
         time=tt, reference=np.ascontiguousarray(reference), command=np.ascontiguousarray(command),
         closed_loop=closed, load=load, initial_position=float(x0), initial_pressures=pressures,

@@ -15,7 +15,8 @@ order, and the replay says which (``ReplaySetup.conditions``):
   configuration's conductances), else the configuration;
 - the valve command drives the plant from ``test.valve_null_from`` [s] on (a hold test: the
   positioner switched to manual with the valve at null), else the controller runs throughout;
-- start: position and chamber pressures as the medians of the first ``INITIAL_WINDOW``.
+- start: the operating point (position, chamber pressures) as the medians of the first ``INITIAL_WINDOW``; the
+  replay itself starts at rest at the smoothed recorded position (``replay_reset.start_state``).
 
 A recording's sidecar gives the load *there*, at the operating point the test starts from. The
 core's ``position_dependent_load`` adds its stiffness about mid-stroke (compliance/model/assembly.py),

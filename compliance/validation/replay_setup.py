@@ -153,12 +153,17 @@ def resolutions(rec: dict, logged: np.ndarray | None, meta: dict) -> dict:
     return out
 
 
-def replay_conditions(run_cfg: PlantConfig, meta: dict, init: dict, load, load_source: str, overrides: dict, fc, switch) -> dict:
+def replay_conditions(run_cfg: PlantConfig, meta: dict, init: dict, start: float, load, load_source: str, overrides: dict, fc,
+                      switch) -> dict:
     """The test conditions the replay assumed, each with where it came from."""
     window = f"{INITIAL_WINDOW*1e3:.0f} ms"
     return {
         "initial_position": init["initial_position"],
-        "initial_position_source": f"median of the recorded position over the first {window}",
+        "initial_position_source": f"median of the recorded position over the first {window} (the operating point: the load's "
+                                   "anchor)",
+        "start_position": start,
+        "start_position_source": "the recorded position smoothed at the first sample (cubic Savitzky-Golay, as every "
+                                 "re-synchronised segment starts): the replay starts at rest there",
         "initial_pressures": init["initial_pressures"],
         "initial_pressures_source": (f"medians of the recorded pressures over the first {window}" if init["initial_pressures"]
                                      else "at rest balancing the load, mean (p_s + p_atm)/2 (pressures not recorded)"),

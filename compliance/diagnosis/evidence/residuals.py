@@ -22,6 +22,7 @@ from compliance.validation.recorded_noise import QUANTISED_SHARE, sensor_noise_s
 from compliance.validation.replay_conditions import load_at_start
 from compliance.validation.replay import ReplaySetup, prepare_replay, run_replay
 from compliance.validation.fit_metrics import nrmse
+from compliance.simulation.rk4 import OUTPUT_COLUMNS
 
 # lowest floors we accept (instrument resolution a logger rarely beats): keeps one signal from
 # dominating when its noise estimate comes out implausibly small
@@ -299,13 +300,62 @@ def build_residual_model(cfg: PlantConfig, setup: ReplaySetup, *, stride: int = 
                          recorded={s: setup.recorded[s] for s in signals}, local=local or None)
 
 
-def evaluate(model: ResidualModel, cfg: PlantConfig, setup: ReplaySetup) -> tuple[np.ndarray, dict | None]:
-    """Run one replay and return (normalised residual vector, replay or None when it diverged)."""
+CHECK_SHARE = 0.05  # a stopping replay checks its residual after each segment that adds this share of the fitted samples
+STOP_MARGIN = 1.0 + 1e-9  # a partial sum of squares summed in another order than the full one: stop only clearly above
+
+
+class Bound:
+    """Stops a replay once its chi-square over the samples replayed so far exceeds ``limit`` (``run_replay``'s ``stop``).
+
+    The replay is re-synchronised in segments, so after each segment the residuals of every fitted
+    sample before its end are final; their sum of squares only grows with the rest. A candidate
+    whose value can no longer matter to the search asking for it (``servo.simplex``, the grid scans
+    of ``servo.fit``) is known to be worse once that partial sum exceeds the limit, and the rest of
+    the recording is not replayed. ``vec`` holds the residuals so far (zeros beyond): its sum of
+    squares is the partial chi-square, a lower bound of the full one.
+    """
+
+    def __init__(self, model: ResidualModel, limit: float):
+        self.model, self.limit = model, limit
+        self.vec = np.zeros(model.size)
+        self.chi2 = 0.0
+        self.done = 0  # fitted samples accounted for (positions in model.index)
+        self.every = max(1, int(CHECK_SHARE * model.index.size))
+        self.columns = [OUTPUT_COLUMNS.index(s) for s in model.signals]
+
+    def __call__(self, out: np.ndarray, k: int) -> bool:
+        """True when the residuals of the samples before ``k`` (final once a segment ends at ``k``) exceed the limit."""
+        m = self.model
+        j = int(np.searchsorted(m.index, k, side="left"))
+        if j - self.done < self.every:
+            return False
+        idx = m.index[self.done:j]
+        size = m.index.size
+        for i, (s, col) in enumerate(zip(m.signals, self.columns)):
+            scale = m.scale(s)
+            if not np.isscalar(scale):
+                scale = scale[self.done:j]
+            r = (m.recorded[s][idx] - out[idx, col]) / scale
+            self.vec[i * size + self.done:i * size + j] = r
+            self.chi2 += float(np.dot(r, r))
+        self.done = j
+        return self.chi2 > self.limit * STOP_MARGIN
+
+
+def evaluate(model: ResidualModel, cfg: PlantConfig, setup: ReplaySetup, limit: float = math.inf) -> tuple[np.ndarray, dict | None, bool]:
+    """Run one replay; (normalised residual vector, replay or None when it diverged or stopped, stopped).
+
+    With a finite ``limit`` the replay stops at the first segment where its chi-square exceeds it
+    (``Bound``); the vector then holds the residuals so far, zeros beyond.
+    """
+    bound = Bound(model, limit) if math.isfinite(limit) else None
     try:
-        sim = run_replay(cfg, setup)
+        sim = run_replay(cfg, setup, stop=bound)
     except SimulationError:
-        return model.vector(None), None
-    return model.vector(sim), sim
+        return model.vector(None), None, False
+    if sim is None:
+        return bound.vec, None, True
+    return model.vector(sim), sim, False
 
 
 def signal_fit(model: ResidualModel, sim: dict | None, mask: np.ndarray | None = None) -> dict:

@@ -40,6 +40,7 @@ from compliance.diagnosis.servo.candidates import Candidate
 from compliance.diagnosis.servo.instrument_candidates import instrumented
 from compliance.validation.replay import ReplaySetup
 from compliance.diagnosis.evidence.residuals import ResidualModel, evaluate
+from compliance.diagnosis.servo.simplex import simplex_search
 
 DIFF_STEP = 0.01  # forward-difference step, 1 % of each parameter's (log) range
 MAX_NFEV = 6  # least-squares polishing evaluations (besides the Jacobian's)
@@ -74,17 +75,24 @@ class FitContext:
     model: ResidualModel
     sims: int = 0
     memo: dict = field(default_factory=dict, repr=False)  # (keys, values) -> (residuals, replay): the latest MEMO
+    stopped: bool = False  # the last ``residual`` stopped its replay early
+    stopped_sims: int = 0  # replays stopped early (counted in ``sims`` too)
 
-    def residual(self, params, values) -> tuple[np.ndarray, dict | None]:
-        """Normalised data residuals of a parameter set, and the replay (None if it failed).
+    def residual(self, params, values, limit: float = math.inf) -> tuple[np.ndarray, dict | None]:
+        """Normalised data residuals of a parameter set, and the replay (None if it failed or stopped).
 
         Instrumentation parameters (``servo.instrument_candidates``) act on the logger model and on the
         states the re-synchronisations read (the plant's, not the instrument's). A parameter set
         replayed moments ago (a fit's best grid point where its simplex starts, the fitted values
         the caller replays again) is not replayed twice: values equal to 10 significant digits
         (a round trip through the fit's unit cube) give the same replay.
+
+        ``limit``: the caller only needs to know whether the chi-square exceeds it; the replay may
+        stop at the first segment where it does (``evidence.residuals.Bound``), and ``stopped`` says
+        so (the residuals after that segment are then zero).
         """
         key = (tuple(fp.key for fp in params), tuple(float(f"{v:.10g}") for v in values))
+        self.stopped = False
         if key in self.memo:
             return self.memo[key]
         setup = instrumented(self.setup, params, values)
@@ -93,11 +101,14 @@ class FitContext:
             cfg = apply(self.cfg, params, values)
         except InputError:
             return self.model.vector(None), None
-        out = evaluate(self.model, cfg, setup)
-        self.memo[key] = out
+        vec, sim, self.stopped = evaluate(self.model, cfg, setup, limit)
+        if self.stopped:
+            self.stopped_sims += 1
+            return vec, None
+        self.memo[key] = (vec, sim)
         while len(self.memo) > MEMO:
             self.memo.pop(next(iter(self.memo)))
-        return out
+        return vec, sim
 
 
 @dataclass
@@ -180,32 +191,35 @@ def chi2_parts(model: ResidualModel, vec: np.ndarray) -> tuple[float, dict]:
 
 
 def _objective(ctx: FitContext, params, cache: dict):
+    """``fun(u, limit)``: the residual vector (data, then priors) at the unit-cube point ``u``; with a finite ``limit``
+    on its sum of squares the replay may stop once it exceeds it (``FitContext.residual``)."""
     prior_idx = [i for i, fp in enumerate(params) if fp.prior]
 
-    def fun(u):
+    def fun(u, limit=math.inf):
         key = tuple(np.round(u, 12))
-        if key in cache:
-            return cache[key]
+        hit = cache.get(key)
+        if hit is not None and (hit[1] or float(np.dot(hit[0], hit[0])) > limit):
+            return hit[0]
         values = [fp.from_unit(x) for fp, x in zip(params, u)]
-        vec, _ = ctx.residual(params, values)
+        prior = [params[i].prior_residual(values[i]) for i in prior_idx]
+        vec, _ = ctx.residual(params, values, limit - sum(p * p for p in prior))
         if prior_idx:
-            vec = np.concatenate([vec, [params[i].prior_residual(values[i]) for i in prior_idx]])
-        cache[key] = vec
+            vec = np.concatenate([vec, prior])
+        cache[key] = (vec, not ctx.stopped)
         return vec
 
     return fun
 
 
 def _nelder_mead(fun, u0: np.ndarray, maxfev: int, step: float = 0.05) -> np.ndarray:
-    """Simplex search of sum(fun(u)^2) in the unit cube (points outside are clipped and penalised)."""
-    from scipy.optimize import minimize
-
+    """Simplex search of sum(fun(u)^2) in the unit cube (points outside are clipped and penalised; ``servo.simplex``)."""
     k = u0.size
 
-    def f(u):
+    def f(u, limit=math.inf):
         uc = np.clip(u, 0.0, 1.0)
-        out = float(np.dot(r := fun(uc), r))
-        return out * (1.0 + 10.0 * float(np.sum((u - uc) ** 2)))
+        pen = 1.0 + 10.0 * float(np.sum((u - uc) ** 2))
+        out = float(np.dot(r := fun(uc, limit / pen), r))
+        return out * pen
 
     simplex = [u0]
     for i in range(k):
@@ -214,9 +228,7 @@ def _nelder_mead(fun, u0: np.ndarray, maxfev: int, step: float = 0.05) -> np.nda
         simplex.append(v)
     f0 = f(u0)
     # stop when the simplex spans < 0.2 % of the range and its values differ by < 0.1 % (the roughness level)
-    res = minimize(f, u0, method="Nelder-Mead",
-                   options={"initial_simplex": np.array(simplex), "maxfev": maxfev, "xatol": 2e-3, "fatol": 1e-3 * f0})
-    return np.clip(res.x, 0.0, 1.0)
+    return np.clip(simplex_search(f, np.array(simplex), maxfev, xatol=2e-3, fatol=1e-3 * f0), 0.0, 1.0)
 
 
 def least_squares_fit(ctx: FitContext, name: str, params: tuple[ParamHandle, ...], start: list[float], *,
@@ -304,13 +316,21 @@ def _stderr(params, values, jac, n, model, vec, lag: int) -> tuple[list[float], 
     return [fp.stderr(v, float(x)) for fp, v, x in zip(params, values, su)], cov * np.outer(d, d)
 
 
-def scan_points(ctx: FitContext, params, points: list[list[float]]) -> list[float]:
-    """Chi-square (data + prior) at each point of a scan (SI values per point)."""
+def scan_points(ctx: FitContext, params, points: list[list[float]], keep: float | None = None) -> list[float]:
+    """Chi-square (data + prior) at each point of a scan (SI values per point).
+
+    ``keep``: only points within ``keep`` times the best so far matter to the caller (the argmin: 1;
+    a second start within ``SECOND_START`` of the best: that ratio); a replay stops once its point
+    is known to be beyond, and its value is then a lower bound above that level.
+    """
     out = []
+    best = math.inf
     for values in points:
-        vec, _ = ctx.residual(params, values)
         prior = sum(fp.prior_residual(v) ** 2 for fp, v in zip(params, values))
+        limit = keep * best - prior if keep is not None and math.isfinite(best) else math.inf
+        vec, _ = ctx.residual(params, values, limit)
         out.append(float(np.dot(vec, vec)) + prior)
+        best = min(best, out[-1])
     return out
 
 
@@ -346,7 +366,7 @@ def fit_candidate(ctx: FitContext, cand: Candidate, base_fit: FitResult | None, 
     for g in grid:
         points.append([g.get(fp.name, d) for fp, d in zip(eparams, defaults)] + bvalues)
     all_params = tuple(eparams) + bparams
-    chis = scan_points(ctx, all_params, points)
+    chis = scan_points(ctx, all_params, points, keep=SECOND_START)
     best = int(np.argmin(chis))
     if screen is not None and chis[best] > screen:
         vec, _ = ctx.residual(all_params, points[best])

@@ -88,6 +88,7 @@ class JointContext:
     contexts: list
     labels: list
     sims: int = 0
+    stopped: bool = False  # the last ``residual`` did not replay every recording in full
 
     @property
     def model(self) -> JointModel:
@@ -104,14 +105,27 @@ class JointContext:
         """The first recording's configuration (nominal values of recalibrated parameters)."""
         return self.contexts[0].cfg
 
-    def residual(self, params, values) -> tuple[np.ndarray, list | None]:
-        """Stacked normalised residuals of one shared parameter set (each recording replayed with its conditions)."""
+    def residual(self, params, values, limit: float = math.inf) -> tuple[np.ndarray, list | None]:
+        """Stacked normalised residuals of one shared parameter set (each recording replayed with its conditions).
+
+        With a finite ``limit`` on their sum of squares (``servo.fit.FitContext.residual``) the recordings are
+        replayed one after the other against what the limit leaves, and those after the one that
+        exceeds it are not replayed (their residuals are zero; ``stopped`` says so).
+        """
         vecs, sims = [], []
+        chi2 = 0.0
+        self.stopped = False
         for c in self.contexts:
-            v, s = c.residual(params, values)
+            if self.stopped:
+                vecs.append(np.zeros(c.model.size))
+                sims.append(None)
+                continue
+            v, s = c.residual(params, values, limit - chi2)
+            chi2 += float(np.dot(v, v))
+            self.sims += 1
+            self.stopped = c.stopped or chi2 > limit
             vecs.append(v)
             sims.append(s)
-        self.sims += len(self.contexts)
         return np.concatenate(vecs), (None if any(s is None for s in sims) else sims)
 
 
