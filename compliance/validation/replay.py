@@ -208,7 +208,8 @@ def run_replay(cfg: PlantConfig, setup: ReplaySetup, *, noise: np.ndarray | None
     lx, ly = load_curve_arrays(cfg)
     n = setup.n_samples
     out = np.zeros((n + 1, N_OUT))
-    nz = setup.noise if noise is None else noise
+    nz = setup.noise if noise is None else np.ascontiguousarray(noise, dtype=float)
+    quiet = np.zeros(n + 1)
     bounds = list(setup.resets) + [n]
     kp, ki = P[P_KP], P[P_KI]
     if stop is not None and setup.logger is not None and setup.logger.active:
@@ -225,13 +226,12 @@ def run_replay(cfg: PlantConfig, setup: ReplaySetup, *, noise: np.ndarray | None
             y0 = reset_state(cfg, P, setup, k0, out, lx, ly)
             if closed and kp > 0.0 and ki != 0.0:
                 ref = ref + ki * setup.states["integral"][k0] / kp  # carries the integral state (module doc)
-        seg = np.zeros((k1 - k0 + 1, N_OUT))
-        pos_noise = nz[k0:k1 + 1] if closed else np.zeros(k1 - k0 + 1)
-        status = simulate_core(P, y0, np.ascontiguousarray(ref), np.ascontiguousarray(setup.command[k0:k1 + 1]),
-                               closed, np.ascontiguousarray(pos_noise), 0.0, lx, ly, k1 - k0, n_sub, seg)
+        pos_noise = nz[k0:k1 + 1] if closed else quiet[k0:k1 + 1]
+        # the segment writes its rows in place; its last row is the next segment's first, which that one overwrites
+        status = simulate_core(P, y0, np.ascontiguousarray(ref), np.ascontiguousarray(setup.command[k0:k1 + 1]), closed,
+                               np.ascontiguousarray(pos_noise), 0.0, lx, ly, k1 - k0, n_sub, out[k0:k1 + 1])
         if status >= 0:
             raise SimulationError(f"replay of {setup.source} became non-physical at t = {(k0 + status)*ts:.3f} s")
-        out[k0:k1 + 1] = seg
         if stop is not None and k1 < n and stop(out, k1):
             return None
     sim = {c: out[:, OUT[c]] for c in OUTPUT_COLUMNS[1:]}

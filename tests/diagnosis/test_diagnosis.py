@@ -88,7 +88,7 @@ def test_lumped_total_lag_propagates_the_full_covariance():
 def test_newey_west_information_counts_correlated_residuals_as_fewer():
     """White residuals: S = J^T J var(r). AR(1) residuals with rho = 0.8: S approaches the long-run
     variance (1 + rho)/(1 - rho) = 9 times larger, less the Bartlett truncation 2 rho/((L+1)(1-rho)^2)."""
-    from compliance.diagnosis.servo.fit import hac_information
+    from compliance.diagnosis.estimation.standard_errors import hac_information
     from compliance.diagnosis.evidence.residuals import ResidualModel
 
     m, lag, rho = 40000, 50, 0.8

@@ -25,6 +25,7 @@ below J^T J (the floors' own noise level).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -40,12 +41,14 @@ from compliance.diagnosis.servo.candidates import Candidate
 from compliance.diagnosis.servo.instrument_candidates import instrumented
 from compliance.validation.replay import ReplaySetup
 from compliance.diagnosis.evidence.residuals import ResidualModel, evaluate
-from compliance.diagnosis.servo.simplex import simplex_search
+from compliance.diagnosis.estimation.simplex import simplex_search
+from compliance.diagnosis.estimation.standard_errors import fit_errors
 
 DIFF_STEP = 0.01  # forward-difference step, 1 % of each parameter's (log) range
 MAX_NFEV = 6  # least-squares polishing evaluations (besides the Jacobian's)
 SIMPLEX_FEV = 16  # simplex evaluations per fitted parameter
-SECOND_START = 2.0  # a second local fit starts from a grid point within this chi-square ratio of the best
+SECOND_START = 2.0  # a second local fit starts from a grid point within this chi-square ratio of the best ...
+COMPETE = 2.0  # ... of a candidate whose first fit is within this ratio of the best candidate's (the others have lost)
 MEMO = 16  # replays a fit context remembers (each its residuals and simulated signals: ~2 MB for 30 s at 1 kHz)
 HAC_SECONDS = 1.0  # s; Newey-West bandwidth: residual correlation of about one stick-slip episode
 # share of the nominal excess chi-square an effect's best grid point must remove to be refined (our choice: a candidate
@@ -146,6 +149,7 @@ class FitResult:
     message: str = ""
     scan: list = field(default_factory=list)
     cov: np.ndarray | None = None  # covariance of the fitted values [SI], from the final Jacobian
+    second_from: list | None = None  # start of a second local fit not run yet (``fit_candidate``'s ``second``)
 
     @property
     def k(self) -> int:
@@ -262,58 +266,11 @@ def least_squares_fit(ctx: FitContext, name: str, params: tuple[ParamHandle, ...
     chi2, parts = chi2_parts(ctx.model, vec)
     t_res = ctx.setup.time[ctx.model.index]
     dt_res = float(np.median(np.diff(t_res))) if t_res.size > 1 else 1.0
-    stderr, cov = _stderr(params, values, res.jac, n, ctx.model, vec, max(1, int(round(HAC_SECONDS / dt_res))))
+    stderr, cov = fit_errors(params, values, res.jac, n, ctx.model, vec, max(1, int(round(HAC_SECONDS / dt_res))))
     out = FitResult(name, tuple(params), values, stderr, chi2, parts, n, ctx.sims - sims0,
                     time.perf_counter() - t0, str(res.message))
     out.cov = cov
     return out
-
-
-def hac_information(jac_data: np.ndarray, vec: np.ndarray, model: ResidualModel, lag: int) -> np.ndarray:
-    """Newey-West (1987) estimate of the residual scores' covariance S, per signal block.
-
-    Parameters
-    ----------
-    jac_data : ndarray (n, k)
-        Jacobian rows of the data residuals.
-    vec : ndarray (n,)
-        Data residuals (normalised).
-    model : ResidualModel
-        Gives the per-signal blocks (each a time series).
-    lag : int
-        Bandwidth L in residual samples (Bartlett weights 1 - l/(L + 1)).
-    """
-    k = jac_data.shape[1]
-    s = np.zeros((k, k))
-    # one block per signal; a joint model of several recordings (servo/joint_recordings.py) has blocks of its own lengths
-    sizes = getattr(model, "block_sizes", None) or [model.index.size] * len(model.signals)
-    start = 0
-    for m in sizes:
-        g = jac_data[start:start + m] * vec[start:start + m, None]
-        start += m
-        s += g.T @ g
-        for lg in range(1, min(lag, m - 1) + 1):
-            c = g[lg:].T @ g[:-lg]
-            s += (1.0 - lg / (lag + 1.0)) * (c + c.T)
-    return s
-
-
-def _stderr(params, values, jac, n, model, vec, lag: int) -> tuple[list[float], np.ndarray]:
-    """Standard errors [SI] and the covariance [SI] of the fitted values (Newey-West sandwich)."""
-    k = len(params)
-    jd, jp = jac[:n], jac[n:]  # data rows, prior rows (independent, unit variance)
-    try:
-        a_inv = np.linalg.pinv(jac.T @ jac)
-        s = hac_information(jd, vec, model, lag)
-        plain = jd.T @ jd
-        if np.trace(s) < np.trace(plain):
-            s = s * (np.trace(plain) / max(np.trace(s), 1e-300))  # never below the floors' noise
-        cov = a_inv @ (s + jp.T @ jp) @ a_inv
-    except np.linalg.LinAlgError:
-        cov = np.full((k, k), np.inf)
-    su = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-    d = np.array([fp.stderr(v, 1.0) for fp, v in zip(params, values)])  # dvalue/du (linear in sigma_u)
-    return [fp.stderr(v, float(x)) for fp, v, x in zip(params, values, su)], cov * np.outer(d, d)
 
 
 def scan_points(ctx: FitContext, params, points: list[list[float]], keep: float | None = None) -> list[float]:
@@ -343,7 +300,7 @@ def replays_bound(cand: Candidate) -> int:
 
 
 def fit_candidate(ctx: FitContext, cand: Candidate, base_fit: FitResult | None, *, max_nfev: int = MAX_NFEV,
-                  screen: float | None = None) -> FitResult:
+                  screen: float | None = None, second: bool = True) -> FitResult:
     """Fit one effect on top of the recalibrated base, co-fitting the recalibrated base parameters.
 
     The effect's grid is scanned with the base parameters at their recalibrated values; the
@@ -354,6 +311,10 @@ def fit_candidate(ctx: FitContext, cand: Candidate, base_fit: FitResult | None, 
 
     ``screen`` (a chi-square): when no grid point gets below it, the candidate is not refined and
     its result is the best grid point (``message`` says so; no standard errors).
+
+    ``second``: False leaves the second local fit to the caller (``second_start``), who runs it only
+    for a candidate that still competes once every first fit is known; the result's
+    ``second_from`` holds its start.
     """
     t0 = time.perf_counter()
     sims0 = ctx.sims
@@ -379,13 +340,34 @@ def fit_candidate(ctx: FitContext, cand: Candidate, base_fit: FitResult | None, 
     if len(eparams) > 1:
         others = [i for i in np.argsort(chis) if points[i][0] != points[best][0]]
         if others and chis[others[0]] <= SECOND_START * chis[best]:
-            alt = least_squares_fit(ctx, cand.name, all_params, points[others[0]], max_nfev=max_nfev)
-            if alt.chi2 < res.chi2:
-                res = alt
+            if second:
+                alt = least_squares_fit(ctx, cand.name, all_params, points[others[0]], max_nfev=max_nfev)
+                if alt.chi2 < res.chi2:
+                    res = alt
+            else:
+                res.second_from = list(points[others[0]])
     res.sims = ctx.sims - sims0
     res.seconds = time.perf_counter() - t0
     res.scan = [(dict(zip([fp.key for fp in all_params], p)), c) for p, c in zip(points, chis)]
     return res
 
 
-__all__ = ["FitContext", "FitResult", "fit_candidate", "replays_bound", "screen_level", "least_squares_fit", "scan_points", "chi2_parts"]
+def second_start(ctx: FitContext, first: FitResult, *, max_nfev: int = MAX_NFEV) -> FitResult:
+    """``first`` or the second local fit from ``first.second_from``, whichever fits better (``fit_candidate``)."""
+    t0 = time.perf_counter()
+    alt = least_squares_fit(ctx, first.name, first.params, first.second_from, max_nfev=max_nfev)
+    best = alt if alt.chi2 < first.chi2 else first
+    out = dataclasses.replace(best, sims=first.sims + alt.sims, seconds=first.seconds + time.perf_counter() - t0,
+                              second_from=None, scan=first.scan)
+    out.cov = best.cov
+    return out
+
+
+def competing(fits, factor: float = COMPETE) -> list:
+    """The fits that still compete: a chi-square within ``factor`` of the best one."""
+    finite = [f.chi2 for f in fits if math.isfinite(f.chi2)]
+    best = min(finite, default=math.inf)
+    return [f for f in fits if f.chi2 <= factor * best]
+
+
+__all__ = ["FitContext", "FitResult", "competing", "fit_candidate", "second_start", "replays_bound", "screen_level", "least_squares_fit", "scan_points", "chi2_parts"]
