@@ -108,10 +108,10 @@ class FitContext:
         if self.stopped:
             self.stopped_sims += 1
             return vec, None
-        self.memo[key] = (vec, sim)
+        out = self.memo[key] = (vec, sim)
         while len(self.memo) > MEMO:
             self.memo.pop(next(iter(self.memo)))
-        return vec, sim
+        return out
 
 
 @dataclass
