@@ -48,7 +48,7 @@ from compliance.validation.recorded_noise import NOISE_FREE_STD, replay_noise, r
 from compliance.validation.replay_conditions import (command_from_of, flow_control_of, initial_conditions, load_at_start, load_of,
                                                      replay_config, where_of)
 from compliance.validation.replay_reset import OUT, reset_state, start_state
-from compliance.validation.replay_setup import ReplaySetup, recorded_states, replay_conditions, resolutions
+from compliance.validation.replay_setup import ReplaySetup, clip_to_full_scale, full_scale, recorded_states, replay_conditions, resolutions
 from compliance.validation.replay_segments import MAX_SEGMENT, plan_segments
 from compliance.validation.resampling import logged_indices, on_controller_clock
 
@@ -146,7 +146,7 @@ def prepare_replay(cfg: PlantConfig, frame: pd.DataFrame, meta: dict | None, *, 
         closed_loop=closed, load=load, initial_position=float(x0), initial_pressures=pressures,
         noise=np.ascontiguousarray(injected), recorded=rec, resets=resets, states=states, overrides=overrides,
         notes=notes, source=src, logged=logged, logger=logger, resolution=resolution, command_from=command_from,
-        flow_control=fc, conditions=conditions, noise_replay=bool(np.any(injected)),
+        flow_control=fc, conditions=conditions, noise_replay=bool(np.any(injected)), full_scale=full_scale(rec, logged),
     )
 
 
@@ -235,7 +235,10 @@ def run_replay(cfg: PlantConfig, setup: ReplaySetup, *, noise: np.ndarray | None
         if stop is not None and k1 < n and stop(out, k1):
             return None
     sim = {c: out[:, OUT[c]] for c in OUTPUT_COLUMNS[1:]}
-    return setup.logger.apply(sim, ts) if setup.logger is not None else sim  # as the logger recorded it
+    sim = setup.logger.apply(sim, ts) if setup.logger is not None else sim  # as the logger recorded it ...
+    for s, levels in setup.full_scale.items():  # ... and as a transducer at its full scale read it
+        sim[s] = clip_to_full_scale(sim[s], levels)
+    return sim
 
 
 def replay(cfg: PlantConfig, recording: pd.DataFrame, metadata: dict | None = None, mode: str = "closed_loop", *,

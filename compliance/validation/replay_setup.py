@@ -69,6 +69,9 @@ class ReplaySetup:
         lattice of the logged samples (0 when none).
     noise_replay : bool
         The recording's own noise is fed to the model's controller.
+    full_scale : dict
+        Pressure signal -> (low, high) [Pa abs] where its transducer saturated (either None when it
+        did not; ``full_scale``).
     """
 
     time: np.ndarray
@@ -92,6 +95,7 @@ class ReplaySetup:
     flow_control: bool | None = None
     conditions: dict = field(default_factory=dict)
     noise_replay: bool = False
+    full_scale: dict = field(default_factory=dict)
 
     def __post_init__(self):
         if self.command_from < 0:
@@ -143,6 +147,40 @@ def recorded_states(rec: dict, reference: np.ndarray | None, ts: float) -> dict:
     return states
 
 
+SATURATED_RUN = 10  # consecutive samples at exactly a channel's extreme: a transducer at its full scale
+
+
+def full_scale(rec: dict, logged: np.ndarray | None) -> dict:
+    """Pressure signal -> (low, high) where its transducer saturated, each None when it did not [Pa abs].
+
+    A transducer past its range reads its full scale, exactly, sample after sample (a 0-10 bar
+    transmitter under a closing stroke's compressed chamber reads 10 bar while the chamber holds
+    more); a live reading with noise never repeats one value ``SATURATED_RUN`` times at its extreme.
+    The replay does not restart a segment from such a reading and clips its own signal where the
+    transducer did.
+    """
+    out = {}
+    for s in ("pressure_a", "pressure_b", "supply_pressure"):
+        if s not in rec:
+            continue
+        v = rec[s] if logged is None else rec[s][logged]
+        levels = []
+        for extreme in (float(np.min(v)), float(np.max(v))):
+            at = np.concatenate(([0], (v == extreme).astype(np.int8), [0]))
+            edges = np.flatnonzero(np.diff(at))
+            longest = int(np.max(edges[1::2] - edges[::2])) if edges.size else 0
+            levels.append(extreme if longest >= SATURATED_RUN and np.ptp(v) > 0 else None)
+        if levels != [None, None]:
+            out[s] = tuple(levels)
+    return out
+
+
+def clip_to_full_scale(values: np.ndarray, levels: tuple) -> np.ndarray:
+    """``values`` as the saturating transducer reads them (``full_scale``)."""
+    lo, hi = levels
+    return np.clip(values, -np.inf if lo is None else lo, np.inf if hi is None else hi)
+
+
 def resolutions(rec: dict, logged: np.ndarray | None, meta: dict) -> dict:
     """Signal -> quantisation step [SI]: the channel's declared resolution, else the logged samples' lattice."""
     channels = meta.get("channels") or {}
@@ -178,4 +216,5 @@ def replay_conditions(run_cfg: PlantConfig, meta: dict, init: dict, start: float
     }
 
 
-__all__ = ["ReplaySetup", "STATE_WINDOW", "VELOCITY_WINDOW", "recorded_states", "replay_conditions", "resolutions"]
+__all__ = ["ReplaySetup", "SATURATED_RUN", "STATE_WINDOW", "VELOCITY_WINDOW", "clip_to_full_scale", "full_scale", "recorded_states",
+           "replay_conditions", "resolutions"]

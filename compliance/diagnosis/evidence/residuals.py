@@ -21,6 +21,7 @@ from compliance.errors import InputError, SimulationError
 from compliance.validation.recorded_noise import QUANTISED_SHARE, sensor_noise_std
 from compliance.validation.replay_conditions import load_at_start
 from compliance.validation.replay import ReplaySetup, prepare_replay, run_replay
+from compliance.validation.replay_setup import clip_to_full_scale
 from compliance.validation.fit_metrics import nrmse
 from compliance.simulation.rk4 import OUTPUT_COLUMNS
 
@@ -144,7 +145,7 @@ def null_recording(cfg: PlantConfig, setup: ReplaySetup, sensor: dict, seed: int
         frame["reference"] = setup.reference[:n]
     for s_ in ("pressure_a", "pressure_b", "supply_pressure"):
         if s_ in rec:
-            frame[s_] = syn[s_][:n]
+            frame[s_] = syn[s_][:n] if s_ not in setup.full_scale else clip_to_full_scale(syn[s_][:n], setup.full_scale[s_])
     if setup.logger is not None:  # through the recording's instruments (filter, delays, calibration) ...
         logged = setup.logger.apply({c: frame[c].to_numpy() for c in frame.columns}, ts)
         frame = pd.DataFrame({c: logged[c] for c in frame.columns})
@@ -315,8 +316,9 @@ class Bound:
     squares is the partial chi-square, a lower bound of the full one.
     """
 
-    def __init__(self, model: ResidualModel, limit: float):
+    def __init__(self, model: ResidualModel, limit: float, full_scale: dict | None = None):
         self.model, self.limit = model, limit
+        self.full_scale = full_scale or {}
         self.vec = np.zeros(model.size)
         self.chi2 = 0.0
         self.done = 0  # fitted samples accounted for (positions in model.index)
@@ -335,7 +337,8 @@ class Bound:
             scale = m.scale(s)
             if not np.isscalar(scale):
                 scale = scale[self.done:j]
-            r = (m.recorded[s][idx] - out[idx, col]) / scale
+            sim = out[idx, col] if s not in self.full_scale else clip_to_full_scale(out[idx, col], self.full_scale[s])
+            r = (m.recorded[s][idx] - sim) / scale
             self.vec[i * size + self.done:i * size + j] = r
             self.chi2 += float(np.dot(r, r))
         self.done = j
@@ -348,7 +351,7 @@ def evaluate(model: ResidualModel, cfg: PlantConfig, setup: ReplaySetup, limit: 
     With a finite ``limit`` the replay stops at the first segment where its chi-square exceeds it
     (``Bound``); the vector then holds the residuals so far, zeros beyond.
     """
-    bound = Bound(model, limit) if math.isfinite(limit) else None
+    bound = Bound(model, limit, setup.full_scale) if math.isfinite(limit) else None
     try:
         sim = run_replay(cfg, setup, stop=bound)
     except SimulationError:

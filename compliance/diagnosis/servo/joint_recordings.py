@@ -1,8 +1,10 @@
-"""Joint diagnosis of several closed-loop recordings of one plant: shared physics, each test's own conditions.
+"""Joint diagnosis of several recordings of one plant: shared physics, each test's own conditions.
 
 ``diagnose_joint(cfg, recordings)`` runs the single-recording engine's stages on each recording
-(``servo.diagnose.prepare_recording``: the replay with the recording's own load, start, supply pressure
-and controller gains from its sidecar, its noise floors) and then fits every candidate - the
+(``servo.diagnose.prepare_recording``: the replay with the recording's own load, start, supply pressure,
+controller gains, flow-control valves and loop switch from its sidecar, its noise floors; a closed-loop
+test, a full stroke driven by its valve command, a hold whose positioner went to manual: a site's
+commissioning tests) and then fits every candidate - the
 recalibration of base parameters and each declared effect - with *one* parameter set shared by
 all recordings. The objective is the sum of the per-recording chi-squares, each recording's
 residuals normalised by its own floors (``JointContext``); the information criteria count every
@@ -37,11 +39,11 @@ from compliance.errors import InputError
 from compliance.files.jsonable import json_number
 from compliance.model.config import PlantConfig, plant_from_dict
 from compliance.diagnosis.servo.candidates import base_params, effect_candidate, signature_order
-from compliance.diagnosis.servo.fit import FitContext, FitResult, chi2_parts, screen_level
+from compliance.diagnosis.servo.fit import FitContext, FitResult, chi2_parts, competing, screen_level
 from compliance.diagnosis.servo.report_data import SCHEMA
 from compliance.diagnosis.servo.selection import AMBIGUOUS_BIC, RESIDUAL_LIMIT, ambiguity_set, honest, score_all, signals_left, verdict
 from compliance.diagnosis.verdicts.verdict import EXPLAINED, DiagnosisVerdict
-from compliance.diagnosis.servo.parallel_fits import FitEffect, RecalibrateBase
+from compliance.diagnosis.servo.parallel_fits import FitEffect, RecalibrateBase, SecondStart
 
 
 
@@ -217,10 +219,6 @@ def _stages(cfg: PlantConfig, recordings, stride: int, jobs, scheduler) -> tuple
     from compliance.campaign.executor import warm_up
     from compliance.processes import map_tasks
 
-    for i, (frame, meta) in enumerate(recordings, 1):
-        if "reference" not in frame.columns:
-            raise InputError(f"{meta.get('source_path', f'recording {i}')}: a joint diagnosis needs closed-loop recordings "
-                             "(a 'reference' column); diagnose an open-loop recording on its own")
     warm_up(cfg)  # the compiled core loaded once, before the workers fork
     stages, stats = map_tasks(_prepare_task, (cfg, stride), list(recordings), workers=jobs, scheduler=scheduler,
                               progress=False, label="replays", retries=0)
@@ -252,12 +250,21 @@ def _fit_all(stages, labels, names, recalibrate, jobs, scheduler) -> tuple[dict,
                                label="joint fits", retries=1)
     if stats.failed:
         raise RuntimeError(f"joint fit failed: {stats.errors[0][1]}")
-    return {res.name: res for res in results}, stats
+    fits = {res.name: res for res in results}
+    # a second local fit only where it can still matter (servo.fit.competing)
+    second = [SecondStart(f) for f in competing(list(fits.values())) if f.second_from]
+    if second:
+        more, stats2 = map_tasks(_task, payload, second, workers=jobs, scheduler=scheduler, progress=False,
+                                 label="joint fits", retries=1)
+        if stats2.failed:
+            raise RuntimeError(f"joint fit failed: {stats2.errors[0][1]}")
+        fits.update({res.name: res for res in more})
+    return fits, stats
 
 
 def diagnose_joint(cfg: PlantConfig, recordings, *, effects=None, jobs: int | None = None, scheduler: str | None = None,
                    stride: int = 5, recalibrate: bool | tuple = True) -> JointDiagnosis:
-    """Diagnose several closed-loop recordings of one plant together (see the module docstring).
+    """Diagnose several recordings of one plant together (see the module docstring).
 
     Parameters
     ----------
@@ -279,7 +286,7 @@ def diagnose_joint(cfg: PlantConfig, recordings, *, effects=None, jobs: int | No
     Raises
     ------
     InputError
-        No recording, an open-loop recording, an unknown effect, a recording the replay cannot use.
+        No recording, an unknown effect, a recording the replay cannot use.
     """
     from compliance.diagnosis.servo.stage import check_effects
 
