@@ -18,7 +18,8 @@ import pytest
 from compliance.cli import main
 from compliance.model.config import load_plant
 from compliance.diagnosis.evidence.discriminating_test import SUPPLY_FACTOR
-from compliance.diagnosis.servo.joint_recordings import JointModel, diagnose_joint
+from compliance.diagnosis.estimation.joint_residuals import JointModel
+from compliance.diagnosis.servo.joint_recordings import diagnose_joint
 from compliance.diagnosis.servo.selection import RESIDUAL_LIMIT
 from compliance.recordings.synth import PRACTICE_NOISE, synthesise, write_recording
 

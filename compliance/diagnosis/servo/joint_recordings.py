@@ -35,100 +35,18 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from compliance.effects import EFFECTS
 from compliance.errors import InputError
 from compliance.files.jsonable import json_number
 from compliance.model.config import PlantConfig, plant_from_dict
 from compliance.diagnosis.servo.candidates import base_params, effect_candidate, signature_order
-from compliance.diagnosis.servo.fit import FitContext, FitResult, chi2_parts, competing, screen_level
+from compliance.diagnosis.servo.fit import FitContext, FitResult, chi2_parts, competing, least_squares_fit, screen_level
 from compliance.diagnosis.servo.report_data import SCHEMA
 from compliance.diagnosis.servo.selection import AMBIGUOUS_BIC, RESIDUAL_LIMIT, ambiguity_set, honest, score_all, signals_left, verdict
 from compliance.diagnosis.verdicts.verdict import EXPLAINED, DiagnosisVerdict
 from compliance.diagnosis.servo.parallel_fits import FitEffect, RecalibrateBase, SecondStart
+from compliance.diagnosis.estimation.joint_residuals import JointContext, JointModel
 
-
-
-@dataclass
-class JointModel:
-    """The residual models of several recordings as one: signal blocks labelled ``recording:signal``."""
-
-    parts: list
-    labels: list
-
-    @property
-    def size(self) -> int:
-        """Length of the stacked residual vector."""
-        return int(sum(p.size for p in self.parts))
-
-    @property
-    def signals(self) -> tuple:
-        """Block labels ``label:signal``, in vector order."""
-        return tuple(f"{lab}:{s}" for lab, p in zip(self.labels, self.parts) for s in p.signals)
-
-    @property
-    def block_sizes(self) -> list:
-        """Length of each block (a signal of one recording), for the per-block autocorrelation of ``servo.fit``."""
-        return [p.index.size for p in self.parts for _ in p.signals]
-
-    @property
-    def index(self) -> np.ndarray:
-        """The first recording's fitted samples (only their spacing is read: ``servo.fit.HAC_SECONDS`` in samples)."""
-        return self.parts[0].index
-
-    def split(self, vec: np.ndarray) -> dict:
-        """Block label -> its part of a residual vector."""
-        out, start = {}, 0
-        for lab, m in zip(self.signals, self.block_sizes):
-            out[lab] = vec[start:start + m]
-            start += m
-        return out
-
-
-@dataclass
-class JointContext:
-    """What every joint fit shares: one ``FitContext`` per recording (its own configuration, replay, floors)."""
-
-    contexts: list
-    labels: list
-    sims: int = 0
-    stopped: bool = False  # the last ``residual`` did not replay every recording in full
-
-    @property
-    def model(self) -> JointModel:
-        """The stacked residual model."""
-        return JointModel([c.model for c in self.contexts], self.labels)
-
-    @property
-    def setup(self):
-        """The first recording's replay (its time base gives the residual spacing)."""
-        return self.contexts[0].setup
-
-    @property
-    def cfg(self) -> PlantConfig:
-        """The first recording's configuration (nominal values of recalibrated parameters)."""
-        return self.contexts[0].cfg
-
-    def residual(self, params, values, limit: float = math.inf) -> tuple[np.ndarray, list | None]:
-        """Stacked normalised residuals of one shared parameter set (each recording replayed with its conditions).
-
-        With a finite ``limit`` on their sum of squares (``servo.fit.FitContext.residual``) the recordings are
-        replayed one after the other against what the limit leaves, and those after the one that
-        exceeds it are not replayed (their residuals are zero; ``stopped`` says so).
-        """
-        vecs, sims = [], []
-        chi2 = 0.0
-        self.stopped = False
-        for c in self.contexts:
-            if self.stopped:
-                vecs.append(np.zeros(c.model.size))
-                sims.append(None)
-                continue
-            v, s = c.residual(params, values, limit - chi2)
-            chi2 += float(np.dot(v, v))
-            self.sims += 1
-            self.stopped = c.stopped or chi2 > limit
-            vecs.append(v)
-            sims.append(s)
-        return np.concatenate(vecs), (None if any(s is None for s in sims) else sims)
 
 
 def _joint_context(labels, parts) -> JointContext:
@@ -227,6 +145,60 @@ def _stages(cfg: PlantConfig, recordings, stride: int, jobs, scheduler) -> tuple
     return stages, [f"R{i}" for i in range(1, len(stages) + 1)]
 
 
+def _throttled(cfg: PlantConfig, setup) -> bool:
+    return cfg.flow_control_installed if setup.flow_control is None else bool(setup.flow_control)
+
+
+def _commissioned(cfg: PlantConfig, stages, labels, recordings, stride: int, jobs, scheduler):
+    """The site's flow-control throttles fitted on the recordings that ran with them, and the stages on them.
+
+    A site's needles 2V2/2V3 sit where its commissioning engineer left them (``servo.candidates.THROTTLES``),
+    and a full stroke's open-loop replay integrates a few per cent of throttle error into millimetres: left
+    at the plant file's values they would hold most of every stroke's residual and each candidate would be
+    judged on them. They are test conditions, like the supply pressure: fitted first (one shared pair,
+    priors on the file's values), and every candidate is then fitted on top.
+
+    Returns
+    -------
+    (PlantConfig, list, FitResult or None)
+        The configuration with the fitted throttles (unchanged when no recording ran with them or
+        the fit does not improve on the file's values), its stages, the fit.
+    """
+    from compliance.model.config import plant_to_toml
+    from compliance.model.parameters import apply
+
+    chosen = [i for i, st in enumerate(stages) if _throttled(cfg, st.setup)]
+    params = base_params(cfg, keys=(), throttles=True)
+    if not chosen or not params:
+        return cfg, stages, None
+    ctx = _joint_context([labels[i] for i in chosen], [(plant_to_toml(stages[i].rc), stages[i].setup, stages[i].model)
+                                                       for i in chosen])
+    fit = least_squares_fit(ctx, "flow_control", params, [fp.nominal for fp in params])
+    fit.sims = ctx.sims
+    if not fit.chi2 < sum(stages[i].fits["nominal"].chi2 for i in chosen):
+        return cfg, stages, fit
+    cfg = apply(cfg, params, fit.values)
+    stages, _ = _stages(cfg, recordings, stride, jobs, scheduler)
+    return cfg, stages, fit
+
+
+def _with_settings(fits: dict, settings, stages, labels) -> None:
+    """Each effect that still competes refitted together with the site's throttles (in place, when that fits better):
+    the throttles were fitted on the nominal plant, and an effect that changes a stroke moves them too."""
+    from compliance.model.config import plant_to_toml
+
+    if settings is None or not settings.params:
+        return
+    ctx = _joint_context(labels, [(plant_to_toml(s.rc), s.setup, s.model) for s in stages])
+    for f in competing([f for k, f in fits.items() if k in EFFECTS]):
+        params = tuple(f.params) + tuple(settings.params)
+        res = least_squares_fit(ctx, f.name, params, list(f.values) + list(settings.values), simplex_fev=8)
+        res.sims = f.sims + ctx.sims
+        ctx.sims = 0
+        if res.chi2 < f.chi2:
+            fits[f.name] = res
+
+
 def _fit_all(stages, labels, names, recalibrate, jobs, scheduler) -> tuple[dict, object]:
     """Stage 3, joint: the recalibration and one fit per effect, each with one parameter set for every recording."""
     from compliance.model.config import plant_to_toml
@@ -295,7 +267,9 @@ def diagnose_joint(cfg: PlantConfig, recordings, *, effects=None, jobs: int | No
         raise InputError("a joint diagnosis needs at least one recording")
     names = check_effects(cfg, effects)
     stages, labels = _stages(cfg, recordings, stride, jobs, scheduler)
+    cfg, stages, settings = _commissioned(cfg, stages, labels, recordings, stride, jobs, scheduler)
     fits, stats = _fit_all(stages, labels, names, recalibrate, jobs, scheduler)
+    _with_settings(fits, settings, stages, labels)
     model = JointModel([s.model for s in stages], labels)
     n = model.size
     nvec = np.concatenate([s.nvec for s in stages])
@@ -317,6 +291,10 @@ def diagnose_joint(cfg: PlantConfig, recordings, *, effects=None, jobs: int | No
             for lab, s in zip(labels, stages)]
     sims = sum(s.sims for s in stages) + sum(f.sims for k, f in fits.items() if k != "nominal")
     notes = [f"{lab}: {note}" for lab, s in zip(labels, stages) for note in s.setup.notes]
+    if settings is not None:
+        sims += settings.sims
+        notes.insert(0, "the flow-control throttles as commissioned on site, fitted first on the recordings that ran with them: "
+                     + ", ".join(f"{fp.key} = {v:.4g} {fp.unit}" for fp, v in zip(settings.params, settings.values)))
     return JointDiagnosis(verdict_name, reason, winner, ambiguous, fits, scores, objectives, recs, n,
                           time.perf_counter() - t0, sims, stats.workers, stats.backend, notes)
 
@@ -349,4 +327,4 @@ def format_joint(d: dict, quiet: bool = False) -> str:
     return "\n".join(lines)
 
 
-__all__ = ["JointContext", "JointDiagnosis", "JointModel", "diagnose_joint", "format_joint"]
+__all__ = ["JointDiagnosis", "diagnose_joint", "format_joint"]
