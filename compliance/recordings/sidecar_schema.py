@@ -6,8 +6,7 @@ so a misspelt key is never silently ignored and its default silently used. A qua
 of the wrong kind (a load in tonnes, a mass, where a force is expected) is named before any
 conversion hides it. The instruments' tables, ``[logger]`` and ``[channels.NAME]``
 (docs/recording-format.md), have their own declaration in ``recordings/instruments.py``, which
-checks them, and so has the test as run, ``[test]`` (``recordings/test_table.py``); here they are
-known keys.
+checks them; here they are known keys.
 """
 
 from __future__ import annotations
@@ -61,8 +60,7 @@ SIDECAR_SCHEMA: dict = {
     "logger": Free("the logger: rate, anti-alias filter (recordings/instruments.py)"),
     "channels": Free("each channel's sensor: delay, resolution, gain, offset (recordings/instruments.py)"),
     "synthesis": Free("how a synthetic recording was made (compliance.recordings.synth)"),
-    # the test as run (kind, steps, direction, hold window, ...) is declared and checked in recordings/test_table.py
-    "test": Free("the test as run: kind, step sizes and times, direction, hold window (recordings/test_table.py)"),
+    "test": Free("the test as run: kind, times, flow-control valves, hold window (the replay reads flow_control and valve_null_from)"),
 }
 
 
