@@ -136,7 +136,7 @@ def null_recording(cfg: PlantConfig, setup: ReplaySetup, sensor: dict, seed: int
                         pressure_quantum=qp)
     t = setup.time
     ts = float(np.median(np.diff(t)))
-    pre = int(round(NULL_PRE_ROLL / ts))
+    pre = min(int(round(NULL_PRE_ROLL / ts)), t.size)  # a recording shorter than the pre-roll settles for as long as it lasts
     load = load_at_start(cfg, setup.load, setup.initial_position)
     syn = _null_run(cfg, setup, pre, load, noise, seed)
     n = min(len(syn["position"]), t.size)
