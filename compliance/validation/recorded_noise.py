@@ -25,7 +25,10 @@ import math
 import numpy as np
 from scipy.signal import savgol_coeffs, savgol_filter
 
-NOISE_FREE_STD = 1e-7  # m; below 0.1 um (finer than any position transducer) a recording counts as noise-free
+# m; a recording whose position noise estimate spreads less than 1 um counts as noise-free: a gate servo's transducer
+# over a 100-400 mm stroke scatters more (the practice recordings: 20 um), while what the 41 ms cubic smoother of
+# ``position_noise_estimate`` leaves of a noise-free step response is 0.1-0.3 um (our choice)
+NOISE_FREE_STD = 1e-6
 MAD_TO_STD = 1.4826  # normal distribution: std = 1.4826 * MAD (1 / the 75 % quantile of the standard normal)
 MIN_REST_SAMPLES = 200  # consecutive pairs at rest for the difference floor to use only those
 
