@@ -58,6 +58,7 @@ class JointContext:
     labels: list
     sims: int = 0
     stopped: bool = False  # the last ``residual`` did not replay every recording in full
+    order: list | None = None  # recordings in the order they are replayed (``residual``)
 
     @property
     def model(self) -> JointModel:
@@ -79,22 +80,26 @@ class JointContext:
 
         With a finite ``limit`` on their sum of squares (``servo.fit.FitContext.residual``) the recordings are
         replayed one after the other against what the limit leaves, and those after the one that
-        exceeds it are not replayed (their residuals are zero; ``stopped`` says so).
+        exceeds it are not replayed (their residuals are zero; ``stopped`` says so). They are replayed
+        in the order of their share of the first full evaluation, largest first (where a worse candidate
+        shows soonest); the vector keeps the recordings' order.
         """
-        vecs, sims = [], []
+        n = len(self.contexts)
+        vecs, sims = [None] * n, [None] * n
         chi2 = 0.0
         self.stopped = False
-        for c in self.contexts:
+        for i in self.order or range(n):
+            c = self.contexts[i]
             if self.stopped:
-                vecs.append(np.zeros(c.model.size))
-                sims.append(None)
+                vecs[i] = np.zeros(c.model.size)
                 continue
             v, s = c.residual(params, values, limit - chi2)
             chi2 += float(np.dot(v, v))
             self.sims += 1
             self.stopped = c.stopped or chi2 > limit
-            vecs.append(v)
-            sims.append(s)
+            vecs[i], sims[i] = v, s
+        if self.order is None and not self.stopped:
+            self.order = sorted(range(n), key=lambda i: -float(np.dot(vecs[i], vecs[i])))
         return np.concatenate(vecs), (None if any(s is None for s in sims) else sims)
 
 
