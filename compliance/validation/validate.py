@@ -179,7 +179,9 @@ def _compare_mode(recording: pd.DataFrame, sim: pd.DataFrame, mode: str, regimes
     """
     t = recording["time"].to_numpy(dtype=float)
     exclude = ("valve_command",) if mode == "plant_only" else ()
-    located, floors, levels = locate(recording, sim, regimes, bases, settings.locate, exclude=exclude)
+    switch = sim.attrs["conditions"].get("command_from")
+    located, floors, levels = locate(recording, sim, regimes, bases, settings.locate, exclude=exclude,
+                                     command_input_from=None if switch is None or mode != "closed_loop" else t[0] + switch)
     events = merge_across_signals(located, regimes, settings.locate.merge_gap)
     signals = [s for s in floors]  # compared signals, in SIGNALS order
     fits = {s: {**signal_fit(recording[s].to_numpy(dtype=float), sim[s].to_numpy(dtype=float)), "unit": SIGNAL_UNITS[s]} for s in signals}
