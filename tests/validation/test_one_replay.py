@@ -76,3 +76,12 @@ def test_a_transducer_at_full_scale_is_found_and_the_model_clipped_alike(plant):
     found = full_scale({"pressure_a": clipped, "pressure_b": v}, None)
     assert found == {"pressure_a": (None, 1e6)}  # a live reading never repeats its maximum SATURATED_RUN times
     assert np.count_nonzero(clipped == 1e6) >= SATURATED_RUN
+
+
+def test_a_hold_tests_command_floor_is_the_controllers(plant):
+    frame, meta = read_recording(HOLD)
+    result = validate(plant, frame, meta, ValidationSettings(modes=("closed_loop",)))
+    # the controller's command dithers by ~0.3 V around the dead band until the switch; the 0 V written after it is
+    # the replay's input, not a measurement: a floor from it (its quantisation, 0.1 mV) would flag every dither
+    assert result["noise_floors"]["valve_command"]["value"] > 0.05
+    assert result["conditions"]["command_from"] == pytest.approx(1.0)
