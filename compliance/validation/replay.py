@@ -42,7 +42,7 @@ from compliance.model.config import PlantConfig
 from compliance.model.plant_vector import load_curve_arrays, parameter_vector
 from compliance.model.vector_slots import P_KI, P_KP
 from compliance.simulation.pid_loop import simulate_core
-from compliance.simulation.rk4 import N_OUT, OUTPUT_COLUMNS
+from compliance.simulation.rk4 import OUTPUT_COLUMNS, output_buffer
 from compliance.validation.logger_model import logger_model
 from compliance.validation.recorded_noise import NOISE_FREE_STD, replay_noise, robust_std
 from compliance.validation.replay_conditions import (command_from_of, flow_control_of, initial_conditions, load_at_start, load_of,
@@ -207,7 +207,7 @@ def run_replay(cfg: PlantConfig, setup: ReplaySetup, *, noise: np.ndarray | None
     n_sub = int(round(ts / cfg.p("simulation.step")))
     lx, ly = load_curve_arrays(cfg)
     n = setup.n_samples
-    out = np.zeros((n + 1, N_OUT))
+    out = output_buffer(n + 1)  # by column, as the loop writes it: each signal contiguous
     nz = setup.noise if noise is None else np.ascontiguousarray(noise, dtype=float)
     quiet = np.zeros(n + 1)
     bounds = list(setup.resets) + [n]
@@ -226,12 +226,14 @@ def run_replay(cfg: PlantConfig, setup: ReplaySetup, *, noise: np.ndarray | None
             y0 = reset_state(cfg, P, setup, k0, out, lx, ly)
             if closed and kp > 0.0 and ki != 0.0:
                 ref = ref + ki * setup.states["integral"][k0] / kp  # carries the integral state (module doc)
+        seg = output_buffer(k1 - k0 + 1)  # the layout the loop is compiled for
         pos_noise = nz[k0:k1 + 1] if closed else quiet[k0:k1 + 1]
-        # the segment writes its rows in place; its last row is the next segment's first, which that one overwrites
-        status = simulate_core(P, y0, np.ascontiguousarray(ref), np.ascontiguousarray(setup.command[k0:k1 + 1]), closed,
-                               np.ascontiguousarray(pos_noise), 0.0, lx, ly, k1 - k0, n_sub, out[k0:k1 + 1])
+        # writable copies: a read-only input (pandas' to_numpy) would compile the loop once more for it
+        status = simulate_core(P, y0, np.array(ref), np.array(setup.command[k0:k1 + 1]), closed, np.array(pos_noise), 0.0,
+                               lx, ly, k1 - k0, n_sub, seg)
         if status >= 0:
             raise SimulationError(f"replay of {setup.source} became non-physical at t = {(k0 + status)*ts:.3f} s")
+        out[k0:k1 + 1] = seg
         if stop is not None and k1 < n and stop(out, k1):
             return None
     sim = {c: out[:, OUT[c]] for c in OUTPUT_COLUMNS[1:]}
