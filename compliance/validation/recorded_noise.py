@@ -29,6 +29,7 @@ from scipy.signal import savgol_coeffs, savgol_filter
 # over a 100-400 mm stroke scatters more (the practice recordings: 20 um), while what the 41 ms cubic smoother of
 # ``position_noise_estimate`` leaves of a noise-free step response is 0.1-0.3 um (our choice)
 NOISE_FREE_STD = 1e-6
+NOISE_SMOOTHING = 0.031  # s; cubic Savitzky-Golay window a measured position is conditioned with (acceptance.measure)
 MAD_TO_STD = 1.4826  # normal distribution: std = 1.4826 * MAD (1 / the 75 % quantile of the standard normal)
 MIN_REST_SAMPLES = 200  # consecutive pairs at rest for the difference floor to use only those
 
