@@ -44,7 +44,7 @@ from compliance.diagnosis.servo.fit import FitContext, FitResult, chi2_parts, co
 from compliance.diagnosis.servo.report_data import SCHEMA
 from compliance.diagnosis.servo.selection import AMBIGUOUS_BIC, RESIDUAL_LIMIT, ambiguity_set, honest, score_all, verdict
 from compliance.diagnosis.verdicts.verdict import EXPLAINED, DiagnosisVerdict
-from compliance.diagnosis.servo.parallel_fits import FitEffect, RecalibrateBase, SecondStart
+from compliance.diagnosis.servo.parallel_fits import FitEffect, RecalibrateBase, RefitSet, SecondStart
 from compliance.diagnosis.estimation.joint_residuals import JointContext, JointModel
 
 
@@ -150,7 +150,7 @@ def _throttled(cfg: PlantConfig, setup) -> bool:
 
 
 def _commissioned(cfg: PlantConfig, stages, labels, recordings, stride: int, jobs, scheduler):
-    """The site's flow-control throttles fitted on the recordings that ran with them, and the stages on them.
+    """The site's flow-control throttles fitted on the full strokes that ran with them, and the stages on them.
 
     A site's needles 2V2/2V3 sit where its commissioning engineer left them (``servo.candidates.THROTTLES``),
     and a full stroke's open-loop replay integrates a few per cent of throttle error into millimetres: left
@@ -161,13 +161,15 @@ def _commissioned(cfg: PlantConfig, stages, labels, recordings, stride: int, job
     Returns
     -------
     (PlantConfig, list, FitResult or None)
-        The configuration with the fitted throttles (unchanged when no recording ran with them or
+        The configuration with the fitted throttles (unchanged when no full stroke ran with them or
         the fit does not improve on the file's values), its stages, the fit.
     """
     from compliance.model.config import plant_to_toml
     from compliance.model.parameters import apply
 
-    chosen = [i for i, st in enumerate(stages) if _throttled(cfg, st.setup)]
+    # the tests the throttles are commissioned by: full strokes at full command, driven by it (IEC 60308 stroke times);
+    # elsewhere (a hold at null, small steps) they barely act, and fitted there they would wander to their bounds
+    chosen = [i for i, st in enumerate(stages) if _throttled(cfg, st.setup) and not st.setup.closed_loop]
     params = base_params(cfg, keys=(), throttles=True)
     if not chosen or not params:
         return cfg, stages, None
@@ -182,19 +184,26 @@ def _commissioned(cfg: PlantConfig, stages, labels, recordings, stride: int, job
     return cfg, stages, fit
 
 
-def _with_settings(fits: dict, settings, stages, labels) -> None:
+def _with_settings(fits: dict, settings, stages, labels, jobs, scheduler) -> None:
     """Each effect that still competes refitted together with the site's throttles (in place, when that fits better):
-    the throttles were fitted on the nominal plant, and an effect that changes a stroke moves them too."""
+    the throttles were fitted on the nominal plant, and an effect that changes a stroke moves them too. The refits
+    run on the workers, one task each."""
     from compliance.model.config import plant_to_toml
+    from compliance.processes import PerProcess, map_tasks
 
     if settings is None or not settings.params:
         return
-    ctx = _joint_context(labels, [(plant_to_toml(s.rc), s.setup, s.model) for s in stages])
-    for f in competing([f for k, f in fits.items() if k in EFFECTS]):
-        params = tuple(f.params) + tuple(settings.params)
-        res = least_squares_fit(ctx, f.name, params, list(f.values) + list(settings.values), simplex_fev=8)
-        res.sims = f.sims + ctx.sims
-        ctx.sims = 0
+    rivals = competing([f for k, f in fits.items() if k in EFFECTS])
+    tasks = [RefitSet(f.name, tuple(f.params) + tuple(settings.params), list(f.values) + list(settings.values)) for f in rivals]
+    if not tasks:
+        return
+    payload = PerProcess(_joint_context, tuple(labels), [(plant_to_toml(s.rc), s.setup, s.model) for s in stages])
+    results, stats = map_tasks(_task, payload, tasks, workers=jobs, scheduler=scheduler, progress=False,
+                               label="joint fits", retries=1)
+    if stats.failed:
+        raise RuntimeError(f"joint fit failed: {stats.errors[0][1]}")
+    for f, res in zip(rivals, results):
+        res.sims += f.sims
         if res.chi2 < f.chi2:
             fits[f.name] = res
 
@@ -269,7 +278,7 @@ def diagnose_joint(cfg: PlantConfig, recordings, *, effects=None, jobs: int | No
     stages, labels = _stages(cfg, recordings, stride, jobs, scheduler)
     cfg, stages, settings = _commissioned(cfg, stages, labels, recordings, stride, jobs, scheduler)
     fits, stats = _fit_all(stages, labels, names, recalibrate, jobs, scheduler)
-    _with_settings(fits, settings, stages, labels)
+    _with_settings(fits, settings, stages, labels, jobs, scheduler)
     model = JointModel([s.model for s in stages], labels)
     n = model.size
     nvec = np.concatenate([s.nvec for s in stages])
@@ -293,7 +302,7 @@ def diagnose_joint(cfg: PlantConfig, recordings, *, effects=None, jobs: int | No
     notes = [f"{lab}: {note}" for lab, s in zip(labels, stages) for note in s.setup.notes]
     if settings is not None:
         sims += settings.sims
-        notes.insert(0, "the flow-control throttles as commissioned on site, fitted first on the recordings that ran with them: "
+        notes.insert(0, "the flow-control throttles as commissioned on site, fitted first on the full strokes that ran with them: "
                      + ", ".join(f"{fp.key} = {v:.4g} {fp.unit}" for fp, v in zip(settings.params, settings.values)))
     return JointDiagnosis(verdict_name, reason, winner, ambiguous, fits, scores, objectives, recs, n,
                           time.perf_counter() - t0, sims, stats.workers, stats.backend, notes)
