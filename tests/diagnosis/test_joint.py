@@ -152,5 +152,5 @@ def test_a_sites_holds_name_its_leak():
     d = diagnose_joint(load_plant("plant-a"), recs, effects=["external_leakage"], recalibrate=False, jobs=1)
     assert d.winner == "external_leakage"
     # the emulator's leak is laminar like ours (k_ext = 1e-9 kg/(s Pa)); 8.9 mm of drift in 10 s pins it
-    assert d.fits["external_leakage"].value("effects.external_leakage.conductance") == pytest.approx(1e-9, rel=0.05)
+    assert d.fits["external_leakage"].value("external_leakage.conductance") == pytest.approx(1e-9, rel=0.05)
     assert not any("throttles" in n for n in d.notes)  # no full stroke: the throttles stay as the plant file sets them
