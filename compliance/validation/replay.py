@@ -39,6 +39,7 @@ import pandas as pd
 
 from compliance.errors import InputError, SimulationError
 from compliance.model.config import PlantConfig
+from compliance.plants import kind_of
 from compliance.model.plant_vector import load_curve_arrays, parameter_vector
 from compliance.model.vector_slots import P_KI, P_KP
 from compliance.simulation.pid_loop import simulate_core
@@ -110,6 +111,8 @@ def prepare_replay(cfg: PlantConfig, frame: pd.DataFrame, meta: dict | None, *, 
     src = where_of(meta) if meta.get("source_path") else "<recording>"
     mode = mode or ("closed_loop" if "reference" in frame.columns else "plant_only")
     _check_inputs(frame, mode, noise, src)
+    if mode == "closed_loop":
+        kind_of(cfg).check_diagnosable(cfg)  # the replay's closed loop is the PID servo's (simulate_core)
     run_cfg, overrides = replay_config(cfg, meta, frame)
     notes: list[str] = []
     ts = run_cfg.p("controller.sample_time")

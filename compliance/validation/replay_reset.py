@@ -1,18 +1,16 @@
 """The state a replay segment starts from: the recording's measured states, the rest carried over or set by physics.
 
-The one place outside ``effects/`` where the replay reads effect states (gas temperatures, the
-second cylinder's speed, the reservoir pressure, the hoses, the sensor's lag).
+The effects' own states (gas temperatures, the second cylinder's speed, the reservoir pressure,
+the hoses) are restarted by their ``replay_reset`` hooks and the sensor's lag read through its
+``reading_lag`` hook (``compliance.effects.structure``): this module names no effect.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from compliance.effects.heat_transfer import S_TA, S_TB
-from compliance.effects.line_dynamics import P_LD_ON, S_PLA, S_PLB
-from compliance.effects.linkage_compliance import S_V2
-from compliance.effects.sensor_lag import P_SL_ON, P_SL_TAU, P_SL_TD
-from compliance.effects.supply_droop import P_SD_ON, S_PSUP
+from compliance.effects.base import ReplayPoint
+from compliance.effects.structure import reading_lags, reset_for_replay
 from compliance.model.rest_state import initial_state, set_rest_internal_states
 from compliance.model.vector_slots import P_STROKE, S_PA, S_PB, S_V
 from compliance.simulation.rk4 import OUTPUT_COLUMNS
@@ -34,13 +32,11 @@ def start_state(cfg, P: np.ndarray, setup) -> np.ndarray:
     return initial_state(cfg, P, min(max(float(setup.states["position"][0]), 0.0), P[P_STROKE]), setup.initial_pressures)
 
 
-def _measured(setup, signal: str, k: int, previous: np.ndarray) -> float:
-    """A pressure at sample ``k``: the recorded one (smoothed), or the previous segment's where it is not
-    recorded or its transducer sat at its full scale there (``ReplaySetup.full_scale``)."""
+def _readable(setup, signal: str, k: int) -> bool:
+    """Whether the recording read ``signal`` at sample ``k``: recorded, and its transducer not at its full
+    scale there (``ReplaySetup.full_scale``); where it did not, the previous segment's value stands."""
     levels = setup.full_scale.get(signal)
-    if signal not in setup.states or (levels is not None and setup.recorded[signal][k] in levels):
-        return float(previous[k, OUT[signal]])
-    return float(setup.states[signal][k])
+    return signal in setup.states and (levels is None or setup.recorded[signal][k] not in levels)
 
 
 def reset_state(cfg, P: np.ndarray, setup, k: int, previous: np.ndarray, lx, ly) -> np.ndarray:
@@ -54,25 +50,25 @@ def reset_state(cfg, P: np.ndarray, setup, k: int, previous: np.ndarray, lx, ly)
     st = setup.states
     x = float(st["position"][k])
     v = float(st["velocity"][k])
-    if P[P_SL_ON]:
+    lags = reading_lags(P)
+    if lags:
         # the recorded position is the sensor's, which trails the piston by its total lag (exactly for a
         # delay, to first order for the lag): the piston is where the reading arrives that much later
-        later = setup.time[k] + P[P_SL_TAU] + P[P_SL_TD]
+        later = setup.time[k]
+        for lag in lags:
+            later = later + lag
         x = float(np.interp(later, setup.time, st["position"]))
         v = float(np.interp(later, setup.time, st["velocity"]))
-    pa, pb = (_measured(setup, s, k, previous) for s in ("pressure_a", "pressure_b"))
+    measured = {s: float(st[s][k]) for s in st if _readable(setup, s, k)}
+    simulated = dict(zip(OUTPUT_COLUMNS, previous[k].tolist()))
+    pa, pb = (measured.get(s, simulated[s]) for s in ("pressure_a", "pressure_b"))
     y = initial_state(cfg, P, min(max(x, 0.0), P[P_STROKE]), (pa, pb))
     # a meter-out throttle holds a chamber above the supply while the load drives the piston into it:
     # the measured (or carried) pressure stands, not the rest state's clamp to the supply
     y[S_PA], y[S_PB] = pa, pb
-    if P[P_LD_ON]:
-        y[S_PLA], y[S_PLB] = pa, pb  # the hoses at the chamber pressures
     y[S_V] = v
-    y[S_V2] = v
-    y[S_TA] = previous[k, OUT["temperature_a"]]  # gas temperatures are not measured: carried over
-    y[S_TB] = previous[k, OUT["temperature_b"]]
-    if P[P_SD_ON]:
-        y[S_PSUP] = _measured(setup, "supply_pressure", k, previous)
+    # the effects' states at the restart: measured ones from the recording, the others carried over
+    reset_for_replay(P, y, ReplayPoint(v, measured, simulated))
     set_rest_internal_states(P, y, lx, ly, v)  # bristles carry the net force, the link its share
     return y
 

@@ -166,8 +166,9 @@ def _null_run(cfg: PlantConfig, setup: ReplaySetup, pre: int, load, noise, seed:
     is recorded in two runs: the closed loop up to the switch, then the command from the state the
     loop left the servo in (at rest: its position and pressures).
     """
+    from compliance.plants import simulate
+    from compliance.simulation import Scenario
     from compliance.simulation.profiles import Profile
-    from compliance.simulation import Scenario, simulate
 
     t = setup.time
     ts = float(np.median(np.diff(t)))
