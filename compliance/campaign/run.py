@@ -25,7 +25,7 @@ from compliance import __version__
 from compliance.campaign.plan import Job, plan
 from compliance.campaign.executor import execute
 from compliance.processes import available_cores
-from compliance.campaign.judge import judge, sample_dict
+from compliance.campaign.judge import EVALUATION_RULE, explain_fails_under_uncertain, judge, sample_dict
 from compliance.errors import InputError
 from compliance.requirements.consistency import consistency_findings
 from compliance.requirements.tightening import check_tightening
@@ -173,6 +173,7 @@ def run_campaign(cfg, reqset: RequirementSet, *, workers: int | None = None, pro
     bands = None
     if uncertainty == "local" and ranged_parameters(cfg):
         bands = local_bands(cfg, reqset, jobs, entries, workers=workers, progress=progress)
+    explain_fails_under_uncertain(entries)
     runs = []
     for j, o in zip(jobs, outcomes):
         proc = reqset.procedures[j.procedure]
@@ -197,7 +198,7 @@ def run_campaign(cfg, reqset: RequirementSet, *, workers: int | None = None, pro
         "plant": plant_section(cfg),
         "requirement_set": reqset.as_dict(),
         "summary": summary_section(entries, notes, bands),
-        "coverage": {"unjudged": unjudged(reqset, jobs, outcomes, entries)},
+        "coverage": {"unjudged": unjudged(reqset, jobs, outcomes, entries), "evaluation_rule": EVALUATION_RULE},
         "findings": consistency_findings(reqset, stroke),
         "uncertainty": bands,
         "requirements": entries,

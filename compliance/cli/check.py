@@ -104,8 +104,11 @@ def monte_carlo(cfg, reqset, results: dict, args) -> None:
     from compliance.campaign.run import summary_section
     from compliance.sweep.tolerance.uncertainty_mc import monte_carlo_bands
 
+    from compliance.campaign.judge import explain_fails_under_uncertain
+
     results["uncertainty"] = monte_carlo_bands(cfg, reqset, results, args.uncertainty, workers=args.jobs,
                                                progress=not args.quiet)
+    explain_fails_under_uncertain(results["requirements"])
     results["summary"] = summary_section(results["requirements"], results["summary"]["notes"], results["uncertainty"])
     results["summary"]["qualifier"] = verdict_qualifier(results)
 
