@@ -10,8 +10,9 @@ limits the test knows (:class:`StepLimits`), and says which rule excluded a step
 - **dead-zone dominated**: its 63.2 % point lies within ``STALL_MARGIN`` x the dead-zone stall band
   of the set-point, where the compensated valve shuts;
 - **ramped**: a set-point rate limiter of rate R acts on it: the set-point reaches the step h only
-  after h / R, and a first-order loop following that ramp reaches 63.2 % about h / (2R) later; a
-  ramp longer than ``RAMP_FRACTION`` of the time constant biases it by more than 5 %;
+  after T_r = h / R, and a first-order loop following that ramp reaches 63.2 % later by
+  tau ln(tau (exp(T_r / tau) - 1) / T_r) ~ T_r / 2; a ramp longer than ``RAMP_FRACTION`` of the time
+  constant moves that point by more than 5 % of it: the test is no longer a step;
 - **saturated**: the valve command reached the flow saturation voltage (valve fully open, or a
   meter-out flow-control valve limiting the flow) before the 63.2 % point;
 - **rate limited**: its peak speed reaches ``RATE_LIMIT_FRACTION`` of the full-command peak speed,
@@ -35,7 +36,7 @@ RATE_LIMIT_FRACTION = 0.9
 # a step counts for the time constant only if its 63.2 % point lies this many stall bands away from the
 # set-point: closer in, the response is governed by the valve dead zone, not the loop
 STALL_MARGIN = 2.0
-# a set-point ramp longer than this fraction of the time constant biases it by more than half that (5 %)
+# a set-point ramp longer than this fraction of the time constant moves the 63.2 % point by more than half that (5 %)
 RAMP_FRACTION = 0.10
 
 
