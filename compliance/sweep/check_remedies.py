@@ -131,7 +131,8 @@ def remedies_for_check(cfg, reqset, sweep_file: str | None, *, workers=None, pro
         if cfg.options["controller.type"] == "pid" and not (sweep_file and sweep_file != "default"):
             from compliance.sweep.remedies.governor_stage import governor_stage
 
-            gov = governor_stage(ctx, cfg, reqset, cat, workers=workers)
+            gov = governor_stage(ctx, cfg, reqset, cat, workers=workers, uncertain=uncertain, run_kw=run_kw,
+                                 yield_units=yield_units)
         if gov is not None and gov["status"] == RemedyStatus.FOUND:
             rem = gov
         else:
