@@ -138,6 +138,9 @@ def summary_lines(results: dict) -> list[str]:
     c = s["counts"]
     out = [f"plant {results['plant']['name']} ({results['plant'].get('path')}) against "
            f"{results['requirement_set']['name']} ({results['requirement_set']['path']})"]
+    remedy_yield = (results["plant"].get("provenance") or {}).get("remedy_yield")
+    if remedy_yield:  # a configuration written by --save-remedy: the yield its search showed
+        out.append(f"  remedy: {remedy_yield}")
     cov = s.get("coverage")
     out.append(
         f"{c['pass']} pass, {c.get('pass_by_construction', 0)} pass by construction (not evidence), "

@@ -122,5 +122,10 @@ def remedy_configuration(cfg, rem, paths):
     note = "remedies search of govcheck check --remedies: " + ", ".join(
         f"{c['path']} {c['from']:.4g} -> {c['to']:.4g}" for c in rem["remedy"]["changes"])
     hw = ", ".join(h["title"] for h in rem["remedy"].get("hardware", []))
-    return changed.replace(name=f"{cfg.name}-remedy",
-                           provenance={**cfg.provenance, "remedy": note + (f"; hardware: {hw}" if hw else "")})
+    prov = {**cfg.provenance, "remedy": note + (f"; hardware: {hw}" if hw else "")}
+    y = rem.get("tolerance_yield")
+    if y:
+        prov["remedy_yield"] = (f"tolerance yield {y['pass']} of {y['valid']} delivered units pass every mandatory requirement "
+                                f"(one-sided {100 * y['confidence']:.0f} % lower bound {100 * y['lower_bound']:.1f} %: "
+                                f"{'meets' if y['meets'] else 'does not show'} >= {100 * y['target']:.0f} %)")
+    return changed.replace(name=f"{cfg.name}-remedy", provenance=prov)
