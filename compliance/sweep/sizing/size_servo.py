@@ -47,17 +47,18 @@ def _areas(bore: float, rod: float) -> tuple[float, float]:
     return cap, cap - math.pi * rod * rod / 4.0
 
 
-def size_cylinders(force: float, supply: float, atmosphere: float, min_area: float = 0.0) -> dict:
+def size_cylinders(force: float, supply: float, atmosphere: float, min_area: float = 0.0, count: int | None = None) -> dict:
     """Count, bore, rod [m], side area [m^2] and load ratio for ``force`` [N] at ``supply`` [Pa abs].
 
-    ``min_area`` [m^2]: take a side area above it (the next size up when a check asks for a lower load share).
+    ``min_area`` [m^2]: take a side area above it (the next size up when a check asks for a lower load share);
+    ``count``: keep that arrangement (2 = the tandem pair, 1 = one cylinder).
     """
     need = max(force / (LOAD_RATIO * (supply - atmosphere)), min_area)
     options = []
     for bore, rod in ISO_15552:
         cap, ann = _areas(bore, rod)
         options += [(cap + ann, 0, 2, bore, rod), (min(cap, ann), 1, 1, bore, rod)]  # tandem first on a tie
-    ok = sorted(o for o in options if o[0] >= need and o[0] > min_area)
+    ok = sorted(o for o in options if o[0] >= need and o[0] > min_area and (count is None or o[2] == count))
     if not ok:
         raise ValueError(f"no ISO 15552 pair carries {force:.0f} N at {supply/1e5:.1f} bar abs")
     area, _, count, bore, rod = ok[0]
@@ -110,7 +111,7 @@ def time_constant_target(reqset) -> float:
     return TAU_DEFAULT
 
 
-def size_servo(duty, template, tau: float | None = None, min_area: float = 0.0) -> tuple:
+def size_servo(duty, template, tau: float | None = None, min_area: float = 0.0, count: int | None = None) -> tuple:
     """(sized configuration, sizing record) for ``duty`` on ``template`` (steady throttle rule).
 
     The throttles are the steady first guess (:func:`compliance.sweep.sizing.throttle_tuning.tune_throttles`
@@ -118,7 +119,7 @@ def size_servo(duty, template, tau: float | None = None, min_area: float = 0.0) 
     (``sizing.governor_design``). ``min_area`` [m^2]: cylinders with a larger side area than this.
     """
     atm = template.params["air.atmospheric_pressure"]
-    cyl = size_cylinders(duty.max_force, duty.supply_pressure, atm, min_area)
+    cyl = size_cylinders(duty.max_force, duty.supply_pressure, atm, min_area, count)
     times = [t for t in (duty.opening_time, duty.closing_time) if t]
     speed = duty.stroke / min(times) if times else duty.stroke / 5.0
     ts = template.params["air.supply_temperature"]
@@ -149,8 +150,8 @@ def size_and_check(duty, template, reqset, *, workers=None, progress=False) -> t
     and the controller on the sized hardware and checks the full campaign with the file's readings. What it
     cannot meet on a pair of cylinders (the time constant spreading wider than its window, the gate lagging
     the limiter under load, the tracking error at the rated load) grows with the load's share of the
-    cylinders' force, so the next ISO 15552 pair up is sized (valve resized for it) and designed again, up
-    to ``MAX_BORE_STEPS`` times.
+    cylinders' force, so the next ISO 15552 size up in the same arrangement is sized (valve resized for it)
+    and designed again, up to ``MAX_BORE_STEPS`` times.
 
     Returns
     -------
@@ -161,9 +162,9 @@ def size_and_check(duty, template, reqset, *, workers=None, progress=False) -> t
     from compliance.sweep.sizing.governor_design import design_and_check
 
     tau = time_constant_target(reqset)
-    rounds, min_area = [], 0.0
+    rounds, min_area, count = [], 0.0, None
     for _ in range(MAX_BORE_STEPS + 1):
-        cfg, rec = size_servo(duty, template, tau, min_area)
+        cfg, rec = size_servo(duty, template, tau, min_area, count)
         cyl = rec["cylinders"]
         cfg, design, results = design_and_check(cfg, reqset, workers=workers, progress=progress)
         rec["design"] = design
@@ -173,9 +174,9 @@ def size_and_check(duty, template, reqset, *, workers=None, progress=False) -> t
                        "cannot": design.get("cannot")})
         if results["summary"]["status"] == "pass":
             break
-        min_area = cyl["area"]
+        min_area, count = cyl["area"], cyl["count"]  # the next pair up, same arrangement
         try:
-            size_cylinders(duty.max_force, duty.supply_pressure, template.params["air.atmospheric_pressure"], min_area)
+            size_cylinders(duty.max_force, duty.supply_pressure, template.params["air.atmospheric_pressure"], min_area, count)
         except ValueError:
             break
     return cfg, rec, results, rounds
