@@ -111,5 +111,8 @@ def test_a_rate_limited_time_constant_is_explained_by_the_ramp():
 
     cfg = load_plant("plant-a").replace(params={"controller.setpoint_opening_rate": 0.0312,
                                                 "controller.setpoint_closing_rate": 0.0315})
-    text = explain("IEC61362-TC", "steps-10-down@tc-mid", cfg, load_requirements("shpp-400kw"), True)
+    shpp = load_requirements("shpp-400kw")
+    text = explain("IEC61362-TC", "steps-10@mid-no-load", cfg, shpp, True)  # a point where the limiter acts
     assert "0.324 s" in text and "31.2 mm/s" in text
+    # at a tc-* point the step is injected downstream of the limiter: the ramp is not the explanation
+    assert "ramps" not in explain("IEC61362-TC", "steps-10-down@tc-mid", cfg, shpp, True)
