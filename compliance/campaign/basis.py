@@ -70,8 +70,8 @@ def row_basis(cfg, reqset, req, row) -> tuple[Basis, str]:
     proc = reqset.procedures.get(row["procedure"])
     fc = proc.settings.get("flow_control", True) if proc is not None and proc.kind == "full_stroke" else op.flow_control
     installed = cfg.flow_control_installed if fc is None else bool(fc)
-    limiter_sets = (cfg.setpoint_rate_limited and op.setpoint_limiter is not False and proc is not None
-                    and proc.kind == "full_stroke" and proc.settings.get("drive") == "governor")
+    limiter_sets = (proc is not None and proc.kind == "full_stroke" and proc.settings.get("drive") == "governor"
+                    and op.setpoint_limiter is not False and getattr(cfg, "setpoint_rate_limited", False))
     # with the governor's rate limiter setting the stroke rate the throttles are its backstop: the time is the
     # model's prediction of how the gate follows the limited set-point under this load, not the derivation's target
     found = None if limiter_sets else _derived(cfg, op, installed, _stroke_metric(req, row))

@@ -34,8 +34,8 @@ METRICS: dict[str, MetricInfo] = {
         MetricInfo("dead_time", "s", "s", 1.0, ("steps",), "command step to first detectable motion", ("detect",)),
         MetricInfo(
             "time_constant", "s", "s", 1.0, ("steps",),
-            "end of dead time to 63.2 % of the travel (option travel: the achieved travel or the commanded step), "
-            "first step from rest, steps no limiting device acts on only",
+            "end of dead time to 63.2 % of the travel (achieved, or the commanded step), first step from rest, "
+            "steps no limiting device acts on",
             ("detect", "travel"),
         ),
         MetricInfo("rise_time", "s", "s", 1.0, ("steps",), "10 % to 90 % of the actual change", ("final_window",)),
@@ -53,11 +53,9 @@ METRICS: dict[str, MetricInfo] = {
         MetricInfo("tracking_max_error", "m", "mm", 1e3, ("sine",), "max |reference - position| after the skip"),
         MetricInfo("dead_band", "m", "mm", 1e3, ("dead_band",), "width of the position/reference hysteresis loop"),
         MetricInfo("opening_time", "s", "s", 1.0, ("full_stroke",),
-                   "full-stroke opening time by the timing the requirement names (option timing: full_rate, end_to_end, "
-                   "extrapolated)", ("timing",)),
+                   "full-stroke opening time, timed as the requirement's timing names", ("timing",)),
         MetricInfo("closing_time", "s", "s", 1.0, ("full_stroke",),
-                   "full-stroke closing time by the timing the requirement names (option timing: full_rate, end_to_end, "
-                   "extrapolated)", ("timing",)),
+                   "full-stroke closing time, timed as the requirement's timing names", ("timing",)),
         MetricInfo("start_delay", "s", "s", 1.0, ("full_stroke",),
                    "full stroke: command to 1 % of the stroke travelled"),
         MetricInfo("time_to_end", "s", "s", 1.0, ("full_stroke",),

@@ -112,12 +112,11 @@ def time_constant_eligibility(k: int, n: int, event: StepEvent, sm: StepMetrics,
 
     if k > 0 and from_rest:
         return out("not_from_rest", f"not from rest at the operating point: step {k + 1} of {n} starts where step {k} "
-                                    f"settled ({sm.x_start * 1e3:.1f} mm); the standards' test steps from rest at the point")
+                                    f"settled ({sm.x_start * 1e3:.1f} mm)")
     stall = limits.stall.get(side, 0.0)
     if stall > 0.0 and (1.0 - TAU_FRACTION) * h < STALL_MARGIN * stall:
         return out("dead_zone", f"dead-zone dominated: the 63.2 % point lies {(1 - TAU_FRACTION) * h * 1e3:.2f} mm from the "
-                                f"set-point, inside {STALL_MARGIN:g} x the stall band {stall * 1e3:.2f} mm where the "
-                                "compensated valve shuts")
+                                f"set-point, inside {STALL_MARGIN:g} x the stall band {stall * 1e3:.2f} mm")
     rate = limits.ramp_rate.get(side, 0.0)
     if rate > 0.0:
         ramp = h / rate
@@ -132,7 +131,7 @@ def time_constant_eligibility(k: int, n: int, event: StepEvent, sm: StepMetrics,
     sat = limits.command_saturation.get(side)
     if sat is not None and sm.command_peak is not None and sm.command_peak >= sat * (1.0 - 1e-9):
         return out("saturated", f"saturated: the valve command reached {sm.command_peak:.2f} V >= the flow saturation "
-                                f"{sat:.2f} V (valve fully open, or a flow-control valve limiting the flow) before 63.2 %")
+                                f"{sat:.2f} V before 63.2 %")
     if limits.full_speed:
         peak, straight = limits.full_speed[side]
         moved = abs(sm.x_final - sm.x_start) if travel == "achieved" else h
