@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 
 from compliance.model.parameters import param_handle
-from compliance.requirements.verdict import Overall
+from compliance.requirements.verdict import Overall, Severity, Status
 from compliance.sweep.remedies.outcome import RemedyStatus
 
 __all__ = ["governor_stage", "load_share"]
@@ -69,8 +69,8 @@ def _attempt(cfg, reqset, option, workers):
 def _binding(results) -> tuple:
     """The mandatory requirement with the smallest margin % in ``results`` and that margin."""
     m = [(e["worst"]["margin_pct"], e["id"]) for e in results["requirements"]
-         if e["severity"] == "mandatory" and e.get("worst") and e["worst"].get("margin_pct") is not None
-         and e["status"] in ("pass", "fail", "uncertain")]
+         if e["severity"] == Severity.MANDATORY and e.get("worst") and e["worst"].get("margin_pct") is not None
+         and e["status"] in (Status.PASS, Status.FAIL, Status.UNCERTAIN)]
     return (min(m)[1], min(m)[0]) if m else (None, None)
 
 
@@ -127,7 +127,7 @@ def governor_stage(ctx, cfg, reqset, catalogue, *, workers=None, uncertain=(), r
             found = {"status": RemedyStatus.FOUND, "remedy": pick, "closest": None, "stages": stages,
                      "skipped_options": skipped, "evaluated": len(stages) + (yield_units or 0)}
             y = tolerance_yield(found, ctx, cfg, uncertain, run_kw or {}, yield_units) if yield_units else None
-            stage["tolerance_yield"] = None if y is None else {k: y[k] for k in ("pass", "valid", "lower_bound", "meets")}
+            stage["tolerance_yield"] = None if y is None else {k: y[k] for k in (Status.PASS.value, "valid", "lower_bound", "meets")}
             before = "".join(f" {s['stage']}: {s['design'].get('cannot') or _yield_text(s)}." for s in stages[:-1])
             found["note"] = ("the governor design (set-point rate limiter, flow-control valves wide open, time constant "
                              f"tuned on the file's own test) passes a full campaign ({len(results['runs'])} runs) "

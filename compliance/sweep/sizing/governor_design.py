@@ -33,6 +33,8 @@ from __future__ import annotations
 import dataclasses
 import math
 
+from compliance.requirements.verdict import Severity, Status
+
 __all__ = ["LEAD_FRACTION", "RATE_SHARE", "STABILITY", "TAU_MARGIN", "THROTTLE_OPEN", "design_governor", "limiter_settings",
            "stability", "tau_range"]
 
@@ -51,7 +53,7 @@ THROTTLE_KEYS = ("flow_control.opening_conductance", "flow_control.closing_condu
 
 def _window(reqset, metric: str, stroke: float):
     for r in reqset.requirements:
-        if r.metric == metric and r.enabled and r.limit is not None and r.severity == "mandatory":
+        if r.metric == metric and r.enabled and r.limit is not None and r.severity == Severity.MANDATORY:
             lim = r.resolved_limit(stroke)
             return (lim[0], lim[-1]) if r.comparator == "within" else (None, lim[0])
     return None
@@ -61,7 +63,7 @@ def _rate_limit(reqset, stroke: float) -> float | None:
     """The tightest mandatory stroke-rate limit [m/s] (``stroke_speed``), or None."""
     vals = [r.resolved_limit(stroke)[-1] for r in reqset.requirements
             if r.enabled and r.limit is not None and r.metric == "stroke_speed" and r.comparator in ("<=", "<")
-            and r.severity == "mandatory"]
+            and r.severity == Severity.MANDATORY]
     return min(vals) if vals else None
 
 
@@ -93,7 +95,7 @@ def limiter_settings(cfg, reqset) -> tuple[dict, dict]:
 def _tau_requirements(reqset):
     return [r for r in reqset.requirements
             if r.metric == "time_constant" and r.enabled and r.source == "simulation" and r.limit is not None
-            and r.comparator == "within" and r.severity == "mandatory"]
+            and r.comparator == "within" and r.severity == Severity.MANDATORY]
 
 
 def tau_range(cfg, reqset, *, workers=None) -> dict | None:
@@ -115,7 +117,7 @@ def tau_range(cfg, reqset, *, workers=None) -> dict | None:
     by = {"up": [], "down": []}
     rows = []
     for r in e["rows"]:
-        if r["status"] in ("pass", "fail") and r["value"] is not None:
+        if r["status"] in (Status.PASS, Status.FAIL) and r["value"] is not None:
             d = "down" if " down " in (r.get("which") or "") else "up"
             by[d].append(r["value"])
             rows.append((r["run"], r["which"], r["value"]))
@@ -232,7 +234,8 @@ _POSITIONING = ("tracking_max_error", "max_positioning_error")
 
 
 def _mandatory_failures(results) -> list[dict]:
-    return [e for e in results["requirements"] if e["severity"] == "mandatory" and e["status"] in ("fail", "uncertain")]
+    return [e for e in results["requirements"]
+            if e["severity"] == Severity.MANDATORY and e["status"] in (Status.FAIL, Status.UNCERTAIN)]
 
 
 def _worst(e) -> dict:

@@ -159,6 +159,7 @@ def size_and_check(duty, template, reqset, *, workers=None, progress=False) -> t
         (configuration, sizing record of the last pair, results of its check, rounds): ``rounds`` has one
         entry per pair tried (bore, load share, status, failing requirements, what the design could not meet).
     """
+    from compliance.requirements.verdict import Overall
     from compliance.sweep.sizing.governor_design import design_and_check
 
     tau = time_constant_target(reqset)
@@ -172,7 +173,7 @@ def size_and_check(duty, template, reqset, *, workers=None, progress=False) -> t
                        "valve_rating": rec["valve"]["rating"], "status": results["summary"]["status"],
                        "failed_mandatory": results["summary"]["failed_mandatory"] + results["summary"].get("uncertain", []),
                        "cannot": design.get("cannot")})
-        if results["summary"]["status"] == "pass":
+        if results["summary"]["status"] == Overall.PASS:
             break
         min_area, count = cyl["area"], cyl["count"]  # the next pair up, same arrangement
         try:
