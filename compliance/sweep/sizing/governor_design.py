@@ -268,6 +268,13 @@ def corrections(cfg, reqset, results) -> tuple[dict, list[str]]:
                 new[key] = rate
                 why.append(f"{e['id']} {w['value']:.2f} s at {w.get('operating_point')}: {d} rate "
                            f"{cfg.params[key] * 1e3:.2f} -> {rate * 1e3:.2f} mm/s")
+            elif cfg.params[key] > 0.0:  # the rate is at its cap: the gate lags the limited set-point under this load
+                lag = w["value"] * cfg.params[key] / L - 1.0
+                why.append(f"{e['id']} {w['value']:.2f} s at {w.get('operating_point')}: the {d} rate is at its cap "
+                           f"{cfg.params[key] * 1e3:.2f} mm/s ({RATE_SHARE:g} x the {v_lim * 1e3:.1f} mm/s stroke-rate limit) "
+                           f"and the gate lags the limited set-point by {100 * lag:.1f} % under this load "
+                           f"({L * 1e3:.0f} mm / {cfg.params[key] * 1e3:.2f} mm/s = {L / cfg.params[key]:.2f} s): no rate "
+                           "fixes it; a lower load share (larger bore, higher supply) or a stiffer loop does")
         elif e["metric"] == "stroke_speed" and w.get("value") and d:
             key = LIMITER_KEYS[0 if d == "opening" else 1]
             rate = new.get(key, cfg.params[key]) * e["limit"][0] / w["value"] * RATE_SHARE
@@ -303,6 +310,7 @@ def design_and_check(cfg, reqset, *, workers=None, rounds: int = 3, progress=Fal
             break
         new, why = corrections(cfg, reqset, results)
         record["rounds"].append({"failing": failing, "corrections": why})
+        record["why_not"] = [w for w in why if "no rate fixes it" in w]
         if not new or len(record["rounds"]) > rounds:
             break
         cfg = cfg.replace(params=new)
@@ -310,7 +318,7 @@ def design_and_check(cfg, reqset, *, workers=None, rounds: int = 3, progress=Fal
             cfg = _tune_time_constant(cfg, reqset, record, workers)
     failing = [e for e in _mandatory_failures(results)]
     if failing:
-        parts = [record["spread"]] if record.get("spread") else []
+        parts = ([record["spread"]] if record.get("spread") else []) + list(record.get("why_not") or [])
         for e in failing:
             w = _worst(e)
             parts.append(f"{e['id']} {e['status']} ({w.get('display', {}).get('value') if isinstance(w.get('display'), dict) else w.get('value')} "
