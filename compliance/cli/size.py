@@ -78,7 +78,6 @@ def run(args) -> int:
     from compliance.cli.sweep import check_remedies_options, remedies_kwargs, save_remedy
     from compliance.model.config import load_plant, save_plant
     from compliance.requirements.loading import load_requirements
-    from compliance.requirements.verdict import Overall
     from compliance.sweep.sizing.duty_file import load_duty
     from compliance.sweep.sizing.size_servo import size_and_check, size_servo, time_constant_target
 
@@ -97,7 +96,7 @@ def run(args) -> int:
         if args.out:
             save_plant(cfg, args.out, overwrite=True)
         return 0
-    from compliance.campaign.results_files import summary_table, write_json
+    from compliance.campaign.results_files import summary_table
 
     cfg, rec, results, rounds = size_and_check(duty, template, reqset, workers=args.jobs, progress=not args.quiet)
     if not args.quiet:
@@ -105,19 +104,21 @@ def run(args) -> int:
     if args.out:
         save_plant(cfg, args.out, overwrite=True)
         cfg = load_plant(args.out)
-    results["sizing"] = {"duty": duty.path, "record": rec, "rounds": rounds}
-    if args.remedies:
-        from compliance.sweep.check_remedies import remedies_for_check
+    from compliance.results.check_result import CheckResult
 
-        results["remedies"] = remedies_for_check(cfg, reqset, None, workers=args.jobs, progress=not args.quiet,
-                                                 **remedies_kwargs(args))
-        save_remedy(args, cfg, results["remedies"])
+    results = CheckResult.of(results).with_(sizing={"duty": duty.path, "record": rec, "rounds": rounds})
+    if args.remedies:
+        from compliance.pipeline.chain import remedy_search
+
+        results = results.with_(remedies=remedy_search(cfg, reqset, "default", jobs=args.jobs, progress=not args.quiet,
+                                                       **remedies_kwargs(args)))
+        save_remedy(args, cfg, results.remedies)
     table = summary_table(results)
     sys.stdout.write(table.rstrip().splitlines()[-1] + "\n" if args.quiet else table)
     if args.remedies and not args.quiet:
         from compliance.sweep.summary_text import remedies_markdown
 
-        sys.stdout.write("\n" + remedies_markdown(results["remedies"]))
+        sys.stdout.write("\n" + remedies_markdown(results.remedies))
     if args.json:
-        write_json(results, args.json)
-    return 0 if results["summary"]["status"] == Overall.PASS else 1
+        results.to_json(args.json)
+    return 0 if results.passed else 1

@@ -14,7 +14,7 @@ import numpy as np
 from compliance import metrics as M
 from compliance.metrics.catalogue import option_value
 from compliance.metrics.step_eligibility import RATE_LIMIT_FRACTION, StepLimits, time_constant_eligibility
-from compliance.model.pid_controller import stall_error
+from compliance.plants import kind_of
 from compliance.errors import InputError
 from compliance.procedures.scenarios import add_drive_samples, closed_loop_trace, full_command_stroke, start_position, stroke
 from compliance.procedures.outcomes import Sample, request_key
@@ -95,7 +95,7 @@ def step_limits(cfg, op, with_speeds: bool) -> StepLimits:
     """
     p = cfg.params
     return StepLimits(
-        stall={+1: stall_error(cfg, "opening"), -1: stall_error(cfg, "closing")},
+        stall={+1: kind_of(cfg).stall_error(cfg, "opening"), -1: kind_of(cfg).stall_error(cfg, "closing")},
         command_saturation={+1: flow_saturation_voltage(cfg, +1, op.flow_control),
                             -1: flow_saturation_voltage(cfg, -1, op.flow_control)},
         ramp_rate={+1: p.get("controller.setpoint_opening_rate", 0.0), -1: p.get("controller.setpoint_closing_rate", 0.0)},
