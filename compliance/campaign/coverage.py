@@ -21,7 +21,7 @@ CASES_BASIS = ("a judged test case is one requirement \u00d7 procedure \u00d7 op
 
 
 def case_coverage(entries: list[dict]) -> dict:
-    """Judged test cases evaluated and not evaluated, on the one basis :data:`CASES_BASIS`.
+    """Judged test cases evaluated, excluded and not evaluated, on the one basis :data:`CASES_BASIS`.
 
     Parameters
     ----------
@@ -31,19 +31,24 @@ def case_coverage(entries: list[dict]) -> dict:
     Returns
     -------
     dict
-        ``{"rows", "evaluated", "not_evaluated", "basis"}``: a case is evaluated when its verdict
-        row is PASS, FAIL or UNCERTAIN (a value was judged against the limit).
+        ``{"rows", "evaluated", "excluded", "not_evaluated", "basis"}``: a case is evaluated when its
+        verdict row is PASS, FAIL or UNCERTAIN (a value was judged against the limit), excluded when an
+        eligibility rule the requirement states excluded every value of it (``judge.EVALUATION_RULE``:
+        not a gap), not evaluated otherwise (a failed run, a missing value).
     """
     rows = [r for e in entries if e.get("limit") is not None for r in e["rows"]]
     evaluated = sum(1 for r in rows if r.get("status") in (Status.PASS, Status.FAIL, Status.UNCERTAIN))
-    return {"rows": len(rows), "evaluated": evaluated, "not_evaluated": len(rows) - evaluated, "basis": CASES_BASIS}
+    excluded = sum(1 for r in rows if r.get("status") == Status.NOT_EVALUATED and r.get("excluded"))
+    return {"rows": len(rows), "evaluated": evaluated, "excluded": excluded,
+            "not_evaluated": len(rows) - evaluated - excluded, "basis": CASES_BASIS}
 
 
 def case_coverage_text(cov: dict) -> str:
-    """``"87 of 111 judged test cases evaluated, 24 not evaluated"`` from :func:`case_coverage`."""
-    n = cov["rows"]
-    ne = cov.get("not_evaluated", n - cov["evaluated"])
-    return f"{cov['evaluated']} of {n} judged test cases evaluated, {ne} not evaluated"
+    """``"91 of 115 judged test cases evaluated, 24 excluded by an eligibility rule, 0 not evaluated"``."""
+    n, ex = cov["rows"], cov.get("excluded") or 0
+    ne = cov.get("not_evaluated", n - cov["evaluated"] - ex)
+    return (f"{cov['evaluated']} of {n} judged test cases evaluated, "
+            + (f"{ex} excluded by an eligibility rule, " if ex else "") + f"{ne} not evaluated")
 
 
 def _judged_pairs(entries) -> tuple[set[tuple[str, str]], dict]:

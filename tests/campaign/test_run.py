@@ -200,8 +200,13 @@ def test_plant_a_against_shpp_end_to_end(tmp_path, capsys):
     assert "cases evaluated" in printed and "assumptions that matter most" in printed
     # the judged test cases on one basis: the same counts as the JSON (and page 1 of the report)
     cov = r["summary"]["coverage"]
-    assert cov["rows"] == cov["evaluated"] + cov["not_evaluated"] > cov["evaluated"] > 0
-    assert f"{cov['evaluated']} of {cov['rows']} judged test cases evaluated, {cov['not_evaluated']} not evaluated" in printed
+    assert cov["rows"] == cov["evaluated"] + cov["excluded"] + cov["not_evaluated"] > cov["evaluated"] > 0
+    excluded = sum(1 for e in r["requirements"] if e["limit"] is not None for row in e["rows"] if row.get("excluded")
+                   and row["status"] == "not_evaluated")
+    assert cov["excluded"] == excluded  # an excluded case (a stated eligibility rule) is counted apart from a gap
+    assert (f"{cov['evaluated']} of {cov['rows']} judged test cases evaluated, "
+            + (f"{excluded} excluded by an eligibility rule, " if excluded else "")
+            + f"{cov['not_evaluated']} not evaluated") in printed
     assert cov["basis"] in printed
     # every computed value is judged or carries the reason it is not (issue 22)
     judged = {(row["run"], e["request_key"]) for e in r["requirements"] for row in e["rows"]}
