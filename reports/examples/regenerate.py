@@ -40,27 +40,6 @@ COMMANDS = {
              "--report", str(OUT / "site-acceptance-p2.html"), "--pdf", str(OUT / "site-acceptance-p2.pdf"), "--quiet"],
 }
 EXIT_OK = (0, 1)  # a compliance check that fails its requirements still wrote its report
-# the sweep example's best-results.json keeps its plot traces at this many points per signal: the summary
-# shows verdicts, and `govcheck report` renders the file with coarser figures (8 MB at the sweep's 2000 points)
-EXAMPLE_TRACE_POINTS = 200
-
-
-def trim_traces(path: Path, points: int = EXAMPLE_TRACE_POINTS) -> None:
-    """Thin every plot trace of a results file to at most ``points`` evenly chosen samples per signal, in place."""
-    import json
-
-    res = json.loads(path.read_text())
-    for run in res.get("runs", []):
-        for tr in run.get("traces", []):
-            n = tr.get("points", 0)
-            if n <= points:
-                continue
-            keep = sorted({round(i * (n - 1) / (points - 1)) for i in range(points)})
-            for k, v in list(tr.items()):
-                if isinstance(v, list) and len(v) == n:
-                    tr[k] = [v[i] for i in keep]
-            tr["points"] = len(keep)
-    path.write_text(json.dumps(res, separators=(",", ":")))
 
 
 def _run(name: str, args: list[str], friction_runs: list[str]) -> None:
@@ -126,8 +105,6 @@ def main(argv=None) -> int:
             if (args.only and name not in args.only) or (name == "sweep" and args.skip_sweep):
                 continue
             _run(name, cmd, friction)
-            if name == "sweep":
-                trim_traces(ROOT / OUT / "plant-a-remedies" / "best-results.json")
     problems = check()
     for p in problems:
         print(p)
