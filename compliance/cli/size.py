@@ -104,9 +104,16 @@ def run(args) -> int:
     if args.out:
         save_plant(cfg, args.out, overwrite=True)
         cfg = load_plant(args.out)
+    from compliance.campaign.uncertainty import ranged_parameters
     from compliance.results.check_result import CheckResult
 
-    results = CheckResult.of(results).with_(sizing={"duty": duty.path, "record": rec, "rounds": rounds})
+    if ranged_parameters(cfg):  # judged as `govcheck check` will judge the written file: with the bands of its declared ranges
+        from compliance.pipeline.chain import check
+
+        results = check(cfg, reqset, uncertainty="local", jobs=args.jobs, progress=not args.quiet)
+    else:
+        results = CheckResult.of(results)
+    results = results.with_(sizing={"duty": duty.path, "record": rec, "rounds": rounds})
     if args.remedies:
         from compliance.pipeline.chain import remedy_search
 
