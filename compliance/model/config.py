@@ -156,6 +156,11 @@ class PlantConfig:
             # a range or a derivation target was stated about the value the file gave: a new value drops it
             assumptions=MappingProxyType({k: a for k, a in self.assumptions.items() if new_params[k] == self.params[k]}),
         )
+        if new_params != dict(self.params) or new_effects != {k: dict(v) for k, v in self.effects.items()} \
+                or new_options != dict(self.options):
+            # the measurements were taken on the configuration the file gave: a changed design (a remedy, a sized
+            # proposal, a --set) has none of its own, and the base plant's figures would be compared with another servo
+            cfg = dc_replace(cfg, model_evidence=MappingProxyType({"paper": None, "recordings": ()}))
         _check_physical(cfg, self.path or "<configuration>")
         return cfg
 

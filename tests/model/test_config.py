@@ -132,3 +132,18 @@ def test_a_saved_configuration_keeps_the_ranges_and_targets_of_the_values_it_did
             assert b["range"]["note"] == a["range"]["note"]
             assert b["range"]["low"] == pytest.approx(a["range"]["low"], rel=1e-9)
             assert b["range"]["high"] == pytest.approx(a["range"]["high"], rel=1e-9)
+
+
+def test_a_changed_design_does_not_carry_the_measurements_of_the_plant_it_came_from(tmp_path):
+    """Plant A's paper measured plant A at its own gains and hardware: a configuration with any value changed
+    (a remedy, a sized proposal) names no measurement, and its saved file none; an unchanged copy keeps them."""
+    from compliance.model.config import load_plant, plant_to_toml
+
+    cfg = load_plant("plant-a")
+    assert cfg.model_evidence["paper"]  # plant A answers to its paper
+    assert cfg.replace(name="copy").model_evidence["paper"] == cfg.model_evidence["paper"]
+    same = cfg.replace(params={"controller.kp": cfg.params["controller.kp"]})
+    assert same.model_evidence["paper"] == cfg.model_evidence["paper"]
+    changed = cfg.replace(params={"controller.kp": 1.5 * cfg.params["controller.kp"]})
+    assert changed.model_evidence["paper"] is None and changed.model_evidence["recordings"] == ()
+    assert "[model_evidence]" not in plant_to_toml(changed) and "[model_evidence]" in plant_to_toml(cfg)
