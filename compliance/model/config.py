@@ -159,7 +159,7 @@ class PlantConfig:
         if new_params != dict(self.params) or new_effects != {k: dict(v) for k, v in self.effects.items()} \
                 or new_options != dict(self.options):
             # the measurements were taken on the configuration the file gave: a changed design (a remedy, a sized
-            # proposal, a --set) has none of its own, and the base plant's figures would be compared with another servo
+            # proposal) has none of its own, and the base plant's figures would be compared with another servo
             cfg = dc_replace(cfg, model_evidence=MappingProxyType({"paper": None, "recordings": ()}))
         _check_physical(cfg, self.path or "<configuration>")
         return cfg
