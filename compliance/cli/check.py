@@ -6,7 +6,7 @@ import shlex
 import sys
 from importlib import resources
 
-from compliance.cli.common import (add_document_options, add_jobs, add_outputs, add_parser, add_plant_argument, add_quiet,
+from compliance.cli.common import (add_allow_conflicts, add_document_options, add_jobs, add_outputs, add_parser, add_plant_argument, add_quiet,
                                    add_reproducible, document_options,
                                    check_args_outputs, plant_source)
 
@@ -52,9 +52,7 @@ def register(subparsers):
     p.add_argument("--uncertainty", type=int, default=None, metavar="N",
                    help="bands from a Latin-hypercube Monte Carlo of N plants over the plant file's declared ranges "
                         "(instead of the local sensitivities); 0 = point values only")
-    p.add_argument("--allow-conflicts", action="store_true",
-                   help="judge a requirement set even when two mandatory limits cannot hold together (without it such a set "
-                        "is refused with exit code 2 before any simulation; docs/requirements.md)")
+    add_allow_conflicts(p)
     from compliance.cli.sweep import add_remedies_options
 
     add_remedies_options(p)
@@ -131,7 +129,7 @@ def run(args) -> int:
     from compliance.cli.common import plant_from_args
     from compliance.cli.progress import progress
     from compliance.files.reproducible import fixed_created, is_reproducible
-    from compliance.requirements.loading import load_requirements
+    from compliance.cli.common import checked_requirements
     from compliance.requirements.verdict import Overall
 
     check_uncertainty_option(args)
@@ -147,10 +145,7 @@ def run(args) -> int:
 
         load_sweep(args.remedies)
     cfg = plant_from_args(args)
-    reqset = load_requirements(args.requirements)
-    from compliance.requirements.consistency import check_consistency
-
-    check_consistency(reqset, cfg.p("cylinder.stroke"), args.allow_conflicts)  # before any simulation
+    reqset = checked_requirements(args.requirements, [cfg.p("cylinder.stroke")], args)  # before any simulation
     check_uncertainty_option(args, cfg)
     stages = 1 + bool(args.linear) + (render is not None)
     # the campaign reports its runs itself on a terminal; in a CI log these stage lines (and a heartbeat) show progress

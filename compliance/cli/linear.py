@@ -42,8 +42,9 @@ def register(subparsers):
     p.add_argument("--crosscheck", action="store_true", help="compare with nonlinear 1 %% and 5 %% steps at the paper's operating points")
     p.add_argument("--governor", action="store_true",
                    help="equivalent gate-servo parameters for HYGOV / HYGOV4 (Tg, VELM, UO/UC, GMAX/GMIN), ANDES table, PSS/E record")
-    p.add_argument("--stroke-load", default="default",
-                   help="load during the governor's large moves: a force, 'curve' or 'none' (default: the load curve)")
+    p.add_argument("--stroke-load", default=None,
+                   help="with --governor: load during the governor's large moves: a force, 'curve' or 'none' "
+                        "(default: the load curve)")
     add_outputs(p, "json", help={"json": "write everything as JSON to FILE.json"})
     p.add_argument("--governor-json", metavar="FILE.json", help="write only the HYGOV parameters as JSON (implies --governor)")
     p.add_argument("--plot", metavar="FILE.png", help="write Bode, Nyquist, pole-zero and step plots (.png, .svg or .pdf)")
@@ -129,14 +130,17 @@ def run(args) -> int:
     from compliance.files.jsonable import jsonable
     from compliance.linear.analysis import analyse
 
+    governor = bool(args.governor or args.governor_json)
+    if args.stroke_load is not None and not governor:
+        raise InputError(f"--stroke-load {args.stroke_load}: the load of the governor's large moves; it needs --governor "
+                         "(or --governor-json), without which no large move is run")
+    sl = None
+    if governor:  # parsed before any work: a bad --stroke-load is exit 2 with nothing run
+        sl = "default" if args.stroke_load is None else parse_load(args.stroke_load, "--stroke-load")
     check_args_outputs(args, (args.governor_json, "--governor-json", (".json",)), (args.plot, "--plot", _PLOT_SUFFIXES))
     cfg = plant_from_args(args)
     L = cfg.p("cylinder.stroke")
-    governor = bool(args.governor or args.governor_json)
     x, load, flow_control = _point(cfg, args, governor)
-    sl = None
-    if governor:  # parsed before any work: a bad --stroke-load is exit 2 with nothing run
-        sl = "default" if args.stroke_load == "default" else parse_load(args.stroke_load, "--stroke-load")
     a = analyse(cfg, x, load, flow_control=flow_control, gain=args.gain)
     summary = _summary(cfg, a, flow_control)
     print(summary.splitlines()[0] if args.quiet else summary)

@@ -154,7 +154,21 @@ def _check_output(path: str) -> None:
 
     check_output(path, "-o/--output", OUTPUT_SUFFIXES)
     if path.lower().endswith(".cfg"):
-        check_output(Path(path).with_suffix(".dat"), "-o/--output (its COMTRADE .dat)")
+        dat = Path(path).with_suffix(".dat")
+        check_output(dat, "-o/--output (its COMTRADE .dat)")
+        if dat.exists() and not _written_by_simulate(path):
+            raise InputError(f"-o {path}: its COMTRADE data file {dat} exists and was not written by govcheck simulate "
+                             "(no govcheck sidecar beside it); choose another output name (nothing is overwritten)")
+
+
+def _written_by_simulate(output: str) -> bool:
+    """The files of ``output`` are an earlier govcheck simulate run: its sidecar carries the mark."""
+    from compliance.recordings.metadata import sidecar_path
+
+    side = sidecar_path(output)
+    if not side.is_file():
+        return False
+    return side.read_text(encoding="utf-8", errors="replace").split("\n", 1)[0].strip() == SIDECAR_MARK
 
 
 def sidecar_text(cfg, scenario, plant: str) -> str:

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import sys
 
-from compliance.cli.common import add_jobs, add_outputs, add_parser, add_quiet, check_args_outputs
+from compliance.cli.common import add_allow_conflicts, add_jobs, add_outputs, add_parser, add_quiet, check_args_outputs
+from compliance.errors import InputError
 
 
 def register(subparsers):
@@ -28,14 +29,17 @@ def register(subparsers):
     )
     p.add_argument("requirements", metavar="REQUIREMENTS", help="requirement file: a TOML file or a shipped name")
     p.add_argument("--duty", required=True, metavar="DUTY.toml", help="the duty (schema govcheck-duty/1, docs/sizing.md)")
-    p.add_argument("--out", metavar="FILE.toml", help="write the proposed configuration here")
-    p.add_argument("--no-check", action="store_true", help="propose only; do not run the campaign")
+    p.add_argument("--out", metavar="FILE.toml", help="write the proposed configuration here (when the run has finished; "
+                                                     "never over the duty, its template or the requirement file)")
+    p.add_argument("--no-check", action="store_true", help="propose only; do not run the campaign (no results: takes no "
+                                                          "--json, --remedies or --jobs)")
     p.add_argument("--remedies", action="store_const", const="default", default=None,
                    help="hand the proposal to the remedies search (as `govcheck check --remedies`)")
     from compliance.cli.sweep import add_remedies_options
 
     add_remedies_options(p)
     add_outputs(p, "json")
+    add_allow_conflicts(p)
     add_jobs(p)
     add_quiet(p, "print only the verdict line")
     return p
@@ -57,29 +61,61 @@ def _sizing_text(rec: dict, tune: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _refuse_unused(args) -> None:
+    """With --no-check nothing is checked, so an option that shapes the check would do nothing: refused."""
+    if not args.no_check:
+        return
+    for flag, value in (("--json", args.json), ("--remedies", args.remedies), ("--jobs", args.jobs),
+                        ("--save-remedy", args.save_remedy), ("--catalogue", args.catalogue),
+                        ("--yield-units", args.yield_units), ("--scheduler", args.scheduler),
+                        ("--remedies-state", args.remedies_state)):
+        if value is not None:
+            raise InputError(f"{flag} does nothing with --no-check (the proposal is not checked, so there are no results); "
+                             f"drop {flag} or --no-check")
+
+
+def _sized_configuration(cfg, out: str | None):
+    """The proposal as it will be written (rendered to TOML and read back: what is checked is what is saved)."""
+    import hashlib
+    import tomllib
+
+    from compliance.model.config import plant_from_dict, plant_to_toml
+
+    text = plant_to_toml(cfg)
+    return plant_from_dict(tomllib.loads(text), out or "<sized configuration>", hashlib.sha256(text.encode()).hexdigest()), text
+
+
 def run(args) -> int:
-    """Size, write, check, and optionally search remedies; exit code from the proposal's verdict."""
+    """Size, check, optionally search remedies, then write; exit code from the proposal's verdict.
+
+    Every input and output is checked first; the proposal (--out) is written only when the run has
+    finished, so an interrupted or failed run leaves nothing behind.
+    """
+    from compliance.cli.common import checked_requirements
     from compliance.cli.sweep import check_remedies_options, remedies_kwargs, save_remedy
-    from compliance.model.config import load_plant, save_plant
-    from compliance.requirements.loading import load_requirements
+    from compliance.files.atomic import write_text_atomic
+    from compliance.model.config import load_plant, resolve_plant_path
     from compliance.requirements.verdict import Overall
     from compliance.sweep.sizing.duty_file import load_duty
     from compliance.sweep.sizing.size_servo import size_servo, time_constant_target
     from compliance.sweep.sizing.throttle_tuning import tune_throttles
 
-    check_args_outputs(args, (args.out, "--out", (".toml",)), (args.save_remedy, "--save-remedy", (".toml",)))
+    _refuse_unused(args)
     check_remedies_options(args)
     duty = load_duty(args.duty)
-    reqset = load_requirements(args.requirements)
+    template_path = resolve_plant_path(duty.template)
+    check_args_outputs(args, (args.out, "--out", (".toml",)), (args.save_remedy, "--save-remedy", (".toml",)),
+                       inputs={str(template_path): f"the template of {args.duty}", args.duty: "--duty"})
     template = load_plant(duty.template)
+    reqset = checked_requirements(args.requirements, [duty.stroke], args)  # before any simulation
     cfg, rec = size_servo(duty, template, time_constant_target(reqset))
     cfg, tune = tune_throttles(cfg, reqset, {"opening": duty.opening_time, "closing": duty.closing_time})
+    cfg, text = _sized_configuration(cfg, args.out)
     if not args.quiet:
         sys.stdout.write(_sizing_text(rec, tune))
-    if args.out:
-        save_plant(cfg, args.out, overwrite=True)
-        cfg = load_plant(args.out)
     if args.no_check:
+        if args.out:
+            write_text_atomic(args.out, text)
         return 0
     from compliance.campaign.results_files import summary_table, write_json
     from compliance.campaign.run import run_campaign
@@ -91,13 +127,16 @@ def run(args) -> int:
 
         results["remedies"] = remedies_for_check(cfg, reqset, None, workers=args.jobs, progress=not args.quiet,
                                                  **remedies_kwargs(args))
-        save_remedy(args, cfg, results["remedies"])
     table = summary_table(results)
     sys.stdout.write(table.rstrip().splitlines()[-1] + "\n" if args.quiet else table)
     if args.remedies and not args.quiet:
         from compliance.sweep.summary_text import remedies_markdown
 
         sys.stdout.write("\n" + remedies_markdown(results["remedies"]))
+    if args.out:
+        write_text_atomic(args.out, text)
+    if args.remedies:
+        save_remedy(args, cfg, results["remedies"])
     if args.json:
         write_json(results, args.json)
     return 0 if results["summary"]["status"] == Overall.PASS else 1
