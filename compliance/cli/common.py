@@ -124,11 +124,11 @@ def add_scheduler(parser, what: str = "the parallel work") -> None:
 
 
 def check_scheduler(args) -> str | None:
-    """The ``--scheduler`` given, checked before any work (a bad address is exit 2); None for the local pool."""
-    from compliance.processes import parse_scheduler
+    """The ``--scheduler`` given, checked before any work (a bad or unreachable address is exit 2); None for the local pool."""
+    from compliance.processes.dask_cluster import check_reachable
 
     value = getattr(args, "scheduler", None)
-    parse_scheduler(value)
+    check_reachable(value)
     return value
 
 

@@ -6,7 +6,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from compliance.cli.common import add_jobs, add_outputs, add_parser, add_quiet, add_reproducible, check_args_outputs
+from compliance.cli.common import (add_allow_conflicts, add_jobs, add_outputs, add_parser, add_quiet, add_reproducible,
+                                   check_args_outputs)
 from compliance.errors import InputError, did_you_mean
 
 
@@ -42,6 +43,7 @@ def register(subparsers):
                         "the PR comment still says why it could not be evaluated)")
     p.add_argument("--markdown", metavar="FILE.md", help="write a Markdown summary for a pull-request comment")
     add_outputs(p, "json", help={"json": "write the gate result as JSON to FILE.json"})
+    add_allow_conflicts(p)
     add_jobs(p)
     add_quiet(p, "no progress bar; print only the gate line")
     add_reproducible(p)
@@ -107,13 +109,17 @@ def run(args) -> int:
     if args.max_margin_loss is not None and not args.max_margin_loss >= 0:
         raise InputError(f"--max-margin-loss {args.max_margin_loss}: expected a number of percentage points >= 0")
     check_args_outputs(args, (args.markdown, "--markdown", (".md", ".markdown")))
+    if args.allow_conflicts and _is_results(args.baseline) and _is_results(candidate):
+        raise InputError("--allow-conflicts: both sides are results files, so no requirement set is judged here; drop it")
     base = read_results(args.baseline) if _is_results(args.baseline) else None
     cand = read_results(candidate) if _is_results(candidate) else None
     sources = {"baseline": args.baseline, "candidate": candidate}
     configs = {name: load_plant(src) for name, src in sources.items() if not _is_results(src)}
     reqset = None
     if configs:
-        reqset = _requirements_for(args, base)
+        from compliance.cli.common import checked_requirements
+
+        reqset = checked_requirements(_requirements_for(args, base), [c.p("cylinder.stroke") for c in configs.values()], args)
         if base is not None and reqset.digest != base["requirement_set"].get("digest"):
             print(f"govcheck gate: note: {reqset.path} changed since the baseline was made "
                   f"(digest {str(base['requirement_set'].get('digest'))[:12]} -> {reqset.digest[:12]})", file=sys.stderr)

@@ -10,7 +10,7 @@ import shlex
 import sys
 from pathlib import Path
 
-from compliance.cli.common import add_jobs, add_parser, add_quiet, add_scheduler, check_scheduler
+from compliance.cli.common import add_allow_conflicts, add_jobs, add_parser, add_quiet, add_scheduler, check_scheduler
 from compliance.errors import InputError
 from compliance.sweep.remedies.outcome import RemedyStatus
 
@@ -42,6 +42,7 @@ def register(subparsers):
                    help="tolerance yield of CANDIDATE: 'base', 'best' or a candidate number of an earlier sweep "
                         "in the same output folder")
     p.add_argument("--units", type=int, default=None, help="override the number of Monte Carlo units of --yield")
+    add_allow_conflicts(p)
     add_quiet(p, "no progress; print only the result line")
     return p
 
@@ -88,6 +89,14 @@ def _yield_candidate(which: str, out: Path, spec) -> dict:
     return {a.param.path: float(row[a.param.path]) for a in spec.adjust}
 
 
+def _check_requirement_set(spec, args) -> None:
+    """The sweep's requirement set is checked like every other command's (before any candidate runs)."""
+    from compliance.cli.common import checked_requirements
+    from compliance.model.config import load_plant
+
+    checked_requirements(spec.requirements, [load_plant(spec.base).p("cylinder.stroke")], args)
+
+
 def _command_line(args) -> str:
     parts = ["govcheck", "sweep", args.sweep]
     for flag in ("out", "scheduler", "jobs", "samples"):
@@ -119,6 +128,12 @@ def run(args) -> int:
             raise InputError(f"--{flag} {v}: expected a positive number")
     check_scheduler(args)  # a bad address is exit 2 before any work
     spec = load_sweep(args.sweep)
+    if args.units is not None and not args.yield_of:
+        raise InputError(f"--units {args.units}: the Monte Carlo units of --yield; without --yield no yield is run")
+    if args.samples is not None and spec.method == "grid":
+        raise InputError(f"--samples {args.samples}: overrides the latin-hypercube sample count, and {spec.path} searches a "
+                         "grid (method = \"grid\"), whose size its steps set")
+    _check_requirement_set(spec, args)
     if args.samples:
         spec = replace(spec, samples=args.samples)
     out = _out_dir(args, spec)

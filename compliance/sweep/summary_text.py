@@ -35,6 +35,8 @@ def remedies_markdown(rem: dict) -> str:
         for b in s["by_parameter"][:4]:
             lines.append(f"  - {b['path']} +{_g(b['step'], b['unit'])}: {_pct(b['delta_margin_pct'])} points")
     pick = rem.get("remedy") or rem.get("closest")
+    if rem.get("status") == "already_passes":  # RemedyStatus.ALREADY_PASSES: the note says it; no "closest" to show
+        pick = None
     if pick:
         title = "Smallest verified change" if rem.get("remedy") else "Closest candidate (does not pass)"
         if not pick["changes"]:  # the configuration as given ranks first: no table of nothing
