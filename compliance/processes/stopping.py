@@ -24,7 +24,8 @@ import threading
 import time
 from contextlib import contextmanager
 
-__all__ = ["GRACE", "Terminated", "raise_if_stopping", "stop_signal", "stop_on_signals", "worker_pool"]
+__all__ = ["GRACE", "Terminated", "ignore_late_signals", "raise_if_stopping", "stop_signal", "stop_on_signals",
+           "worker_pool"]
 
 GRACE = 3.0  # [s] after a signal, the unwinding's budget before the watchdog ends the process (the issue asks <= 5 s)
 _ARMED = threading.Event()
@@ -79,6 +80,19 @@ def stop_on_signals() -> None:
     if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:
         signal.signal(signal.SIGINT, _on_signal)
     sys.unraisablehook = _quiet_stop(sys.unraisablehook)
+
+
+def ignore_late_signals() -> None:
+    """The run is over (its outputs written, its exit code decided): a SIGINT or SIGTERM from now on changes nothing.
+
+    The interpreter's teardown puts Python-level handlers back to the default action, so a Ctrl-C
+    landing there would kill the finished process with the signal instead of its exit code; an
+    ignored signal stays ignored. Call it from the command-line entry only, never in a library caller.
+    """
+    if threading.current_thread() is not threading.main_thread() or _SIGNAL:
+        return
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def _quiet_stop(previous):
