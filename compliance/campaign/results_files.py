@@ -61,18 +61,46 @@ def check_numbers(data: dict, where: str) -> None:
     InputError
         The results file is damaged or hand-edited.
     """
-    for key in ("requirements", "runs", "timing", "linear", "plant"):
+    for key in _NUMERIC_SECTIONS:
         _check_numbers(data.get(key), f"{where}: {key}")
 
 
-# keys whose values the report computes with: a number, null, or a list of them (text lives in "display" tables)
+# the sections whose numbers the report computes with (requirement_set, versions and the like are text as written)
+_NUMERIC_SECTIONS = ("requirements", "runs", "timing", "linear", "plant", "summary", "validation")
+# keys whose values the report computes with: a number, null, or a list of them (text lives in "display" tables);
+# every key that holds numbers, and only numbers, in a results file govcheck writes (check, --linear, validation)
 NUMERIC_KEYS = frozenset({
     "value", "margin", "margin_pct", "wall", "wall_time", "time", "position", "reference", "valve_command",
     "pressure_a", "pressure_b", "supply_pressure", "force", "phase_margin_deg", "gain_margin_db", "time_constant",
     "dead_time", "overshoot", "settling_time", "rise_time", "bandwidth_hz", "natural_frequency_hz", "damping_ratio",
     "gain_crossover_hz", "phase_crossover_hz", "max_error", "rms_error", "steady_error", "peak_speed",
+    # the linear analysis, its map, cross-check and governor parameters
+    "GMAX", "GMIN", "Tg", "Tg_linear", "Tg_nonlinear_samples", "Tg_steps", "UC", "UO", "VELM", "UO_peak", "UC_peak",
+    "closed_loop", "closed_loop_discrete", "closed_loop_magnitude_db", "closed_loop_phase_deg", "closed_loop_zeros",
+    "dead_time_linear", "dead_time_viscous", "dominant_time_constant", "first_order_time_constant", "frequency_hz",
+    "gain_margin_db_continuous", "phase_margin_deg_continuous", "loop_discrete_magnitude_db", "loop_discrete_phase_deg",
+    "loop_gain", "loop_magnitude_db", "loop_phase_deg", "natural_frequency_analytic_hz", "plant_minimal",
+    "plant_velocity_gain", "pneumatic", "pneumatic_damping_ratio", "pneumatic_stiffness", "positions", "rate_pu_per_s",
+    "ratio", "ratio_viscous", "ratio_viscous_no_dead_zone", "state_scales", "stroke_time", "t25", "t75", "t_step",
+    "tau_linear", "tau_linear_mean", "tau_nonlinear", "tau_nonlinear_viscous", "time_constant_continuous",
+    "unobservable_or_uncontrollable_states", "viscous_damping_ratio_analytic", "x_final", "x_start", "step",
+    "peak_time", "mean_speed_to_63", "time_to_end", "t25_75", "position_fraction", "rest_velocity",
+    # rows, samples, runs and the validation replay
+    "a_choked", "a_subsonic", "b_choked", "b_subsonic", "after_reversal", "at_rest", "command_at_limit",
+    "holding_under_load", "moving", "valve_saturated", "valve_dead_band", "static_friction", "region_closed",
+    "region_high", "region_low", "region_mid", "opening", "closing", "factor", "fit_percent", "i_end", "i_start",
+    "initial_pressures", "load_force", "limit", "max", "max_abs_error", "mean_absolute_error", "mean_error",
+    "mean_residual", "nrmse", "peak_abs", "peak_ratio", "rms_residual", "run_wall_sum", "sample_time",
+    "sample_time_median", "simulated", "recorded", "speed", "start", "end", "velocity_noise", "workers", "points",
+    "kp", "ki", "kd", "critical_pressure_ratio", "controller.kp", "controller.ki", "controller.kd",
+    "controller.sample_time", "air.supply_pressure", "duration", "size", "initial_position",
+    # summary counts
+    "pass", "fail", "not_evaluated", "disabled", "runs", "samples",
 })
-_TEXT_TABLES = frozenset({"display", "procedure", "operating_point", "settings", "procedures", "operating_points"})
+# keys that hold a number or one of these words
+_NUMBER_OR_WORD = {"load": ("curve", "none", "nominal"), "loads": ("curve", "none", "nominal")}
+_TEXT_TABLES = frozenset({"display", "procedure", "operating_point", "settings", "procedures", "operating_points", "units",
+                          "notes", "open"})
 
 
 def _check_numbers(tree, where: str) -> None:
@@ -81,7 +109,8 @@ def _check_numbers(tree, where: str) -> None:
         for k, v in tree.items():
             if k in _TEXT_TABLES:
                 continue
-            if k in NUMERIC_KEYS and not _numbers(v):
+            words = _NUMBER_OR_WORD.get(k)
+            if (k in NUMERIC_KEYS and not _numbers(v)) or (words and not _numbers(v, words)):
                 raise InputError(f"{where}.{k}: {str(v)[:60]!r} where a number (or null) belongs; the results file is "
                                  "damaged or hand-edited: regenerate it with govcheck check --json")
             _check_numbers(v, f"{where}.{k}")
@@ -90,12 +119,12 @@ def _check_numbers(tree, where: str) -> None:
             _check_numbers(v, f"{where}[{i}]")
 
 
-def _numbers(v) -> bool:
+def _numbers(v, words: tuple = ()) -> bool:
     if isinstance(v, list):
-        return all(_numbers(x) for x in v)
+        return all(_numbers(x, words) for x in v)
     if isinstance(v, dict):
         return True  # a table of its own: its leaves are checked by name
-    return v is None or (isinstance(v, (int, float)) and not isinstance(v, bool))
+    return v is None or isinstance(v, (int, float)) or (isinstance(v, str) and v in words)
 
 
 # --------------------------------------------------------------------------- terminal
