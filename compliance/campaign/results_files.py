@@ -97,26 +97,29 @@ NUMERIC_KEYS = frozenset({
     # summary counts
     "pass", "fail", "not_evaluated", "disabled", "runs", "samples",
 })
+# keys numeric in one table only (a "window" of the validation is a name; the linear map's is its stroke window)
+_NUMERIC_IN = {"map": frozenset({"window"})}
 # keys that hold a number or one of these words
 _NUMBER_OR_WORD = {"load": ("curve", "none", "nominal"), "loads": ("curve", "none", "nominal")}
 _TEXT_TABLES = frozenset({"display", "procedure", "operating_point", "settings", "procedures", "operating_points", "units",
                           "notes", "open"})
 
 
-def _check_numbers(tree, where: str) -> None:
+def _check_numbers(tree, where: str, table: str = "") -> None:
     """A damaged results file (text where the report needs a number) is named, not rendered into a crash."""
     if isinstance(tree, dict):
         for k, v in tree.items():
             if k in _TEXT_TABLES:
                 continue
             words = _NUMBER_OR_WORD.get(k)
-            if (k in NUMERIC_KEYS and not _numbers(v)) or (words and not _numbers(v, words)):
+            numeric = k in NUMERIC_KEYS or k in _NUMERIC_IN.get(table, ())
+            if (numeric and not _numbers(v)) or (words and not _numbers(v, words)):
                 raise InputError(f"{where}.{k}: {str(v)[:60]!r} where a number (or null) belongs; the results file is "
                                  "damaged or hand-edited: regenerate it with govcheck check --json")
-            _check_numbers(v, f"{where}.{k}")
+            _check_numbers(v, f"{where}.{k}", k)
     elif isinstance(tree, list):
         for i, v in enumerate(tree):
-            _check_numbers(v, f"{where}[{i}]")
+            _check_numbers(v, f"{where}[{i}]", table)
 
 
 def _numbers(v, words: tuple = ()) -> bool:

@@ -42,6 +42,11 @@ def register(subparsers):
     p.add_argument("--crosscheck", action="store_true", help="compare with nonlinear 1 %% and 5 %% steps at the paper's operating points")
     p.add_argument("--governor", action="store_true",
                    help="equivalent gate-servo parameters for HYGOV / HYGOV4 (Tg, VELM, UO/UC, GMAX/GMIN), ANDES table, PSS/E record")
+    p.add_argument("--rating", metavar="MVA", help="with --governor: the unit's rating Tn, the machine base of the ANDES and "
+                   "PSS/E numbers (default: the system base)")
+    p.add_argument("--system-base", metavar="MVA", help="with --governor: the study's system base Sb (default 100 MVA)")
+    p.add_argument("--dispatch", metavar="MW", help="with --governor: the unit's power at the operating point, as the "
+                   "study dispatches it (sets At so the gate starts there; default: rating x operating gate)")
     p.add_argument("--stroke-load", default=None,
                    help="with --governor: load during the governor's large moves: a force, 'curve' or 'none' "
                         "(default: the load curve)")
@@ -95,6 +100,30 @@ def _point(cfg, args, governor: bool):
     return x, load, flow_control
 
 
+def _study(args, governor: bool) -> dict:
+    """--rating / --system-base / --dispatch [MVA, MVA, MW], checked before any work; each needs --governor."""
+    from compliance.units import parse_quantity
+
+    out = {}
+    for flag, key, unit in (("--rating", "rating_mva", "MVA"), ("--system-base", "system_mva", "MVA"),
+                            ("--dispatch", "dispatch_mw", "MW")):
+        text = getattr(args, flag.lstrip("-").replace("-", "_"))
+        if text is None:
+            continue
+        if not governor:
+            raise InputError(f"{flag} {text}: a basis of the governor export; it needs --governor (or --governor-json)")
+        try:
+            float(text)
+        except ValueError:
+            value = parse_quantity(text, "W", f"{flag} {text!r}") / 1e6  # VA and W share pint's dimension
+        else:  # a bare number would be SI (watts): a power system's figures are MVA and MW, so say it
+            raise InputError(f"{flag} {text}: give the unit, e.g. '{text} {unit}'")
+        if not value > 0 or value != value or value == float("inf"):
+            raise InputError(f"{flag} {text}: expected a positive power in {unit} (e.g. '50 {unit}')")
+        out[key] = value
+    return out
+
+
 def _fmt(v, scale=1.0, digits=3, unit=""):
     return "-" if v is None else f"{v*scale:.{digits}f} {unit}".rstrip()
 
@@ -134,6 +163,7 @@ def run(args) -> int:
     if args.stroke_load is not None and not governor:
         raise InputError(f"--stroke-load {args.stroke_load}: the load of the governor's large moves; it needs --governor "
                          "(or --governor-json), without which no large move is run")
+    study = _study(args, governor)
     sl = None
     if governor:  # parsed before any work: a bad --stroke-load is exit 2 with nothing run
         sl = "default" if args.stroke_load is None else parse_load(args.stroke_load, "--stroke-load")
@@ -171,6 +201,7 @@ def run(args) -> int:
 
         reuse = a if args.gain == "mean" else None  # Tg_linear is the mean-slope figure of the same point
         gov = governor_parameters(cfg, position=x, load=load, stroke_load=sl, flow_control=flow_control, linear=reuse)
+        gov.study = study
         print(f"\nequivalent gate-servo parameters ({gov.basis()['circuit']}; pu on the machine base, gate = stroke):")
         print(gov.table())
         out["governor"] = gov.to_dict()

@@ -56,6 +56,7 @@ class GovernorModel:
     end_stop: list = field(default_factory=list)  # commissioning strokes from the end stops (comparison)
     GMAX: float = 1.0
     GMIN: float = 0.0
+    study: dict = field(default_factory=dict)  # rating_mva, system_mva, dispatch_mw of the exported ANDES / PSS/E forms
 
     def _best(self, direction: str, key: str) -> float:
         return max(m[key] for m in self.moves if m["direction"] == direction)
@@ -223,12 +224,13 @@ class GovernorModel:
             "units": {"Tg": "s", "VELM": "pu/s", "GMAX": "pu", "GMIN": "pu", "UO": "pu/s", "UC": "pu/s (negative: closing)",
                       "UO_peak": "pu/s", "UC_peak": "pu/s (negative: closing)"},
             "Tg_linear": s["Tg_linear"],
-            "HYGOV4": self.andes()["HYGOV4"],
+            "HYGOV4": self.andes(**self.study)["HYGOV4"],
             "ieee_pes_tr_2013": {"T_G": s["Tg"], "U_O": s["UO"], "U_C": s["UC"], "G_max": s["GMAX"], "G_min": s["GMIN"],
                                  "VELM": s["VELM"]},
-            "andes": self.andes(),
-            "psse_dyr": {"HYGOV": self.dyr(), "basis": "the bare positioner of andes.HYGOV on MBASE = SBASE = "
-                                                         f"{SYSTEM_MVA:g} MVA (GovernorModel.dyr takes another rating)"},
+            "andes": self.andes(**self.study),
+            "psse_dyr": {"HYGOV": self.dyr(**self.study),
+                         "basis": "the bare positioner of andes.HYGOV, on the machine base andes.basis names (a .dyr has no "
+                                  "Tn: MBASE, the generator's rating, must be that Tn)"},
             "family": self.family,
             "conventions": self.conventions(),
             "left_out": self.left_out(),
@@ -300,5 +302,5 @@ class GovernorModel:
         w = max(len(r[0]) for r in rows)
         lines = [f"{n:<{w}}  {v:>8} {u:<5} {m}" for n, v, u, m in rows]
         lines.append(f"model: {self.family['recommended']} ({self.family['why']})")
-        lines.append("PSS/E: " + self.dyr())
+        lines.append("PSS/E: " + self.dyr(**self.study))
         return "\n".join(lines)
