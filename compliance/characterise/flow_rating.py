@@ -17,11 +17,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from compliance.physics.valve_rating import (  # noqa: F401  (the rating point, re-exported for this module's users)
+from compliance.physics.valve_rating import (
     NORMAL_DENSITY,
     NORMAL_TEMPERATURE,
-    RATING_DROP,
-    RATING_INLET_GAUGE,
     rated_mass_flow,
     rating_point,
     sonic_conductance,

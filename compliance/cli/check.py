@@ -4,22 +4,17 @@ from __future__ import annotations
 
 import shlex
 import sys
-from importlib import resources
 
 from compliance.cli.common import (add_allow_conflicts, add_document_options, add_jobs, add_outputs, add_parser, add_plant_argument, add_quiet,
                                    add_reproducible, document_options,
                                    check_args_outputs, plant_source)
 
 
-def shipped_requirements() -> list[str]:
-    """Names of the requirement files shipped with govcheck (usable as ``-r NAME``)."""
-    folder = resources.files("compliance") / "data" / "requirements"
-    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
-
-
 def register(subparsers):
     """Add the ``check`` sub-command."""
-    names = shipped_requirements()
+    from compliance.files.shipped import shipped_names
+
+    names = shipped_names("requirements")
     p = add_parser(
         subparsers, "check",
         help="check a plant configuration against a requirement file",

@@ -17,7 +17,6 @@ import re
 from pathlib import Path
 
 from compliance.errors import InputError
-from compliance.model.force_limit import check_load_force  # noqa: F401 - simulate's --load check
 from compliance.units import parse_quantity
 
 OUTPUT_SUFFIXES = {"json": (".json",), "junit": (".xml",), "report": (".html", ".htm"), "pdf": (".pdf",)}
@@ -294,9 +293,9 @@ def parse_param_overrides(items, option: str = "--param") -> dict:
 
 def looks_like_config(text: str) -> bool:
     """A plant configuration on the command line: a ``.toml`` file or a shipped reference name."""
-    from compliance.model.config import reference_plants
+    from compliance.files.shipped import shipped_names
 
-    return text.lower().endswith(".toml") or (text in reference_plants() and not os.path.exists(text))
+    return text.lower().endswith(".toml") or text in shipped_names("plant")
 
 
 def split_config(args, inputs: list[str], what: str = "RECORDING") -> tuple[str | None, list[str]]:

@@ -167,7 +167,8 @@ def _render_servo_report(cfg, frame, meta, diag, data: dict, args) -> None:
 
 
 def _run_friction(args, first, meta) -> int:
-    from compliance.diagnosis.friction_bench.diagnose import diagnose_friction, format_friction
+    from compliance.diagnosis.friction_bench.diagnose import diagnose_friction
+    from compliance.diagnosis.friction_bench.explanation import format_friction
     from compliance.recordings.reader import read_recording
     from compliance.units import parse_quantity
 

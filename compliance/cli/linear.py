@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 
 from compliance.cli.common import add_outputs, add_parser, add_plant_argument, add_quiet, add_reproducible, check_args_outputs
-from compliance.errors import InputError
 
 _PLOT_SUFFIXES = (".png", ".svg", ".pdf")
 
@@ -58,44 +57,15 @@ def register(subparsers):
     return p
 
 
-def _position(text: str, stroke: float) -> float:
-    from compliance.units import parse_quantity
-
-    t = str(text).strip()
-    if t.endswith("%"):
-        try:
-            return float(t[:-1]) / 100.0 * stroke
-        except ValueError:
-            raise InputError(f"--at {text!r}: expected a percentage of stroke such as '85 %'") from None
-    try:
-        return float(t)
-    except ValueError:
-        return parse_quantity(t, "m", f"--at {text!r}")
-
-
-def parse_load(text, flag: str = "--load"):
-    """'none' -> None, 'curve' -> 'curve', '11.4 kN' -> 11400.0, '11400' -> 11400.0 [N]."""
-    from compliance.units import parse_quantity
-
-    t = str(text).strip()
-    if t.lower() in ("none", "0", ""):
-        return None
-    if t.lower() == "curve":
-        return "curve"
-    try:
-        return float(t)
-    except ValueError:
-        return parse_quantity(t, "N", f"{flag} {text!r}")
-
-
 def _point(cfg, args, governor: bool):
     """(position [m], load, flow_control) of the analysis; with --governor the governor's own point and circuit."""
     from compliance.linear.governor_model import nominal_point
+    from compliance.units.amounts import parse_load, parse_position
 
     x_n, load_n = nominal_point(cfg) if governor else (None, None)
     L = cfg.p("cylinder.stroke")
-    x = _position(args.at, L) if args.at is not None else (x_n if governor else 0.5 * L)
-    load = parse_load(args.load) if args.load is not None else (load_n if governor else None)
+    x = parse_position(args.at, L, f"--at {args.at!r}", require_unit=False) if args.at is not None else (x_n if governor else 0.5 * L)
+    load = parse_load(args.load, f"--load {args.load!r}", require_unit=False) if args.load is not None else (load_n if governor else None)
     flow_control = args.flow_control if args.flow_control is not None else (True if governor else None)
     return x, load, flow_control
 
@@ -166,10 +136,12 @@ def run(args) -> int:
     study = _study(args, governor)
     sl = None
     if governor:  # parsed before any work: a bad --stroke-load is exit 2 with nothing run
-        sl = "default" if args.stroke_load is None else parse_load(args.stroke_load, "--stroke-load")
+        from compliance.units.amounts import parse_load
+
+        sl = "default" if args.stroke_load is None else parse_load(args.stroke_load, f"--stroke-load {args.stroke_load!r}",
+                                                                   require_unit=False)
     check_args_outputs(args, (args.governor_json, "--governor-json", (".json",)), (args.plot, "--plot", _PLOT_SUFFIXES))
     cfg = plant_from_args(args)
-    L = cfg.p("cylinder.stroke")
     x, load, flow_control = _point(cfg, args, governor)
     a = analyse(cfg, x, load, flow_control=flow_control, gain=args.gain)
     summary = _summary(cfg, a, flow_control)

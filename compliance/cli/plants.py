@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from compliance.model.config import load_plant, reference_plants
+from compliance.files.shipped import shipped_names
+from compliance.model.config import load_plant
 
 
 def register(sub):
@@ -16,7 +17,7 @@ def register(sub):
 
 
 def run(args) -> int:
-    for name in reference_plants():
+    for name in shipped_names("plant"):
         cfg = load_plant(name)
         arr = cfg.options["cylinder.arrangement"]
         print(f"{name:10s} {arr:7s} stroke {cfg.p('cylinder.stroke')*1e3:.0f} mm, bore {cfg.p('cylinder.piston_diameter')*1e3:.0f} mm, "

@@ -7,9 +7,10 @@ import json
 import os
 from pathlib import Path
 
-from compliance.cli.common import (add_parser, add_plant_argument, check_load_force, plant_from_args, plant_source,
+from compliance.cli.common import (add_parser, add_plant_argument, plant_from_args, plant_source,
                                    quantity)
 from compliance.errors import InputError
+from compliance.model.force_limit import check_load_force
 from compliance.simulation.profiles import Profile, parse_sine, steps
 
 MAX_DURATION = 3600.0  # [s] one simulation; longer is a typo (1e9 s would need TiB of memory)
@@ -122,13 +123,14 @@ def _check_sine(cfg, x0: float, spec: str) -> None:
 def build_scenario(cfg, args):
     """The :class:`~compliance.simulation.Scenario` the arguments describe (every guard before any work)."""
     from compliance.simulation import Scenario, SensorNoise
+    from compliance.units.amounts import parse_load, parse_position
 
     stroke = cfg.p("cylinder.stroke")
-    x0 = quantity(args.x0, "m", "--x0", 0.5 * stroke)
+    x0 = 0.5 * stroke if args.x0 is None else parse_position(args.x0, stroke, f"--x0 {args.x0!r}", require_unit=False)
     if not 0.0 <= x0 <= stroke:
         raise InputError(f"--x0: {x0*1e3:.1f} mm is outside the stroke 0..{stroke*1e3:.0f} mm")
     duration = _duration(cfg, args.duration)
-    load = "curve" if str(args.load).strip() == "curve" else quantity(args.load, "N", "--load")
+    load = parse_load(args.load, f"--load {args.load!r}", require_unit=False)
     check_load_force(cfg, load, "--load")
     ref = cmd = None
     if args.steps:
@@ -211,9 +213,9 @@ def _sidecar_target(output: str) -> Path:
 
 def _plant_reference(source: str, side: Path) -> str:
     """How the sidecar names the plant: a reference name as is, a file relative to the sidecar's folder."""
-    from compliance.model.config import reference_plants
+    from compliance.files.shipped import looks_like_path, shipped_names
 
-    if source in reference_plants() and not Path(source).exists():
+    if not looks_like_path(source, "plant") and source in shipped_names("plant"):
         return source
     return os.path.relpath(Path(source).resolve(), side.resolve().parent)
 

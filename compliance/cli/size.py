@@ -94,7 +94,8 @@ def run(args) -> int:
     from compliance.cli.common import checked_requirements
     from compliance.cli.sweep import check_remedies_options, remedies_kwargs, save_remedy
     from compliance.files.atomic import write_text_atomic
-    from compliance.model.config import load_plant, resolve_plant_path
+    from compliance.files.shipped import resolve_shipped
+    from compliance.model.config import load_plant
     from compliance.requirements.verdict import Overall
     from compliance.sweep.sizing.duty_file import load_duty
     from compliance.sweep.sizing.size_servo import size_servo, time_constant_target
@@ -103,7 +104,7 @@ def run(args) -> int:
     _refuse_unused(args)
     check_remedies_options(args)
     duty = load_duty(args.duty)
-    template_path = resolve_plant_path(duty.template)
+    template_path = resolve_shipped(duty.template, "plant")
     check_args_outputs(args, (args.out, "--out", (".toml",)), (args.save_remedy, "--save-remedy", (".toml",)),
                        inputs={str(template_path): f"the template of {args.duty}", args.duty: "--duty"})
     template = load_plant(duty.template)

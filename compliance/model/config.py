@@ -9,7 +9,6 @@ import math
 import os
 import tomllib
 from dataclasses import dataclass, field, replace as dc_replace
-from importlib import resources
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any, Mapping
@@ -19,6 +18,7 @@ import numpy as np
 from compliance.effects import EFFECTS
 from compliance.errors import InputError, did_you_mean
 from compliance.files.atomic import write_text_atomic
+from compliance.files.shipped import resolve_shipped
 from compliance.model.assumptions import read_assumptions
 from compliance.model.config_fields import SECTIONS, atmosphere_of, effect_values, load_curve_field, section_values
 from compliance.model.parameters import BASE_BY_KEY, BASE_PARAMS, OPTIONS
@@ -28,7 +28,6 @@ from compliance.model.toml_file import read_toml
 _TOP_KEYS = {"name", "description", "provenance", "effects", "identity"}
 
 
-_suggest = did_you_mean
 
 
 @dataclass(frozen=True)
@@ -116,13 +115,13 @@ class PlantConfig:
         new_sources = dict(self.sources)
         for k, v in (params or {}).items():
             if k not in BASE_BY_KEY:
-                raise InputError(f"parameter '{k}' is not known{_suggest(k, BASE_BY_KEY)}")
+                raise InputError(f"parameter '{k}' is not known{did_you_mean(k, BASE_BY_KEY)}")
             new_params[k] = float(v)
             new_sources[k] = (sources or {}).get(k, "user")
         new_effects = {k: dict(v) for k, v in self.effects.items()}
         for k, v in (effects or {}).items():
             if k not in EFFECTS:
-                raise InputError(f"effect '{k}' is not known{_suggest(k, EFFECTS)}")
+                raise InputError(f"effect '{k}' is not known{did_you_mean(k, EFFECTS)}")
             if v is None:
                 new_effects.pop(k, None)
             else:
@@ -133,10 +132,10 @@ class PlantConfig:
         new_options = dict(self.options)
         for k, v in (options or {}).items():
             if k not in OPTIONS:
-                raise InputError(f"option '{k}' is not known{_suggest(k, OPTIONS)}")
+                raise InputError(f"option '{k}' is not known{did_you_mean(k, OPTIONS)}")
             v = str(v).lower() if isinstance(v, bool) else str(v)
             if v not in OPTIONS[k]:
-                raise InputError(f"option {k} = '{v}' is not one of {', '.join(OPTIONS[k])}{_suggest(v, OPTIONS[k])}")
+                raise InputError(f"option {k} = '{v}' is not one of {', '.join(OPTIONS[k])}{did_you_mean(v, OPTIONS[k])}")
             new_options[k] = v
         cfg = dc_replace(
             self,
@@ -152,27 +151,6 @@ class PlantConfig:
 
 
 # ----------------------------------------------------------------------------------------------
-def reference_plants() -> list[str]:
-    """Names of the reference configurations shipped with the package."""
-    folder = resources.files("compliance") / "data" / "plants"
-    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
-
-
-def resolve_plant_path(source: str | os.PathLike) -> Path:
-    """Path of a plant given as a file path or a reference name (``plant-a``)."""
-    s = str(source)
-    p = Path(s)
-    if p.suffix == ".toml" or os.sep in s or p.exists():
-        if not p.is_file():
-            raise InputError(f"{s}: plant configuration file not found")
-        return p
-    ref = resources.files("compliance") / "data" / "plants" / f"{s}.toml"
-    if not ref.is_file():
-        raise InputError(f"plant '{s}' is not a file nor a reference plant{_suggest(s, reference_plants())} "
-                         f"(reference plants: {', '.join(reference_plants())})")
-    return Path(str(ref))
-
-
 def load_plant(source: str | os.PathLike) -> PlantConfig:
     """Load and validate a plant configuration (a TOML path or a reference plant name).
 
@@ -181,7 +159,7 @@ def load_plant(source: str | os.PathLike) -> PlantConfig:
     InputError
         With the file and key path of the first problem found.
     """
-    path = resolve_plant_path(source)
+    path = resolve_shipped(source, "plant")
     data, digest = read_toml(path, "plant configuration")
     return plant_from_dict(data, str(path), digest)
 
@@ -192,7 +170,7 @@ def plant_from_dict(data: dict[str, Any], where: str = "<configuration>", digest
         raise InputError(f"{where}: expected a TOML table at the top level")
     for k in data:
         if k not in _TOP_KEYS and k not in SECTIONS:
-            raise InputError(f"{where}: unknown key '{k}'{_suggest(k, list(_TOP_KEYS) + SECTIONS)}")
+            raise InputError(f"{where}: unknown key '{k}'{did_you_mean(k, list(_TOP_KEYS) + SECTIONS)}")
     name = data.get("name")
     if not isinstance(name, str) or not name.strip():
         raise InputError(f"{where}: missing 'name' (a string naming the plant)")

@@ -33,12 +33,11 @@ from __future__ import annotations
 
 from compliance.model.toml_file import read_toml
 from dataclasses import dataclass, field
-from importlib import resources
-from pathlib import Path
 from types import MappingProxyType
 
 from compliance.errors import did_you_mean
 from compliance.errors import InputError
+from compliance.files.shipped import resolve_shipped
 
 # canonical column -> SI unit ("Pa" columns are absolute pressures); recording-format.md
 CANONICAL_UNITS = MappingProxyType(
@@ -129,16 +128,6 @@ class ColumnMap:
         return None
 
 
-_suggest = did_you_mean
-
-
-def builtin_column_maps() -> list[str]:
-    """Names of the column maps shipped in ``compliance/data/column_maps/``."""
-    folder = resources.files("compliance") / "data" / "column_maps"
-    try:
-        return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
-    except (FileNotFoundError, NotADirectoryError):
-        return []
 
 
 def load_column_map(source) -> ColumnMap:
@@ -164,15 +153,7 @@ def load_column_map(source) -> ColumnMap:
         return source
     if isinstance(source, dict):
         return _from_dict(source, "column map (dict)")
-    path = Path(source)
-    if not path.exists() and path.suffix == "" and str(source) in builtin_column_maps():
-        path = Path(str(resources.files("compliance") / "data" / "column_maps" / f"{source}.toml"))
-    if not path.is_file():
-        known = builtin_column_maps()
-        raise InputError(
-            f"column map {str(source)!r}: no such file, and not a shipped map "
-            f"(shipped: {', '.join(known) or 'none'}){_suggest(source, known)}"
-        )
+    path = resolve_shipped(source, "column_map", where="column map")
     data, _ = read_toml(path, "column map")
     return _from_dict(data, str(path))
 
@@ -187,7 +168,7 @@ def _int_option(data, key, where, default):
 def _from_dict(data: dict, where: str) -> ColumnMap:
     for key in data:
         if key not in _TOP_KEYS:
-            raise InputError(f"{where}: unknown key '{key}'{_suggest(key, _TOP_KEYS)} (known: {', '.join(_TOP_KEYS)})")
+            raise InputError(f"{where}: unknown key '{key}'{did_you_mean(key, _TOP_KEYS)} (known: {', '.join(_TOP_KEYS)})")
     delim_text = data.get("delimiter", "auto")
     if delim_text not in _DELIMITERS:
         raise InputError(
@@ -201,7 +182,7 @@ def _from_dict(data: dict, where: str) -> ColumnMap:
         raise InputError(f"{where}: 'header' must be true or false, got {header!r}")
     fmt = data.get("format")
     if fmt is not None and fmt not in _FORMATS:
-        raise InputError(f"{where}: format {fmt!r} not known{_suggest(fmt, _FORMATS)} (known: {', '.join(_FORMATS)})")
+        raise InputError(f"{where}: format {fmt!r} not known{did_you_mean(fmt, _FORMATS)} (known: {', '.join(_FORMATS)})")
     comment = data.get("comment", "#")
     if not isinstance(comment, str) or len(comment) != 1:
         raise InputError(f"{where}: 'comment' must be one character, got {comment!r}")
@@ -240,7 +221,7 @@ def _spec(name: str, entry, where: str, header: bool, time_unit) -> ColumnSpec:
         raise InputError(f"{where}: expected a table such as {{column = \"x_mm\", unit = \"mm\"}}")
     for key in entry:
         if key not in _ENTRY_KEYS:
-            raise InputError(f"{where}: unknown key '{key}'{_suggest(key, _ENTRY_KEYS)} (known: {', '.join(_ENTRY_KEYS)})")
+            raise InputError(f"{where}: unknown key '{key}'{did_you_mean(key, _ENTRY_KEYS)} (known: {', '.join(_ENTRY_KEYS)})")
     if "column" not in entry:
         raise InputError(f"{where}: missing 'column' (a column name or a 0-based index)")
     column = entry["column"]
@@ -254,7 +235,7 @@ def _spec(name: str, entry, where: str, header: bool, time_unit) -> ColumnSpec:
             si_unit = "Pa"
         else:
             raise InputError(
-                f"{where}: '{name}' is not a canonical column{_suggest(name, CANONICAL_UNITS)}; "
+                f"{where}: '{name}' is not a canonical column{did_you_mean(name, CANONICAL_UNITS)}; "
                 f"known: {', '.join(CANONICAL_UNITS)} (or give si_unit = \"...\" for your own column)"
             )
     unit = entry.get("unit")

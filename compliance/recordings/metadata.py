@@ -11,7 +11,6 @@ import re
 from compliance.model.toml_file import read_toml
 from pathlib import Path
 
-from compliance.errors import InputError
 from compliance.recordings.sidecar_schema import check_sidecar
 from compliance.recordings.instruments import instrument_facts
 from compliance.units import parse_quantity, registry

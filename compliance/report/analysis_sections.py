@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from compliance.units.formatting import fmt_num, fmt_value, unit_text as pretty_unit
 from compliance.report.figures_linear import MAP_QUANTITIES
-from compliance.diagnosis.verdicts.verdict import EXPLAINED, DiagnosisVerdict
+from compliance.diagnosis.verdicts.verdict import EXPLAINED
 
 SIGNAL_DISPLAY = {  # signal -> (label, unit shown, scale from SI)
     "position": ("position", "mm", 1e3),

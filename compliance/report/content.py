@@ -15,7 +15,7 @@ from compliance.errors import InputError
 from compliance.presentation.values import limit_as_written, metric_text, row_texts
 from compliance.report.requirement_pages import TOLERANCE_METRICS, reader_text
 from compliance.requirements.verdict import Basis, Overall, Status
-from compliance.units.formatting import fmt_margin_pct, fmt_num, unit_text
+from compliance.units.formatting import fmt_num, unit_text
 
 RESULTS_SCHEMA = "govcheck-results/1"
 SOURCES = ("paper", "assumed", "derived", "user")

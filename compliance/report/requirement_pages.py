@@ -14,7 +14,7 @@ import re
 from compliance.metrics import METRICS
 from compliance.presentation.values import limit_as_written, metric_text
 from compliance.requirements.verdict import Status
-from compliance.units.formatting import fmt_margin_pct, fmt_value, unit_text
+from compliance.units.formatting import fmt_margin_pct, fmt_value
 
 TOLERANCE_METRICS = ("max_positioning_error", "tracking_max_error", "steady_state_error")
 SPEED_METRICS = ("max_speed", "max_opening_speed", "max_closing_speed")

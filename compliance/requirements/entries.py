@@ -9,7 +9,7 @@ Messages name the file that set the offending key.
 
 from __future__ import annotations
 
-from compliance.units.amounts import parse_amount
+from compliance.units.amounts import parse_amount, parse_load
 from compliance.errors import did_you_mean
 from compliance.errors import InputError
 from compliance.metrics.catalogue import METRICS, STEP_OPTION_DEFAULTS
@@ -45,13 +45,9 @@ def build_operating_point(name: str, e: dict, origin) -> OperatingPoint:
     if e.get("initial_position") is not None:
         pos = parse_amount(e["initial_position"], "m", _where(origin, "operating_points", name, "initial_position"))
     load_text = e.get("load", "none")
-    if load_text is None or load_text.strip().lower() in ("none", "0", ""):
-        load = None
+    load = parse_load(load_text, _where(origin, "operating_points", name, "load"), named=("curve", "nominal"))
+    if load is None:
         load_text = "none"
-    elif load_text.strip().lower() in ("curve", "nominal"):
-        load = load_text.strip().lower()
-    else:
-        load = parse_amount(load_text, "N", _where(origin, "operating_points", name, "load")).value
     return OperatingPoint(name, e.get("title") or name, pos, load, load_text, e.get("flow_control"), e.get("note") or "")
 
 

@@ -16,15 +16,14 @@ frozen objects), ``compliance.units.amounts`` (``"1 %stroke"``) and ``tightening
 from __future__ import annotations
 
 import os
-from importlib import resources
 from pathlib import Path
 
 from pydantic import BaseModel
 
 from compliance.units.amounts import Amount, parse_amount
-from compliance.errors import did_you_mean
 from compliance.errors import InputError
 from compliance.model.toml_file import read_toml
+from compliance.files.shipped import resolve_shipped
 from compliance.requirements.tightening import check_tightening
 from compliance.requirements.limit_sign import check_limit_signs
 from compliance.requirements.entries import SEVERITIES, SOURCES, build_operating_point, build_procedure, build_requirement
@@ -45,39 +44,7 @@ __all__ = [
     "check_tightening",
     "load_requirements",
     "parse_amount",
-    "reference_requirement_files",
-    "resolve_requirements_path",
 ]
-
-
-def reference_requirement_files() -> list[str]:
-    """Names of the requirement files shipped with the package (``iec61362``, ...)."""
-    folder = resources.files("compliance") / "data" / "requirements"
-    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
-
-
-def resolve_requirements_path(source: str | os.PathLike, relative_to: Path | None = None, where: str = "") -> Path:
-    """Path of a requirement file given as a path or a reference name (``"iec61362"``)."""
-    s = str(source)
-    looks_like_path = s.endswith(".toml") or "/" in s or os.sep in s
-    if looks_like_path:
-        p = Path(s)
-        if relative_to is not None and not p.is_absolute():
-            p = relative_to / p
-        if not p.is_file():
-            raise InputError(f"{where or s}: requirement file '{s}' not found")
-        return p
-    ref = resources.files("compliance") / "data" / "requirements" / f"{s}.toml"
-    if not ref.is_file():
-        p = Path(s)
-        if p.is_file():
-            return p
-        names = reference_requirement_files()
-        raise InputError(
-            f"{where or s}: '{s}' is neither a file nor a reference requirement file{did_you_mean(s, names)} "
-            f"(known: {', '.join(names) or 'none'})"
-        )
-    return Path(str(ref))
 
 
 def _load_chain(path: Path, seen: tuple[str, ...]) -> list[tuple[Path, str, dict]]:
@@ -90,7 +57,7 @@ def _load_chain(path: Path, seen: tuple[str, ...]) -> list[tuple[Path, str, dict
     chain: list[tuple[Path, str, dict]] = []
     bases = model.extends if isinstance(model.extends, list) else ([model.extends] if model.extends else [])
     for base in bases:
-        bpath = resolve_requirements_path(base, path.parent, f"{path}: extends")
+        bpath = resolve_shipped(base, "requirements", relative_to=path.parent, where=f"{path}: extends")
         for item in _load_chain(bpath, seen + (key,)):
             if all(str(item[0].resolve()) != str(c[0].resolve()) for c in chain):
                 chain.append(item)
@@ -106,7 +73,7 @@ def load_requirements(source: str | os.PathLike) -> RequirementSet:
     InputError
         One message naming the file and key path of the first problem.
     """
-    path = resolve_requirements_path(source)
+    path = resolve_shipped(source, "requirements")
     chain = _load_chain(path, ())
     merged: dict[str, dict[str, dict]] = {"operating_points": {}, "procedures": {}, "requirements": {}}
     origin: dict[tuple[str, str, str], str] = {}

@@ -10,6 +10,7 @@ import numpy as np
 
 from compliance.errors import InputError
 from compliance.units import parse_quantity
+from compliance.units.amounts import parse_position
 
 
 @dataclass(frozen=True)
@@ -59,16 +60,6 @@ class Profile:
         return Profile(np.array([0.0]), np.array([float(value)]))
 
 
-def _amount(text: str, stroke: float, where: str) -> float:
-    text = text.strip()
-    if text.endswith("%"):
-        try:
-            return float(text[:-1]) / 100.0 * stroke
-        except ValueError:
-            raise InputError(f"{where}: cannot read '{text}' as a percentage of stroke") from None
-    return parse_quantity(text, "m", where)
-
-
 def steps(spec: str, x0: float, stroke: float, where: str = "--steps") -> Profile:
     """Step sequence from a spec such as ``"2%@1s,-2%@4s"`` or ``"5 mm@1 s"``.
 
@@ -85,7 +76,7 @@ def steps(spec: str, x0: float, stroke: float, where: str = "--steps") -> Profil
         t = parse_quantity(when.strip(), "s", where)
         if t < times[-1]:
             raise InputError(f"{where}: step times must not go backwards ('{item.strip()}')")
-        level += _amount(amount, stroke, where)
+        level += parse_position(amount, stroke, where, require_unit=False)
         if not 0.0 <= level <= stroke:
             raise InputError(f"{where}: step '{item.strip()}' takes the set-point to {level*1e3:.1f} mm, outside the stroke 0..{stroke*1e3:.0f} mm")
         times += [t, t]

@@ -19,13 +19,13 @@ from __future__ import annotations
 import csv
 import math
 from dataclasses import dataclass
-from importlib import resources
 from pathlib import Path as _FsPath
 
 import numpy as np
 from scipy.interpolate import CubicSpline
 
 from compliance.errors import InputError
+from compliance.files.shipped import resolve_shipped
 
 GRID_SPACING = 2e-4  # m: arc-length grid of the time parameterisation (0.2 mm)
 CORNER_ANGLE = math.radians(20.0)  # a polyline turning more than this at a point stops there
@@ -286,7 +286,7 @@ def read_path_csv(source) -> np.ndarray:
     InputError
         Missing file, bad header, a non-numeric or non-finite cell (row and column named).
     """
-    path = _resolve_path_file(source)
+    path = resolve_shipped(source, "path")
     rows = [ln for ln in path.read_text(encoding="utf-8").splitlines()]
     data = [(i + 1, ln) for i, ln in enumerate(rows) if ln.strip() and not ln.lstrip().startswith("#")]
     if not data:
@@ -320,26 +320,6 @@ def read_path_csv(source) -> np.ndarray:
     if len(pts) < 2:
         raise InputError(f"{path}: needs at least two points")
     return np.asarray(pts)
-
-
-def _resolve_path_file(source) -> _FsPath:
-    s = str(source)
-    p = _FsPath(s)
-    if p.suffix == ".csv" or "/" in s:
-        if not p.is_file():
-            raise InputError(f"{s}: path file not found")
-        return p
-    ref = resources.files("compliance") / "data" / "paths" / f"{s}.csv"
-    if not ref.is_file():
-        names = shipped_paths()
-        raise InputError(f"path '{s}' is neither a CSV file nor a shipped path (shipped: {', '.join(names) or 'none'})")
-    return _FsPath(str(ref))
-
-
-def shipped_paths() -> list[str]:
-    """Names of the example paths in ``compliance/data/paths/``."""
-    folder = resources.files("compliance") / "data" / "paths"
-    return sorted(q.name[:-4] for q in folder.iterdir() if q.name.endswith(".csv"))
 
 
 def stroke_path(source="jiang", *, scale=1.0, speed_limit=0.05, acceleration_limit=0.5, sample_time=1e-3) -> Trajectory:

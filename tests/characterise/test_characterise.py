@@ -329,7 +329,7 @@ def test_cli_bad_input_exit_2(tmp_path, capsys):
     assert main(["characterise", "valve", str(rec), "--volume", "1 kg"]) == 2
     fixture = str(DATA / "zillen" / "O-ring257_1bar_head1000.csv")
     assert main(["characterise", "friction", fixture, "--column-map", "no-such-map"]) == 2
-    assert "not a shipped map" in capsys.readouterr().err
+    assert "neither a file nor a shipped map" in capsys.readouterr().err
 
 
 def test_flowfit_predict_is_the_law():

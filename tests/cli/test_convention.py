@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from compliance.cli import _COMMANDS, build_parser, main
-from compliance.cli.check import shipped_requirements
+from compliance.files.shipped import shipped_names
 
 ROOT = Path(__file__).resolve().parents[2]
 COMMANDS = [name for name, _ in _COMMANDS]
@@ -40,7 +40,7 @@ def test_characterise_targets_have_descriptions_and_examples(capsys):
 def test_check_help_lists_the_shipped_requirement_files(capsys):
     main(["check", "--help"])
     text = " ".join(capsys.readouterr().out.split())
-    names = shipped_requirements()
+    names = shipped_names("requirements")
     assert {"iec61362", "ieee125", "iec60308", "shpp-400kw"} <= set(names)
     for n in names:
         assert n in text

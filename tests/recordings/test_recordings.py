@@ -290,7 +290,7 @@ def test_bad_map_entries():
         load_column_map({"header": False, "columns": {"time": {"column": "t"}}})
     with pytest.raises(InputError, match="not a canonical column"):
         load_column_map({"columns": {"positon": {"column": "x"}}})
-    with pytest.raises(InputError, match="not a shipped map"):
+    with pytest.raises(InputError, match="neither a file nor a shipped map"):
         load_column_map("zillen-fricton")
 
 

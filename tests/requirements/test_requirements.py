@@ -7,7 +7,8 @@ import pytest
 
 from compliance.cli import main
 from compliance.errors import InputError
-from compliance.requirements.loading import check_tightening, load_requirements, reference_requirement_files
+from compliance.files.shipped import shipped_names
+from compliance.requirements.loading import check_tightening, load_requirements
 
 ROOT = Path(__file__).resolve().parents[2]
 STROKE = 0.160
@@ -43,7 +44,7 @@ def test_shipped_files_are_identical_to_package_data():
     assert shipped == data == ["iec60308.toml", "iec61362.toml", "ieee125.toml", "shpp-400kw.toml", "tracking-robot.toml"]
     for n in shipped:
         assert filecmp.cmp(ROOT / "requirements" / n, ROOT / "compliance" / "data" / "requirements" / n, shallow=False), n
-    assert reference_requirement_files() == [n[:-5] for n in shipped]
+    assert shipped_names("requirements") == [n[:-5] for n in shipped]
 
 
 @pytest.mark.parametrize("name", ["iec60308", "iec61362", "ieee125", "shpp-400kw"])

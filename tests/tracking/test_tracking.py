@@ -21,7 +21,7 @@ from compliance.simulation.profiles import sine
 from compliance.procedures import path_tracking as tracking
 from compliance.model import axis_design as design
 from compliance.metrics.path_tracking import path_deviation, stick_slip_episodes
-from compliance.model.observers import observe
+from tests.tracking.observer_run import observe
 from compliance.tracking.paths import circle, read_path_csv, stroke_path, time_parameterise
 from compliance.simulation.state_feedback_loop import AxisReference, simulate_axis
 

@@ -31,7 +31,7 @@ import numpy as np
 
 from compliance.files.jsonable import json_number
 from compliance.diagnosis.friction_bench.fit import BENCH_EFFECTS, LAWS, PRESLIDING, PRESSURE_EFFECT, LawFit, fit_law, law_scores
-from compliance.diagnosis.friction_bench.explanation import explain_friction, format_friction  # noqa: F401 (re-exported)
+from compliance.diagnosis.friction_bench.explanation import explain_friction
 from compliance.diagnosis.friction_bench.holdout import effect_words, holdout_words, pooled_holdout, prove_out_of_sample
 from compliance.diagnosis.friction_bench.runs import Run, prepare_runs
 from compliance.diagnosis.servo.report_data import SCHEMA

@@ -33,8 +33,8 @@ from compliance.diagnosis.servo.fitted_model import fitted_plant, save_fitted
 from compliance.diagnosis.servo.effect_sets import CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_enough, contributions, full_name, prune
 from compliance.diagnosis.evidence.discriminating_test import design_test
 from compliance.diagnosis.evidence.empirical_force import empirical_term
-from compliance.diagnosis.servo.instrument_candidates import (PREFIX, instrument_candidates, instrument_verdict, instrumented,
-                                                       is_instrument)
+from compliance.diagnosis.servo.instrument_candidates import PREFIX, instrument_candidates, instrument_verdict, instrumented
+from compliance.diagnosis.verdicts.candidate_set import is_instrument
 from compliance.diagnosis.servo.lag_split import adopted_fit, split_scan
 from compliance.diagnosis.servo.friction_form import OPTION as FORM_OPTION, form_after_effects, friction_form_check
 from compliance.diagnosis.evidence.replay_fit import ReplaySetup, run_replay

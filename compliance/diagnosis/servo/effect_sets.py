@@ -33,7 +33,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from compliance.effects import EFFECTS
 from compliance.diagnosis.servo.candidates import effect_candidate
 from compliance.diagnosis.servo.fit import FitContext, FitResult, least_squares_fit, scan_points
 from compliance.diagnosis.servo.instrument_candidates import KIND as INSTRUMENT

@@ -5,7 +5,8 @@ from __future__ import annotations
 from compliance.effects import EFFECTS
 from compliance.diagnosis.servo.candidates import FRICTION_LEVEL
 from compliance.diagnosis.servo.friction_form import form_words
-from compliance.diagnosis.servo.instrument_candidates import PREFIX, finding_words, is_instrument
+from compliance.diagnosis.servo.instrument_candidates import PREFIX, finding_words
+from compliance.diagnosis.verdicts.candidate_set import is_instrument
 from compliance.units.formatting import fmt_dbic, fmt_num, fmt_si
 from compliance.diagnosis.verdicts.candidate_set import CandidateSet
 from compliance.diagnosis.verdicts.verdict import DiagnosisVerdict

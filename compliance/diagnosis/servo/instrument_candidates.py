@@ -21,7 +21,7 @@ from dataclasses import replace
 
 from compliance.model.parameters import ParamHandle
 from compliance.diagnosis.servo.candidates import Candidate
-from compliance.diagnosis.verdicts.candidate_set import INSTRUMENT_PREFIX as PREFIX, is_instrument  # noqa: F401 (public here)
+from compliance.diagnosis.verdicts.candidate_set import INSTRUMENT_PREFIX as PREFIX
 from compliance.validation.logger_model import FILTERED, PRESSURES, LoggerModel
 from compliance.diagnosis.verdicts.verdict import DiagnosisVerdict
 

@@ -39,7 +39,7 @@ from compliance.model.config import PlantConfig, plant_from_dict
 from compliance.diagnosis.servo.candidates import base_params, effect_candidate, signature_order
 from compliance.diagnosis.servo.fit import FitContext, FitResult, chi2_parts, screen_level
 from compliance.diagnosis.servo.report_data import SCHEMA
-from compliance.diagnosis.servo.selection import AMBIGUOUS_BIC, RESIDUAL_LIMIT, ambiguity_set, honest, score_all, signals_left, verdict
+from compliance.diagnosis.servo.selection import AMBIGUOUS_BIC, RESIDUAL_LIMIT, ambiguity_set, honest, score_all, verdict
 from compliance.diagnosis.verdicts.verdict import EXPLAINED, DiagnosisVerdict
 from compliance.diagnosis.servo.parallel_fits import FitEffect, RecalibrateBase
 

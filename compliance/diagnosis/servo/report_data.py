@@ -13,7 +13,8 @@ from functools import cached_property
 
 
 from compliance.effects import EFFECTS
-from compliance.diagnosis.servo.instrument_candidates import finding_words, is_instrument
+from compliance.diagnosis.servo.instrument_candidates import finding_words
+from compliance.diagnosis.verdicts.candidate_set import is_instrument
 from compliance.files.jsonable import json_number, jsonable
 from compliance.model.config import PlantConfig
 from compliance.model.parameters import BASE_BY_KEY

@@ -11,7 +11,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from compliance.model.config import PlantConfig, plant_to_toml, _suggest as _suggest_name
+from compliance.errors import did_you_mean
+from compliance.model.config import PlantConfig, plant_to_toml
 from compliance.effects import EFFECTS
 from compliance.errors import InputError
 from compliance.diagnosis.servo.fit import FitResult, chi2_parts
@@ -52,7 +53,7 @@ def check_effects(cfg: PlantConfig, effects) -> list[str]:
     names = [e for e in EFFECTS if e not in cfg.effects] if effects is None else list(effects)
     for e in names:
         if e not in EFFECTS:
-            raise InputError(f"--effects: '{e}' is not a declared effect{_suggest_name(e, EFFECTS)} (known: {', '.join(EFFECTS)})")
+            raise InputError(f"--effects: '{e}' is not a declared effect{did_you_mean(e, EFFECTS)} (known: {', '.join(EFFECTS)})")
     return names
 
 

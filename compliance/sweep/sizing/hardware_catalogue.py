@@ -11,13 +11,12 @@ pydantic + pint: one :class:`InputError` naming the file and field (exit 2).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from importlib import resources
-from pathlib import Path
 
 from pydantic import BaseModel, ConfigDict, Field
 
 from compliance.effects import EFFECTS
 from compliance.errors import InputError
+from compliance.files.shipped import resolve_shipped
 from compliance.sweep.sizing.data_file import read_validated
 from compliance.physics.valve_rating import NL_MIN, conductance_of_rating, rating_of_conductance
 from compliance.model.parameters import param_handle
@@ -189,10 +188,7 @@ def load_catalogue(source=DEFAULT_CATALOGUE) -> Catalogue:
     InputError
         Unreadable TOML, unknown field, group or parameter path, wrong unit, option that sets nothing.
     """
-    if source in (None, DEFAULT_CATALOGUE):
-        path = Path(str(resources.files("compliance") / "data" / "hardware" / "catalogue.toml"))
-    else:
-        path = Path(source)
+    path = resolve_shipped("catalogue" if source in (None, DEFAULT_CATALOGUE) else source, "hardware")
     raw = read_validated(path, _CatalogueIn, "govcheck-hardware/1", "hardware catalogue")
     opts = tuple(_option(k, v, f"{path}: options.{k}") for k, v in raw.options.items())
     return Catalogue(str(path), raw.title, opts, tuple((k, v.title, v.how) for k, v in raw.settings.items()),
