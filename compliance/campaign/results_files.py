@@ -54,27 +54,33 @@ def read_results(path) -> dict:
 
 
 def check_numbers(data: dict, where: str) -> None:
-    """Refuse text where the report computes with a number (``NUMERIC_KEYS``), naming the key path.
+    """Refuse text where the report computes with a number, naming the key path.
+
+    ``requirements``, ``runs``, ``timing`` and ``plant`` are checked on ``NUMERIC_KEYS`` (their rows hold free
+    text in other keys); the linear analysis and the validation, whose every key ``LINEAR_NUMERIC_KEYS`` names is a
+    number wherever govcheck writes it, on those as well.
 
     Raises
     ------
     InputError
         The results file is damaged or hand-edited.
     """
-    for key in _NUMERIC_SECTIONS:
-        _check_numbers(data.get(key), f"{where}: {key}")
+    for key in ("requirements", "runs", "timing", "plant"):
+        _check_numbers(data.get(key), f"{where}: {key}", NUMERIC_KEYS)
+    for key in ("linear", "validation"):
+        _check_numbers(data.get(key), f"{where}: {key}", NUMERIC_KEYS | LINEAR_NUMERIC_KEYS)
 
 
-# the sections whose numbers the report computes with (requirement_set, versions and the like are text as written)
-_NUMERIC_SECTIONS = ("requirements", "runs", "timing", "linear", "plant", "summary", "validation")
-# keys whose values the report computes with: a number, null, or a list of them (text lives in "display" tables);
-# every key that holds numbers, and only numbers, in a results file govcheck writes (check, --linear, validation)
+# keys whose values the report computes with: a number, null, or a list of them (text lives in "display" tables)
 NUMERIC_KEYS = frozenset({
     "value", "margin", "margin_pct", "wall", "wall_time", "time", "position", "reference", "valve_command",
     "pressure_a", "pressure_b", "supply_pressure", "force", "phase_margin_deg", "gain_margin_db", "time_constant",
     "dead_time", "overshoot", "settling_time", "rise_time", "bandwidth_hz", "natural_frequency_hz", "damping_ratio",
     "gain_crossover_hz", "phase_crossover_hz", "max_error", "rms_error", "steady_error", "peak_speed",
-    # the linear analysis, its map, cross-check and governor parameters
+})
+# the linear analysis (its map, cross-check and governor parameters) and the validation replay: every key that
+# holds numbers, and only numbers, in the results govcheck writes
+LINEAR_NUMERIC_KEYS = frozenset({
     "GMAX", "GMIN", "Tg", "Tg_linear", "Tg_nonlinear_samples", "Tg_steps", "UC", "UO", "VELM", "UO_peak", "UC_peak",
     "closed_loop", "closed_loop_discrete", "closed_loop_magnitude_db", "closed_loop_phase_deg", "closed_loop_zeros",
     "dead_time_linear", "dead_time_viscous", "dominant_time_constant", "first_order_time_constant", "frequency_hz",
@@ -84,42 +90,34 @@ NUMERIC_KEYS = frozenset({
     "ratio", "ratio_viscous", "ratio_viscous_no_dead_zone", "state_scales", "stroke_time", "t25", "t75", "t_step",
     "tau_linear", "tau_linear_mean", "tau_nonlinear", "tau_nonlinear_viscous", "time_constant_continuous",
     "unobservable_or_uncontrollable_states", "viscous_damping_ratio_analytic", "x_final", "x_start", "step",
-    "peak_time", "mean_speed_to_63", "time_to_end", "t25_75", "position_fraction", "rest_velocity",
-    # rows, samples, runs and the validation replay
-    "a_choked", "a_subsonic", "b_choked", "b_subsonic", "after_reversal", "at_rest", "command_at_limit",
-    "holding_under_load", "moving", "valve_saturated", "valve_dead_band", "static_friction", "region_closed",
-    "region_high", "region_low", "region_mid", "opening", "closing", "factor", "fit_percent", "i_end", "i_start",
-    "initial_pressures", "load_force", "limit", "max", "max_abs_error", "mean_absolute_error", "mean_error",
-    "mean_residual", "nrmse", "peak_abs", "peak_ratio", "rms_residual", "run_wall_sum", "sample_time",
-    "sample_time_median", "simulated", "recorded", "speed", "start", "end", "velocity_noise", "workers", "points",
-    "kp", "ki", "kd", "critical_pressure_ratio", "controller.kp", "controller.ki", "controller.kd",
-    "controller.sample_time", "air.supply_pressure", "duration", "size", "initial_position",
-    # summary counts
-    "pass", "fail", "not_evaluated", "disabled", "runs", "samples",
+    "fit_percent", "i_end", "i_start", "initial_pressures", "load_force", "max_abs_error", "mean_absolute_error",
+    "mean_error", "mean_residual", "nrmse", "peak_abs", "peak_ratio", "rms_residual", "sample_time",
+    "sample_time_median", "start", "end", "duration", "velocity_noise", "kp", "ki", "kd",
 })
 # keys numeric in one table only (a "window" of the validation is a name; the linear map's is its stroke window)
 _NUMERIC_IN = {"map": frozenset({"window"})}
 # keys that hold a number or one of these words
 _NUMBER_OR_WORD = {"load": ("curve", "none", "nominal"), "loads": ("curve", "none", "nominal")}
 _TEXT_TABLES = frozenset({"display", "procedure", "operating_point", "settings", "procedures", "operating_points", "units",
-                          "notes", "open"})
+                          "notes", "detail", "conventions", "family", "andes", "psse_dyr", "left_out", "sentences",
+                          "ieee_pes_tr_2013"})
 
 
-def _check_numbers(tree, where: str, table: str = "") -> None:
+def _check_numbers(tree, where: str, keys: frozenset, table: str = "") -> None:
     """A damaged results file (text where the report needs a number) is named, not rendered into a crash."""
     if isinstance(tree, dict):
         for k, v in tree.items():
             if k in _TEXT_TABLES:
                 continue
             words = _NUMBER_OR_WORD.get(k)
-            numeric = k in NUMERIC_KEYS or k in _NUMERIC_IN.get(table, ())
+            numeric = k in keys or k in _NUMERIC_IN.get(table, ())
             if (numeric and not _numbers(v)) or (words and not _numbers(v, words)):
                 raise InputError(f"{where}.{k}: {str(v)[:60]!r} where a number (or null) belongs; the results file is "
                                  "damaged or hand-edited: regenerate it with govcheck check --json")
-            _check_numbers(v, f"{where}.{k}", k)
+            _check_numbers(v, f"{where}.{k}", keys, k)
     elif isinstance(tree, list):
         for i, v in enumerate(tree):
-            _check_numbers(v, f"{where}[{i}]", table)
+            _check_numbers(v, f"{where}[{i}]", keys, table)
 
 
 def _numbers(v, words: tuple = ()) -> bool:

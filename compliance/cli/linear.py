@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from compliance.cli.common import add_outputs, add_parser, add_plant_argument, add_quiet, add_reproducible, check_args_outputs
+from compliance.errors import InputError
 
 _PLOT_SUFFIXES = (".png", ".svg", ".pdf")
 
