@@ -230,3 +230,26 @@ case("older-transducer-unplugged", "validate plant.toml flat.csv", "is its trans
 case("older-map-skips-every-line", "validate plant.toml m.txt --column-map skip.toml --mode plant_only",
      "skip_rows = 500 skips every line", {"m.txt": "t_ms,x_mm,u_V,pA_bar\n" + "".join(f"{i},80,0.01,4.9\n" for i in range(200)),
                                           "skip.toml": "skip_rows = 500\n" + W.COLUMN_MAP})
+
+
+def damaged(path_keys, value="lots"):
+    """The shipped results fixture with text at ``path_keys`` (a hand edit of a number)."""
+    def write(ws):
+        import json
+
+        data = json.loads((W.REPO / "tests" / "data" / "results_fixture.json").read_text(encoding="utf-8"))
+        node = data
+        for k in path_keys[:-1]:
+            node = node[k]
+        node[path_keys[-1]] = value
+        (ws / "bad.json").write_text(json.dumps(data), encoding="utf-8")
+    return write
+
+
+for cid, keys in [
+    ("older-report-text-in-the-linear-map", ("linear", "map", "window", 0)),
+    ("older-report-text-in-the-governor-tg", ("linear", "governor", "parameters", "Tg")),
+    ("older-report-text-in-a-crosscheck", ("linear", "crosscheck", 0, "tau_linear")),
+    ("older-report-text-in-a-pole", ("linear", "analysis", "poles", "closed_loop", 0, 0)),
+]:
+    case(cid, "report bad.json --report out/r.html", "where a number (or null) belongs", {"bad.json": damaged(keys)})
