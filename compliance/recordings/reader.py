@@ -34,8 +34,7 @@ from compliance.recordings.columns import RecordingSource, build_frame, canonica
 from compliance.recordings.comtrade import partner_file, read_comtrade
 from compliance.recordings.delimited import TEXT_SUFFIXES, read_text_table
 from compliance.recordings.mat import read_mat
-from compliance.recordings.declarations import check_declarations
-from compliance.recordings.instruments import instrument_facts, logger_from_comments
+from compliance.recordings.instruments import check_declarations, instrument_facts, logger_from_comments
 from compliance.recordings.metadata import read_sidecar, si_metadata, sidecar_path
 from compliance.recordings.parquet import read_parquet
 from compliance.recordings.plausibility import check_ranges, check_time_base, relative_time

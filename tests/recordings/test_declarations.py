@@ -1,4 +1,4 @@
-"""A sidecar's instrument declarations are held to the data they describe (compliance/recordings/declarations.py).
+"""A sidecar's instrument declarations are held to the data they describe (compliance/recordings/instruments.py).
 
 Each check has its boundary tested both ways: what a logger and transducer can truly do passes (a rate
 within its tolerance, a range the data stay inside, a gauge range on absolute pressures, a delay of
@@ -12,7 +12,7 @@ import pandas as pd
 import pytest
 
 from compliance.errors import InputError
-from compliance.recordings.declarations import (RANGE_MARGIN, RATE_TOLERANCE, check_channel_delays,
+from compliance.recordings.instruments import (RANGE_MARGIN, RATE_TOLERANCE, check_channel_delays,
                                                 check_channel_ranges, check_declarations, check_logger_rate)
 
 
