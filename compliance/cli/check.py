@@ -36,8 +36,9 @@ def register(subparsers):
     p.add_argument("--requirements", "-r", required=True, metavar="REQ",
                    help="requirement file: a TOML file or a shipped name (" + ", ".join(names) + ")")
     add_outputs(p, "json", "junit", "report", "pdf")
-    p.add_argument("--appendix", choices=("none", "summary", "full"), default="summary",
-                   help="report appendix: none, summary (configuration, requirement file, versions; default) or full (+ every run)")
+    p.add_argument("--appendix", choices=("none", "summary", "full"), default=None,
+                   help="with --report/--pdf: report appendix: none, summary (configuration, requirement file, versions; "
+                        "default) or full (+ every run)")
     p.add_argument("--linear", action="store_true",
                    help="add the linear analysis to the results and report: every operating point, the stroke x load map, "
                         "the linear/nonlinear cross-check and the HYGOV parameters (adds ~20-40 s)")
@@ -128,6 +129,12 @@ def run(args) -> int:
     from compliance.requirements.verdict import Overall
 
     check_uncertainty_option(args)
+    if args.appendix is not None and not (args.report or args.pdf):
+        from compliance.errors import InputError
+
+        raise InputError(f"--appendix {args.appendix}: shapes the report, and no report is asked for; add --report "
+                         "FILE.html or --pdf FILE.pdf")
+    args.appendix = args.appendix or "summary"
     from compliance.cli.sweep import check_remedies_options
 
     check_args_outputs(args, (getattr(args, "save_remedy", None), "--save-remedy", (".toml",)))

@@ -85,6 +85,9 @@ def run(args) -> int:
     first, meta = read_recording(args.recordings[0], args.column_map, required=("time",))
     if _is_friction(first):
         return _run_friction(args, first, meta)
+    if args.friction_bore is not None:
+        raise InputError(f"--friction-bore {args.friction_bore}: the bore of a friction-bench run, and "
+                         f"{args.recordings[0]} is a servo recording (it has a valve command); drop --friction-bore")
     if len(args.recordings) > 1:
         return _run_joint(args, plant_arg, effects)
     frame, meta = read_recording(args.recordings[0], args.column_map)
@@ -176,6 +179,11 @@ def _run_friction(args, first, meta) -> int:
         raise InputError("--save-model: a friction-bench diagnosis fits a friction law, not a plant configuration; use --json")
     if args.scheduler:
         raise InputError("--scheduler: friction-bench runs are fitted on the local process pool (seconds per seal); use --jobs")
+    for flag, value in (("--effects", args.effects), ("--no-recalibration", args.no_recalibration or None),
+                        ("--suggest-test", args.suggest_test or None)):
+        if value is not None:
+            raise InputError(f"{flag}: shapes the diagnosis of a servo recording, and {args.recordings[0]} is a "
+                             "friction-bench run (force, no valve command), fitted with the friction laws; drop it")
     runs = [(first, meta)]
     for path in args.recordings[1:]:
         f, m = read_recording(path, args.column_map, required=("time",))

@@ -109,8 +109,11 @@ def run(args) -> int:
     if args.max_margin_loss is not None and not args.max_margin_loss >= 0:
         raise InputError(f"--max-margin-loss {args.max_margin_loss}: expected a number of percentage points >= 0")
     check_args_outputs(args, (args.markdown, "--markdown", (".md", ".markdown")))
-    if args.allow_conflicts and _is_results(args.baseline) and _is_results(candidate):
-        raise InputError("--allow-conflicts: both sides are results files, so no requirement set is judged here; drop it")
+    if _is_results(args.baseline) and _is_results(candidate):  # nothing is run: the options of a run do nothing
+        for flag, value in (("--allow-conflicts", args.allow_conflicts or None), ("--requirements", args.requirements),
+                            ("--jobs", args.jobs)):
+            if value is not None:
+                raise InputError(f"{flag}: both sides are results files, so nothing is run or judged here; drop {flag}")
     base = read_results(args.baseline) if _is_results(args.baseline) else None
     cand = read_results(candidate) if _is_results(candidate) else None
     sources = {"baseline": args.baseline, "candidate": candidate}

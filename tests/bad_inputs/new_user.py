@@ -253,3 +253,13 @@ for cid, keys in [
     ("older-report-text-in-a-pole", ("linear", "analysis", "poles", "closed_loop", 0, 0)),
 ]:
     case(cid, "report bad.json --report out/r.html", "where a number (or null) belongs", {"bad.json": damaged(keys)})
+
+# options that shape something the run does not do
+case("older-sim-seed-without-noise", "simulate plant.toml -o out/n.csv --seed 3", "--seed 3: seeds the sensor noise")
+case("older-check-appendix-without-report", "check plant.toml -r req.toml --appendix full --json out/r.json -q",
+     "--appendix full: shapes the report")
+case("older-gate-requirements-between-results", "gate out/a.json --baseline out/b.json -r req.toml",
+     "--requirements: both sides are results files", {"out/a.json": '{"schema": "x"}', "out/b.json": '{"schema": "x"}'})
+case("older-bench-cases-with-practice", "diagnose-benchmark --practice out --cases 5", "--cases: shapes the generated cases")
+case("older-diag-friction-bore-on-a-servo-run", "diagnose plant.toml rec.csv --friction-bore 25mm",
+     "--friction-bore 25mm: the bore of a friction-bench run")
