@@ -18,7 +18,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "compliance"
 # bottom first: a package may import from itself and from packages before it in this list
 LAYERS = ["errors", "processes", "units", "files", "physics", "effects", "model", "simulation", "metrics", "linear",
           "tracking", "procedures", "requirements", "presentation", "campaign", "sweep", "recordings", "validation",
-          "characterise", "diagnosis", "report", "papers", "cli", "__main__"]
+          "characterise", "diagnosis", "acceptance", "report", "papers", "cli", "__main__"]
 
 
 def _modules() -> dict[str, Path]:

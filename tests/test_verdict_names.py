@@ -26,8 +26,8 @@ OWNERS = {PACKAGE / "requirements" / "verdict.py", PACKAGE / "diagnosis" / "verd
           PACKAGE / "sweep" / "remedies" / "outcome.py"}
 # words that are also plain words or other vocabularies: "open" (a limit nobody set, as text),
 # "disabled", "assumed" (also a parameter source: paper / assumed / derived / user), "uncertain"
-# (also a sweep file's table of uncertain parameters)
-SHARED_WORDS = {"open", "disabled", "assumed", "uncertain"}
+# (also a sweep file's table of uncertain parameters), "measured" (also a plot's label of the recorded trace)
+SHARED_WORDS = {"open", "disabled", "assumed", "uncertain", "measured"}
 VERDICT_WORDS = {m.value for enum in (Status, Overall, Basis, Severity, RemedyStatus, DiagnosisVerdict) for m in enum} - SHARED_WORDS
 KEY_METHODS = {"get", "pop", "setdefault"}
 ENUMS = {"Status", "Overall", "Basis", "Severity", "RemedyStatus", "DiagnosisVerdict"}

@@ -34,6 +34,8 @@ def not_evaluated_reason(entry: dict | None) -> str | None:
     if not entry or entry.get("status") != Status.NOT_EVALUATED:
         return None
     reasons = sorted({r["reason"] for r in entry.get("rows") or [] if r.get("reason")})
+    if not reasons and entry.get("reason"):
+        reasons = [entry["reason"]]
     return "; ".join(reasons) if reasons else "no reason recorded"
 
 
@@ -56,6 +58,16 @@ def _status_reasons(rid: str, b: dict | None, c: dict | None, why: str | None, a
     return [], None
 
 
+def _subject(results: dict) -> dict:
+    """What a results file judged: a plant configuration, or a site's recordings (``govcheck accept``)."""
+    if "site" in results:
+        site = results["site"]
+        return {"plant": f"site {site['name']}", "digest": site.get("digest"), "path": site.get("path"),
+                "verdict": results["summary"]["status"]}
+    return {"plant": results["plant"]["name"], "digest": results["plant"].get("digest"),
+            "path": results["plant"].get("path"), "verdict": results["summary"]["status"]}
+
+
 def compare(baseline: dict, candidate: dict, max_margin_loss: float | None = None,
             allow_not_evaluated: tuple[str, ...] | list[str] = ()) -> dict:
     """Compare two results dicts.
@@ -63,7 +75,8 @@ def compare(baseline: dict, candidate: dict, max_margin_loss: float | None = Non
     Parameters
     ----------
     baseline, candidate : dict
-        Results of ``govcheck check`` (schema govcheck-results/1).
+        Results of ``govcheck check`` (schema govcheck-results/1) or of ``govcheck accept`` (govcheck-site/1: a
+        re-commissioning gated against the last one).
     max_margin_loss : float, optional
         Largest allowed loss of worst-case margin [percentage points]; None: not checked.
     allow_not_evaluated : sequence of str
@@ -116,14 +129,13 @@ def compare(baseline: dict, candidate: dict, max_margin_loss: float | None = Non
         })
     return {
         "schema": "govcheck-gate/1",
+        "subject": "site" if "site" in candidate else "plant",
         "status": Overall.FAIL if tripped else Overall.PASS,
         "tripped": tripped,
         "max_margin_loss": max_margin_loss,
         "allow_not_evaluated": sorted(allowed),
-        "baseline": {"plant": baseline["plant"]["name"], "digest": baseline["plant"].get("digest"),
-                     "path": baseline["plant"].get("path"), "verdict": baseline["summary"]["status"]},
-        "candidate": {"plant": candidate["plant"]["name"], "digest": candidate["plant"].get("digest"),
-                      "path": candidate["plant"].get("path"), "verdict": candidate["summary"]["status"]},
+        "baseline": _subject(baseline),
+        "candidate": _subject(candidate),
         "requirements": {"name": cset.get("name"), "path": cset.get("path"), "digest": cset.get("digest")},
         "rows": rows,
         "notes": notes,

@@ -19,6 +19,7 @@ from compliance.presentation.values import limit_as_written
 from compliance.units.formatting import STATUS_WORD as _STATUS_WORD  # the one status-word table
 
 RESULTS_SCHEMA = "govcheck-results/1"
+SITE_SCHEMA = "govcheck-site/1"  # a site's measured verdicts (govcheck accept, compliance.acceptance): same requirements[]
 
 
 def results_json(results: dict) -> str:
@@ -33,7 +34,7 @@ def write_json(results: dict, path) -> None:
 
 
 def read_results(path) -> dict:
-    """Read a results JSON written by ``govcheck check``.
+    """Read a results JSON written by ``govcheck check`` (or a site's, by ``govcheck accept``).
 
     Raises
     ------
@@ -43,9 +44,9 @@ def read_results(path) -> dict:
     p = Path(path)
     data = read_json(p, "results")
     if "schema" not in data:
-        raise InputError(f"{p}: schema: missing; expected a govcheck results file ('{RESULTS_SCHEMA}')")
-    if data["schema"] != RESULTS_SCHEMA:
-        raise InputError(f"{p}: schema: '{data['schema']}' is not supported (expected '{RESULTS_SCHEMA}')")
+        raise InputError(f"{p}: schema: missing; expected a govcheck results file ('{RESULTS_SCHEMA}' or '{SITE_SCHEMA}')")
+    if data["schema"] not in (RESULTS_SCHEMA, SITE_SCHEMA):
+        raise InputError(f"{p}: schema: '{data['schema']}' is not supported (expected '{RESULTS_SCHEMA}' or '{SITE_SCHEMA}')")
     for key in ("requirements", "summary", "plant", "requirement_set"):
         if key not in data:
             raise InputError(f"{p}: {key}: missing from the results file")
@@ -65,7 +66,7 @@ def check_numbers(data: dict, where: str) -> None:
     InputError
         The results file is damaged or hand-edited.
     """
-    for key in ("requirements", "runs", "timing", "plant"):
+    for key in ("requirements", "runs", "timing", "plant", "site"):
         _check_numbers(data.get(key), f"{where}: {key}", NUMERIC_KEYS)
     for key in ("linear", "validation"):
         _check_numbers(data.get(key), f"{where}: {key}", NUMERIC_KEYS | LINEAR_NUMERIC_KEYS)

@@ -44,12 +44,15 @@ __all__ = [
     "plan",
     "plant_section",
     "run_campaign",
+    "summary_section",
+    "versions_section",
 ]
 
 RESULTS_SCHEMA = "govcheck-results/1"
 
 # --------------------------------------------------------------------------- results
-def _versions() -> dict:
+def versions_section() -> dict:
+    """Versions of govcheck, Python and the numerical packages (a results file's ``versions``)."""
     out = {"govcheck": __version__, "python": platform.python_version()}
     for mod in ("numpy", "scipy", "pandas", "numba", "control", "pint", "pydantic"):
         try:
@@ -193,7 +196,7 @@ def run_campaign(cfg, reqset: RequirementSet, *, workers: int | None = None, pro
         "schema": RESULTS_SCHEMA,
         "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         "command_line": command_line,
-        "versions": _versions(),
+        "versions": versions_section(),
         "plant": plant_section(cfg),
         "requirement_set": reqset.as_dict(),
         "summary": summary_section(entries, notes, bands),

@@ -20,6 +20,7 @@ _COMMANDS = (
     ("simulate", "simulate"),
     ("reproduce", "reproduce"),
     ("check", "check"),
+    ("accept", "accept"),
     ("gate", "gate"),
     ("sweep", "sweep"),
     ("size", "size"),
@@ -74,6 +75,7 @@ def _silence_stdout() -> None:
 
 _EXAMPLES = """examples:
   govcheck check models/plant-a.toml -r requirements/shpp-400kw.toml --json r.json --report r.html
+  govcheck accept site-folder -r shpp-400kw --json s.json --report s.html   (a site's commissioning recordings)
   govcheck simulate plant-a --steps '2%@1s,-2%@4s' -o run.csv --plot run.png
   govcheck validate run.csv --report v.html        (the sidecar run.toml names the plant)
   govcheck diagnose rec.csv.gz --json d.json --save-model fitted.toml

@@ -11,7 +11,7 @@ import re
 from compliance.model.toml_file import read_toml
 from pathlib import Path
 
-from compliance.recordings.sidecar_schema import check_sidecar
+from compliance.recordings.sidecar_schema import check_sidecar, check_test_table
 from compliance.recordings.instruments import instrument_facts
 from compliance.units import parse_quantity, registry
 
@@ -48,14 +48,17 @@ def read_sidecar(path) -> dict:
     Raises
     ------
     InputError
-        The sidecar is not valid TOML, holds a pressure without ``abs`` / ``gauge``, or a
-        ``[logger]`` / ``[channels.NAME]`` table that ``instruments.instrument_facts`` rejects.
+        The sidecar is not valid TOML, holds a pressure without ``abs`` / ``gauge``, a
+        ``[logger]`` / ``[channels.NAME]`` table that ``instruments.instrument_facts`` rejects, or a
+        ``[test]`` table that ``sidecar_schema.check_test_table`` rejects.
     """
     side = sidecar_path(path)
     if not side.is_file():
         return {}
     data, _ = read_toml(side, "recording sidecar")
     check_sidecar(data, str(side))
+    if "test" in data:
+        check_test_table(data["test"], str(side))
     return si_metadata(instrument_facts(data, str(side)), str(side))
 
 

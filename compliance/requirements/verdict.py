@@ -46,6 +46,7 @@ class Basis(StrEnum):
     MODELLED = "modelled"  # the model predicts it from the plant's parameters
     BY_CONSTRUCTION = "by_construction"  # a parameter was derived to give this figure: not evidence
     ASSUMED = "assumed"  # it rests on an assumed input (e.g. the load curve) more than on the servo
+    MEASURED = "measured"  # taken from a recording of the machine (compliance.acceptance)
     NOT_EVALUATED = "not_evaluated"  # no value
 
 

@@ -21,7 +21,8 @@ from compliance.model.pid_controller import first_order_filter_gain, limiter_sam
 from compliance.effects.sensor_lag import P_SL_ON, P_SL_TD
 from compliance.effects.valve_dynamics import P_VD_ON, P_VD_TD, S_SP
 from compliance.model.vector_slots import P_FILT, P_KD, P_KI, P_KP, P_RL_ON, P_TSAMP, P_UCEN, P_ULIM, S_V, S_X
-from compliance.simulation.rk4 import N_OUT, OUTPUT_COLUMNS, measured_position, non_physical, record_sample, rk4_step, rk4_workspace
+from compliance.simulation.rk4 import O_PA, O_PB, O_PS, measured_position, non_physical, output_buffer, output_frame, record_sample
+from compliance.simulation.rk4 import rk4_step, rk4_workspace
 from compliance.simulation.rk4 import sensor_lag_advance, sensor_lag_coefficients, sensor_lag_start, zoh_average
 from compliance.simulation.scenario import Scenario, sample_profile
 
@@ -47,7 +48,7 @@ def simulate_core(P, y0, ref, cmd, closed_loop, pos_noise, pos_quantum, lx, ly, 
     n_samples, n_sub : int
         Number of controller periods and RK4 steps per period.
     out : ndarray
-        (n_samples + 1, N_OUT) output array, filled in place.
+        (n_samples + 1, N_OUT) output array (``rk4.output_buffer``), filled in place.
 
     Returns
     -------
@@ -120,7 +121,7 @@ def simulate_pid(cfg: PlantConfig, scenario: Scenario) -> pd.DataFrame:
     ref = sample_profile(scenario.reference, t, scenario.initial_position)
     cmd = sample_profile(scenario.command, t, P[P_UCEN])
     noise = scenario.noise
-    rng = np.random.default_rng(scenario.seed)
+    rng = np.random.default_rng(scenario.seed) if noise else None  # drawn from only with noise
     pos_noise = rng.normal(0.0, noise.position_std, t.size) if noise and noise.position_std > 0 else np.zeros(t.size)
     if scenario.position_noise is not None:
         given = np.asarray(scenario.position_noise, dtype=float)
@@ -128,20 +129,20 @@ def simulate_pid(cfg: PlantConfig, scenario: Scenario) -> pd.DataFrame:
         pos_noise[: min(t.size, given.size)] = given[: t.size]
     y0 = initial_state(cfg, P, scenario.initial_position, scenario.initial_pressures)
     lx, ly = load_curve_arrays(cfg)
-    out = np.zeros((n_samples + 1, N_OUT))
+    out = output_buffer(n_samples + 1)
     status = simulate_core(P, y0, ref, cmd, closed, pos_noise, noise.position_quantum if noise else 0.0, lx, ly, n_samples, n_sub, out)
     if status >= 0:
         raise SimulationError(
             f"the simulation of '{cfg.name}' became non-physical at t = {status*ts:.3f} s "
             f"(non-finite or non-positive pressure); check the parameters or reduce simulation.step"
         )
-    df = pd.DataFrame(out, columns=list(OUTPUT_COLUMNS))
     if noise and (noise.pressure_std > 0 or noise.pressure_quantum > 0):
-        for col in ("pressure_a", "pressure_b", "supply_pressure"):
-            vals = df[col].to_numpy() + rng.normal(0.0, noise.pressure_std, t.size)
+        for col in (O_PA, O_PB, O_PS):
+            vals = out[:, col] + rng.normal(0.0, noise.pressure_std, t.size)
             if noise.pressure_quantum > 0:
                 vals = noise.pressure_quantum * np.round(vals / noise.pressure_quantum)
-            df[col] = vals
+            out[:, col] = vals
+    df = output_frame(out)
     df.attrs["plant"] = cfg.name
     df.attrs["closed_loop"] = closed
     return df

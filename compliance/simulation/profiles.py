@@ -7,6 +7,7 @@ import re
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from compliance.errors import InputError
 from compliance.units import parse_quantity
@@ -43,21 +44,43 @@ class Profile:
     def at(self, t) -> np.ndarray:
         """Sample the profile at times ``t``; a step at t_s takes its new value from t_s on."""
         t = np.asarray(t, dtype=float)
-        # side='right' makes a double sample (a step) switch exactly at its instant
-        idx = np.searchsorted(self.times, t, side="right") - 1
-        idx = np.clip(idx, 0, self.times.size - 1)
-        nxt = np.clip(idx + 1, 0, self.times.size - 1)
-        t0 = self.times[idx]
-        t1 = self.times[nxt]
-        span = np.where(t1 > t0, t1 - t0, 1.0)
-        w = np.where(t1 > t0, np.clip((t - t0) / span, 0.0, 1.0), 0.0)
-        out = self.values[idx] + w * (self.values[nxt] - self.values[idx])
-        return np.where(t < self.times[0], self.values[0], out)
+        out = np.empty(t.shape)
+        piecewise_linear(self.times, self.values, t.ravel(), out.reshape(-1))
+        return out
 
     @staticmethod
     def constant(value: float) -> "Profile":
         """A constant profile."""
         return Profile(np.array([0.0]), np.array([float(value)]))
+
+
+@njit(cache=True, error_model="numpy")
+def piecewise_linear(times, values, t, out):
+    """Fill ``out[j]`` with the piecewise-linear signal (``times``, ``values``) at ``t[j]`` [s].
+
+    Held at the end values outside the samples; at a double sample (a step) the later value holds
+    from its instant on (the last sample at or before t starts the segment). ``t`` may come in any
+    order; a non-decreasing ``t`` (a sample grid) walks the segments once.
+    """
+    m = times.shape[0]
+    i = -1  # the last sample at or before t (-1: none), as numpy.searchsorted(times, t, "right") - 1
+    for j in range(t.shape[0]):
+        tj = t[j]
+        if tj != tj:
+            i = m - 1  # NaN sorts after every sample
+        else:
+            while i + 1 < m and times[i + 1] <= tj:
+                i += 1
+            while i >= 0 and times[i] > tj:
+                i -= 1
+        a = max(i, 0)
+        b = min(a + 1, m - 1)
+        t0 = times[a]
+        t1 = times[b]
+        w = 0.0
+        if t1 > t0:
+            w = min(max((tj - t0) / (t1 - t0), 0.0), 1.0)
+        out[j] = values[0] if tj < times[0] else values[a] + w * (values[b] - values[a])
 
 
 def steps(spec: str, x0: float, stroke: float, where: str = "--steps") -> Profile:

@@ -24,7 +24,8 @@ from compliance.model.vector_slots import N_STATES, P_UCEN, P_ULIM, S_PA, S_PB, 
 from compliance.model.assembly import plant_rhs, valve_lag_input
 from compliance.model.plant_vector import load_curve_arrays, parameter_vector
 from compliance.model.rest_state import initial_state
-from compliance.simulation.rk4 import OUTPUT_COLUMNS, measured_position, non_physical, record_sample, rk4_step, rk4_workspace
+from compliance.simulation.rk4 import OUTPUT_COLUMNS, measured_position, non_physical, output_buffer, output_frame, record_sample
+from compliance.simulation.rk4 import rk4_step, rk4_workspace
 from compliance.simulation.scenario import Scenario, SensorNoise, sample_profile
 from compliance.model.state_feedback import (
     C_AO_IN, C_AO_LV, C_AO_LX, C_AO_POLE, C_AO_SV, C_AO_SX, C_AREA_RATIO, C_FO_IN, C_FO_L, C_FO_POLE, C_FO_SV, C_KD, C_KI,
@@ -139,7 +140,7 @@ def tracking_core(P, C, y0, ref, dref, ddref, pos_noise, pos_quantum, pa_noise, 
     n_samples, n_sub : int
         Controller periods and RK4 steps per period.
     out : ndarray
-        (n_samples + 1, N_COL) output, filled in place.
+        (n_samples + 1, N_COL) output (``rk4.output_buffer``), filled in place.
 
     Returns
     -------
@@ -281,13 +282,13 @@ def simulate_axis(cfg: PlantConfig, reference: AxisReference, *, mode: str | Non
     pb_noise = rng.normal(0.0, pressure_noise, n) if pressure_noise > 0 else np.zeros(n)
     y0 = initial_state(cfg, P, x0)
     lx, ly = load_curve_arrays(cfg)
-    out = np.zeros((n, N_COL))
+    out = output_buffer(n, N_COL)
     status = tracking_core(P, design.vector, y0, r.position, r.velocity, r.acceleration, pos_noise, float(position_quantum),
                            pa_noise, pb_noise, lx, ly, n_samples, n_sub, out)
     if status >= 0:
         raise SimulationError(f"the tracking simulation of '{cfg.name}' became non-physical at t = {status*ts:.3f} s; "
                               f"check the controller settings or reduce simulation.step")
-    df = pd.DataFrame(out, columns=list(COLUMNS))
+    df = output_frame(out, COLUMNS)
     df.attrs["plant"] = cfg.name
     df.attrs["closed_loop"] = True
     df.attrs["controller"] = design.as_dict()

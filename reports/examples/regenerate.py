@@ -36,6 +36,8 @@ COMMANDS = {
                  "--report", str(OUT / "diagnosis-zillen-friction.html"), "--pdf", str(OUT / "diagnosis-zillen-friction.pdf"),
                  "--quiet"],
     "sweep": ["sweep", "models/sweeps/plant-a-remedies.toml", "--out", str(OUT / "plant-a-remedies")],
+    "site": ["accept", "tests/data/acceptance/site-p2", "--requirements", "requirements/shpp-400kw.toml", "--diagnose",
+             "--report", str(OUT / "site-acceptance-p2.html"), "--pdf", str(OUT / "site-acceptance-p2.pdf"), "--quiet"],
 }
 EXIT_OK = (0, 1)  # a compliance check that fails its requirements still wrote its report
 

@@ -43,7 +43,7 @@ from compliance.model.vector_slots import P_KI, P_KP, P_STROKE, S_V
 from compliance.model.plant_vector import load_curve_arrays, parameter_vector
 from compliance.model.rest_state import initial_state, set_rest_internal_states
 from compliance.diagnosis.evidence.operating_point import load_at_start
-from compliance.simulation.rk4 import N_OUT, OUTPUT_COLUMNS
+from compliance.simulation.rk4 import N_OUT, OUTPUT_COLUMNS, output_buffer
 from compliance.simulation.pid_loop import simulate_core
 from compliance.validation.recorded_noise import position_noise_estimate, sensor_noise_std
 from compliance.validation.logger_model import logger_model
@@ -355,7 +355,7 @@ def run_replay(cfg: PlantConfig, setup: ReplaySetup, *, noise: np.ndarray | None
     n_sub = int(round(ts / cfg.p("simulation.step")))
     lx, ly = load_curve_arrays(cfg)
     n = setup.n_samples
-    out = np.zeros((n + 1, N_OUT))
+    out = np.zeros((N_OUT, n + 1)).T  # by column, as the loop writes it: each signal contiguous
     nz = setup.noise if noise is None else noise
     bounds = list(setup.resets) + [n]
     kp, ki = P[P_KP], P[P_KI]
@@ -374,9 +374,10 @@ def run_replay(cfg: PlantConfig, setup: ReplaySetup, *, noise: np.ndarray | None
             ref = setup.reference[k0:k1 + 1]
             if setup.closed_loop and kp > 0.0 and ki != 0.0:
                 ref = ref + ki * setup.states["integral"][k0] / kp  # carries the integral state (see module doc)
-        seg = np.zeros((k1 - k0 + 1, N_OUT))
-        status = simulate_core(P, y0, np.ascontiguousarray(ref), np.ascontiguousarray(setup.command[k0:k1 + 1]),
-                               setup.closed_loop, np.ascontiguousarray(nz[k0:k1 + 1]), 0.0, lx, ly, k1 - k0, n_sub, seg)
+        seg = output_buffer(k1 - k0 + 1)  # the layout the loop is compiled for
+        # writable copies: a read-only input (pandas' to_numpy) would compile the loop once more for it
+        status = simulate_core(P, y0, np.array(ref), np.array(setup.command[k0:k1 + 1]),
+                               setup.closed_loop, np.array(nz[k0:k1 + 1]), 0.0, lx, ly, k1 - k0, n_sub, seg)
         if status >= 0:
             raise SimulationError(f"replay of {setup.source} became non-physical at t = {(k0 + status)*ts:.3f} s")
         out[k0:k1 + 1] = seg
