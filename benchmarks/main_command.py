@@ -1,4 +1,4 @@
-"""Time the README's main command in one process, phase by phase: campaign, linear analysis, report.
+"""Time the README's main command in one process, phase by phase: campaign (with the bands), linear analysis, report.
 
     python benchmarks/main_command.py [--repeat 3] [--appendix summary]
 
@@ -30,23 +30,20 @@ def _cpu() -> float:
 
 
 def once(appendix: str, out: Path) -> dict:
-    from compliance.campaign.run import run_campaign
-    from compliance.linear.operating_points import linear_for_campaign
-    from compliance.model.config import load_plant
+    """One check as the command runs it: ``compliance.check`` (its stages timed by ``on_stage``), then the report."""
+    from compliance.pipeline.chain import Check
     from compliance.report.render import render_report
-    from compliance.requirements.loading import load_requirements
 
     phases = {}
     t0, c0 = time.perf_counter(), _cpu()
-    cfg = load_plant(ROOT / "models" / "plant-a.toml")
-    rs = load_requirements(ROOT / "requirements" / "shpp-400kw.toml")
-    for name, job in (("campaign", lambda: run_campaign(cfg, rs, progress=False, uncertainty="local")),):
-        t, c = time.perf_counter(), _cpu()
-        res = job()
-        phases[name] = (time.perf_counter() - t, _cpu() - c)
-    t, c = time.perf_counter(), _cpu()
-    res["linear"] = linear_for_campaign(cfg, rs)
-    phases["linear"] = (time.perf_counter() - t, _cpu() - c)
+    prepared = Check.of(ROOT / "models" / "plant-a.toml", ROOT / "requirements" / "shpp-400kw.toml", linear=True)
+    mark = [time.perf_counter(), _cpu()]
+
+    def on_stage(name):
+        phases[name] = (time.perf_counter() - mark[0], _cpu() - mark[1])
+        mark[:] = [time.perf_counter(), _cpu()]
+
+    res = prepared.run(on_stage=on_stage)
     t, c = time.perf_counter(), _cpu()
     render_report(res, out / "r.html", out / "r.pdf", appendix=appendix)
     phases["report"] = (time.perf_counter() - t, _cpu() - c)

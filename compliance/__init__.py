@@ -4,7 +4,7 @@ import hashlib as _hashlib
 import os as _os
 from pathlib import Path as _Path
 
-__version__ = "0.1.0"
+from compliance.version import __version__
 
 
 _COMPILED_STAGES = ("physics", "effects", "model", "simulation")  # the compiled core and the slot layout it freezes
@@ -45,4 +45,18 @@ if "NUMBA_CACHE_DIR" not in _os.environ:
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     _os.environ.setdefault(_var, "1")
 
-__all__ = ["__version__"]
+__all__ = ["CheckResult", "__version__", "check"]
+
+
+def __getattr__(name: str):
+    """``compliance.check`` and ``compliance.CheckResult``, imported on first use (``import compliance`` stays light:
+    every worker process imports the package)."""
+    if name == "check":
+        from compliance.pipeline.chain import check
+
+        return check
+    if name == "CheckResult":
+        from compliance.results.check_result import CheckResult
+
+        return CheckResult
+    raise AttributeError(f"module 'compliance' has no attribute {name!r}")

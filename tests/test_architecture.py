@@ -11,14 +11,16 @@ a lazy import inside a function counts like any other.
 from __future__ import annotations
 
 import ast
+import re
 from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parents[1] / "compliance"
 
 # bottom first: a package may import from itself and from packages before it in this list
-LAYERS = ["errors", "processes", "units", "files", "physics", "effects", "model", "simulation", "metrics", "linear",
-          "tracking", "procedures", "requirements", "presentation", "campaign", "sweep", "recordings", "validation",
-          "characterise", "diagnosis", "acceptance", "report", "papers", "cli", "__main__"]
+LAYERS = ["version", "errors", "processes", "units", "files", "physics", "effects", "model", "simulation", "plants",
+          "metrics", "linear", "tracking", "procedures", "requirements", "presentation", "results", "campaign", "sweep",
+          "recordings", "validation", "characterise", "diagnosis", "acceptance", "report", "papers", "pipeline", "cli",
+          "__main__"]
 
 
 def _modules() -> dict[str, Path]:
@@ -270,3 +272,104 @@ def test_one_process_pool_implementation():
             elif isinstance(node, ast.Attribute) and node.attr in _POOL_NAMES:
                 found.append(f"{name}: uses .{node.attr}")
     assert not found, "process pools outside compliance/processes (use compliance.processes.map_tasks):\n" + "\n".join(found)
+
+
+# an effect's slot constants (P_<SHORT>_..., S_<slot>) are read outside effects/ only by the one composition module
+# (plant_rhs composes the structural effects' kernels) and two simulator modules (the sampled loop holds sensor_lag's
+# filter and the delay lines, the recorder writes the effects' states); everything else goes through the declarations
+SLOT_READERS = {"compliance.model.assembly", "compliance.simulation.rk4", "compliance.simulation.pid_loop"}
+_SLOT_NAME = re.compile(r"^[PS]_[A-Z0-9_]+$")
+
+
+def _effect_slot_reads(tree: ast.Module, effect_modules: set[str]) -> list[str]:
+    """Slot constants of an effect module that ``tree`` imports or reads through a module alias."""
+    found, aliases = [], set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            if node.module in effect_modules:
+                found += [f"{node.module}.{a.name}" for a in node.names if _SLOT_NAME.match(a.name)]
+            aliases |= {a.asname or a.name for a in node.names if f"{node.module}.{a.name}" in effect_modules}
+        elif isinstance(node, ast.Import):
+            aliases |= {a.asname for a in node.names if a.name in effect_modules and a.asname}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Attribute) and _SLOT_NAME.match(node.attr):
+            base = ast.unparse(node.value)
+            if base in aliases or base in effect_modules:
+                found.append(f"{base}.{node.attr}")
+    return found
+
+
+def _effect_module_names() -> set[str]:
+    return {m for m in _modules() if m.startswith("compliance.effects.")}
+
+
+def test_effect_slots_are_read_by_at_most_three_modules_outside_effects():
+    effect_modules = _effect_module_names()
+    readers = {}
+    for name, path in _modules().items():
+        if _layer(name) == "effects":
+            continue
+        reads = _effect_slot_reads(ast.parse(path.read_text()), effect_modules)
+        if reads:
+            readers[name] = reads
+    assert len(SLOT_READERS) <= 3
+    stray = {m: r for m, r in readers.items() if m not in SLOT_READERS}
+    assert not stray, ("effect slot constants read outside effects/ (use the declarations and the hooks of "
+                       "compliance.effects.structure instead):\n" + "\n".join(f"{m}: {', '.join(r)}" for m, r in stray.items()))
+
+
+def test_the_slot_rule_sees_imports_and_module_aliases():
+    src = ("from compliance.effects.heat_transfer import S_TA, wall_heat_flow\n"
+           "from compliance.effects import supply_droop\nimport compliance.effects.sensor_lag as sl\n"
+           "a = supply_droop.P_SD_ON + sl.P_SL_TAU + supply_droop.reservoir_pressure_rate\n")
+    found = _effect_slot_reads(ast.parse(src), _effect_module_names())
+    assert sorted(found) == ["compliance.effects.heat_transfer.S_TA", "sl.P_SL_TAU", "supply_droop.P_SD_ON"]
+
+
+# a plant kind is a room (compliance/plants, docs/internals.md "Adding a plant kind"): nothing outside it reads
+# controller.type, and the package switches on a kind's name in at most MAX_KIND_SWITCHES places
+KIND_NAMES = {"pid", "state_feedback"}
+MAX_KIND_SWITCHES = 6
+
+
+def _constants(node: ast.AST) -> set:
+    if isinstance(node, ast.Constant):
+        return {node.value}
+    if isinstance(node, (ast.Tuple, ast.List, ast.Set)):
+        return {e.value for e in node.elts if isinstance(e, ast.Constant)}
+    return set()
+
+
+def _kind_switches(tree: ast.Module) -> list[tuple[int, str]]:
+    """(line, what) of every plant-kind switch: a read of ``controller.type``, a comparison with a kind's name,
+    a table keyed by the kinds' names, an effect flag for one plant."""
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Subscript) and "controller.type" in _constants(node.slice):
+            found.append((node.lineno, "reads controller.type"))
+        elif (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr == "get"
+              and node.args and "controller.type" in _constants(node.args[0])):
+            found.append((node.lineno, "reads controller.type"))
+        elif isinstance(node, ast.Compare) and KIND_NAMES & set().union(*map(_constants, [node.left, *node.comparators])):
+            found.append((node.lineno, "compares with a kind's name"))
+        elif isinstance(node, ast.Dict) and KIND_NAMES <= {k.value for k in node.keys if isinstance(k, ast.Constant)}:
+            found.append((node.lineno, "a table keyed by the kinds"))
+        elif (isinstance(node, ast.Attribute) and node.attr == "plant_b") or (isinstance(node, ast.keyword) and node.arg == "plant_b"):
+            found.append((node.lineno, "an effect flag for one plant"))
+    return found
+
+
+def test_plant_kinds_are_switched_in_their_room_only():
+    switches = {name: _kind_switches(ast.parse(path.read_text())) for name, path in _modules().items()}
+    outside = [f"{name}:{line}: {what}" for name, found in switches.items() if not name.startswith("compliance.plants")
+               for line, what in found if what == "reads controller.type"]
+    assert not outside, "controller.type read outside compliance/plants (ask plants.kind_of(cfg)):\n" + "\n".join(outside)
+    total = [f"{name}:{line}: {what}" for name, found in switches.items() for line, what in found]
+    assert len(total) <= MAX_KIND_SWITCHES, "plant-kind switches (give the kind a method instead):\n" + "\n".join(total)
+
+
+def test_the_kind_rule_sees_reads_comparisons_and_tables():
+    src = ('a = cfg.options["controller.type"]\nb = o.get("controller.type", "pid")\nif m == "pid": pass\n'
+           'if m in ("state_feedback",): pass\nT = {"pid": 1, "state_feedback": 2}\nS = {"pid": True}\n'
+           'E = Effect(plant_b=False)\nname = "pid"\n')
+    assert sorted(line for line, _ in _kind_switches(ast.parse(src))) == [1, 2, 3, 4, 5, 7]

@@ -28,7 +28,7 @@ from compliance.effects import EFFECTS
 from compliance.model.parameters import apply
 from compliance.presentation.values import metric_text
 from compliance.requirements.verdict import Status
-from compliance.units.formatting import fmt_si
+from compliance.presentation.numbers import fmt_si
 
 __all__ = ["MAX_RECORDINGS", "diagnose_site", "disagreements"]
 

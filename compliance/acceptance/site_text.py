@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from compliance.presentation.values import limit_as_written, metric_text
 from compliance.requirements.verdict import Status
-from compliance.units.formatting import STATUS_WORD
+from compliance.presentation.numbers import STATUS_WORD
 
 __all__ = ["site_table", "site_lines"]
 

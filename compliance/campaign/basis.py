@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from compliance.model.parameters import used_by_model
 from compliance.requirements.verdict import Basis, Overall, Severity, Status
+from compliance.results.summary import Qualifier
 
 __all__ = ["limit_assumed", "requirement_basis", "row_basis", "verdict_qualifier"]
 
@@ -132,10 +133,10 @@ def verdict_qualifier(results: dict) -> str | None:
     words = []
     if any(e.get("limit_assumed") and e.get("status") == Status.PASS and e.get("severity") == Severity.MANDATORY
            for e in results.get("requirements") or []):
-        words.append("against assumed targets")
+        words.append(Qualifier.ASSUMED_TARGETS)
     plant = results.get("plant") or {}
     options = plant.get("options") or {}
     used = [p for p in plant.get("parameters") or [] if isinstance(p, dict) and used_by_model(str(p.get("key")), options)]
     if used and sum(1 for p in used if (p.get("source") or "assumed") == "assumed") > len(used) / 2:
-        words.append("on a mostly assumed model")
+        words.append(Qualifier.ASSUMED_MODEL)
     return ", ".join(words) or None

@@ -10,6 +10,7 @@ is eligible (each sample's own reason). docs/results-schema.md, ``coverage``.
 from __future__ import annotations
 
 from compliance.procedures.outcomes import request_key
+from compliance.results.keys import RequestKey
 from compliance.requirements.verdict import Status
 
 __all__ = ["CASES_BASIS", "case_coverage", "case_coverage_text", "unjudged"]
@@ -56,7 +57,7 @@ def _judged_pairs(entries) -> set[tuple[str, str]]:
 
 def _why_not(reqset, run_id: str, key: str, samples, error) -> str:
     """Why no requirement judged metric request ``key`` of run ``run_id``."""
-    metric = key.split("[")[0]
+    metric = RequestKey.parse(key).metric
     proc, op = run_id.split("@", 1)
     on_metric = [r for r in reqset.requirements if r.metric == metric]
     if not on_metric:

@@ -17,14 +17,10 @@ __all__ = ["execute", "warm_up"]
 
 # --------------------------------------------------------------------------- campaigns
 def warm_up(cfg):
-    """Compile (or load from the numba cache) the simulator core once, before workers fork."""
-    from compliance.simulation import Scenario, simulate
+    """Compile (or load from the numba cache) the plant kind's loops once, before workers fork."""
+    from compliance.plants import kind_of
 
-    simulate(cfg, Scenario(0.01, 0.5 * cfg.p("cylinder.stroke")))
-    if cfg.options["controller.type"] != "pid":
-        from compliance.simulation.state_feedback_loop import warm_up as warm_up_state_feedback
-
-        warm_up_state_feedback(cfg)
+    kind_of(cfg).warm_up(cfg)
 
 
 def _campaign_run(context, job: Job):

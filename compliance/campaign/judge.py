@@ -133,13 +133,17 @@ def _extended_rows(req, limit, by_key: dict, key: str) -> list[dict]:
     return rows
 
 
-def judge(cfg, reqset: RequirementSet, jobs: list[Job], outcomes) -> tuple[list[dict], list[str]]:
-    """Verdict entries per requirement (docs/results-schema.md, ``requirements_results``)."""
+def judge(cfg, reqset: RequirementSet, jobs: list[Job], outcomes, loosened: dict | None = None) -> tuple[list[dict], list[str]]:
+    """Verdict entries per requirement (docs/results-schema.md, ``requirements_results``).
+
+    ``loosened``: requirement id -> loosening notes of the vetted set (``requirements.vetting.vet``);
+    without it (a sweep judging candidates) each requirement's history is checked here.
+    """
     stroke = cfg.p("cylinder.stroke")
     by_key = {j.key: o for j, o in zip(jobs, outcomes)}
     entries, notes = [], []
     for req in reqset.requirements:
-        loosen = check_tightening(req, stroke)
+        loosen = list(loosened[req.id]) if loosened is not None else check_tightening(req, stroke)
         notes.extend(loosen)
         limit = req.resolved_limit(stroke) if req.limit is not None else None
         rows = _rows(cfg, reqset, req, limit, by_key) if req.enabled else []

@@ -18,36 +18,36 @@ A requirement already failing in the baseline is reported, not counted as a regr
 
 from __future__ import annotations
 
-from compliance.campaign.results_files import _STATUS_WORD
 from compliance.requirements.verdict import Overall, Severity, Status
+from compliance.results.check_result import CheckResult
+from compliance.results.entries import RequirementVerdict
+from compliance.presentation.numbers import STATUS_WORD as _STATUS_WORD
 
 
-def _worst(entry: dict | None):
-    if entry is None:
+def _worst(entry: RequirementVerdict | None):
+    """(margin %, value, value as displayed) of a requirement's worst case."""
+    w = entry.worst if entry is not None else None
+    if w is None:
         return None, None, "-"
-    w = entry.get("worst") or {}
-    return w.get("margin_pct"), w.get("value"), (w.get("display") or {}).get("value", "-")
+    return w.margin_pct, w.value, w.display.value if w.display is not None else "-"
 
 
-def not_evaluated_reason(entry: dict | None) -> str | None:
+def not_evaluated_reason(entry: RequirementVerdict | None) -> str | None:
     """Why a requirement could not be evaluated (the distinct reasons of its rows), or None."""
-    if not entry or entry.get("status") != Status.NOT_EVALUATED:
+    if entry is None or entry.status != Status.NOT_EVALUATED:
         return None
-    reasons = sorted({r["reason"] for r in entry.get("rows") or [] if r.get("reason")})
-    if not reasons and entry.get("reason"):
-        reasons = [entry["reason"]]
-    return "; ".join(reasons) if reasons else "no reason recorded"
+    return "; ".join(entry.not_evaluated_reasons() or ([entry.reason] if entry.reason else [])) or "no reason recorded"
 
 
-def _status_reasons(rid: str, b: dict | None, c: dict | None, why: str | None, allowed: bool):
+def _status_reasons(rid: str, b, c, why: str | None, allowed: bool):
     """Why a status change trips the gate (list), and the note of an explicitly allowed one (or None)."""
-    bs = b["status"] if b else "absent"
-    cs = c["status"] if c else "absent"
+    bs = b.status if b else "absent"
+    cs = c.status if c else "absent"
     if b is not None and c is None:
         return ["requirement removed in the candidate"], None
     if b is None and cs == Status.FAIL:
         return ["new requirement fails"], None
-    if cs == Status.NOT_EVALUATED and (bs == Status.PASS or (bs == Status.FAIL and c["severity"] == Severity.MANDATORY)):
+    if cs == Status.NOT_EVALUATED and (bs == Status.PASS or (bs == Status.FAIL and c.severity == Severity.MANDATORY)):
         if allowed:
             return [], f"{bs} -> not_evaluated allowed explicitly (--allow-not-evaluated {rid}): {why}"
         return [f"{bs} -> not_evaluated: could not be evaluated: {why}"], None
@@ -58,25 +58,25 @@ def _status_reasons(rid: str, b: dict | None, c: dict | None, why: str | None, a
     return [], None
 
 
-def _subject(results: dict) -> dict:
-    """What a results file judged: a plant configuration, or a site's recordings (``govcheck accept``)."""
-    if "site" in results:
-        site = results["site"]
+def _subject(result) -> dict:
+    """What a result judged: a plant configuration, or a site's recordings (``govcheck accept``)."""
+    site = getattr(result, "site", None)
+    if site is not None:
         return {"plant": f"site {site['name']}", "digest": site.get("digest"), "path": site.get("path"),
-                "verdict": results["summary"]["status"]}
-    return {"plant": results["plant"]["name"], "digest": results["plant"].get("digest"),
-            "path": results["plant"].get("path"), "verdict": results["summary"]["status"]}
+                "verdict": result.summary.status}
+    p = result.plant
+    return {"plant": p.name, "digest": p.digest, "path": p.path, "verdict": result.summary.status}
 
 
-def compare(baseline: dict, candidate: dict, max_margin_loss: float | None = None,
+def compare(baseline, candidate, max_margin_loss: float | None = None,
             allow_not_evaluated: tuple[str, ...] | list[str] = ()) -> dict:
-    """Compare two results dicts.
+    """Compare two check results.
 
     Parameters
     ----------
-    baseline, candidate : dict
-        Results of ``govcheck check`` (schema govcheck-results/1) or of ``govcheck accept`` (govcheck-site/1: a
-        re-commissioning gated against the last one).
+    baseline, candidate : CheckResult or SiteResult
+        Results of ``govcheck check`` (``compliance.check``, or a results file read with ``read_results``) or of
+        ``govcheck accept`` (schema govcheck-site/1: a re-commissioning gated against the last one).
     max_margin_loss : float, optional
         Largest allowed loss of worst-case margin [percentage points]; None: not checked.
     allow_not_evaluated : sequence of str
@@ -85,25 +85,22 @@ def compare(baseline: dict, candidate: dict, max_margin_loss: float | None = Non
     Returns
     -------
     dict
-        ``{"status": "pass"|"fail", "tripped": [...ids], "rows": [...], "notes": [...], ...}``
+        ``{"status": "pass"|"fail", "tripped": [...ids], "rows": [...], "notes": [...], ...}`` (schema ``govcheck-gate/1``)
     """
-    base = {e["id"]: e for e in baseline["requirements"]}
-    cand = {e["id"]: e for e in candidate["requirements"]}
+    base, cand = baseline.verdicts, candidate.verdicts
     rows, tripped, notes = [], [], []
     allowed = set(allow_not_evaluated)
     unknown = sorted(allowed - set(base) - set(cand))
     if unknown:
         notes.append(f"--allow-not-evaluated names requirements not in either result: {', '.join(unknown)}")
-    bset, cset = baseline["requirement_set"], candidate["requirement_set"]
-    if bset.get("digest") != cset.get("digest"):
-        notes.append(f"requirement files differ: baseline {bset.get('name')} ({str(bset.get('digest'))[:12]}), "
-                     f"candidate {cset.get('name')} ({str(cset.get('digest'))[:12]})")
+    bset, cset = baseline.requirement_set, candidate.requirement_set
+    if bset.digest != cset.digest:
+        notes.append(f"requirement files differ: baseline {bset.name} ({str(bset.digest)[:12]}), "
+                     f"candidate {cset.name} ({str(cset.digest)[:12]})")
     for rid in list(base) + [k for k in cand if k not in base]:
         b, c = base.get(rid), cand.get(rid)
         bm, bv, bd = _worst(b)
         cm, cv, cd = _worst(c)
-        bs = b["status"] if b else "absent"
-        cs = c["status"] if c else "absent"
         delta = None if bm is None or cm is None else cm - bm
         why = not_evaluated_reason(c)
         reasons, allowed_note = _status_reasons(rid, b, c, why, rid in allowed)
@@ -112,31 +109,24 @@ def compare(baseline: dict, candidate: dict, max_margin_loss: float | None = Non
         if reasons:
             tripped.append(rid)
         ref = c or b
+        bs, cs = (b.status if b else "absent"), (c.status if c else "absent")
         rows.append({
-            "id": rid,
-            "title": ref["title"],
-            "metric": ref["metric"],
-            "limit_text": ref["limit_text"],
-            "severity": ref["severity"],
+            "id": rid, "title": ref.title, "metric": ref.metric, "limit_text": ref.limit_text, "severity": ref.severity,
             "baseline": {"status": bs, "value": bv, "display": bd, "margin_pct": bm},
             "candidate": {"status": cs, "value": cv, "display": cd, "margin_pct": cm},
-            "margin_change_pp": delta,
-            "tripped": bool(reasons),
-            "reasons": reasons,
-            "not_evaluated_reason": why,
-            "allowed": allowed_note,
-            "preexisting_failure": bs == Status.FAIL and cs == Status.FAIL,
+            "margin_change_pp": delta, "tripped": bool(reasons), "reasons": reasons, "not_evaluated_reason": why,
+            "allowed": allowed_note, "preexisting_failure": bs == Status.FAIL and cs == Status.FAIL,
         })
     return {
         "schema": "govcheck-gate/1",
-        "subject": "site" if "site" in candidate else "plant",
+        "subject": "site" if getattr(candidate, "site", None) is not None else "plant",
         "status": Overall.FAIL if tripped else Overall.PASS,
         "tripped": tripped,
         "max_margin_loss": max_margin_loss,
         "allow_not_evaluated": sorted(allowed),
         "baseline": _subject(baseline),
         "candidate": _subject(candidate),
-        "requirements": {"name": cset.get("name"), "path": cset.get("path"), "digest": cset.get("digest")},
+        "requirements": {"name": cset.name, "path": cset.path, "digest": cset.digest},
         "rows": rows,
         "notes": notes,
     }

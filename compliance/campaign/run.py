@@ -1,13 +1,12 @@
 """A compliance campaign: plant x requirement set -> results dict (sequencing only, no physics).
 
-``run_campaign`` plans the runs (every procedure x operating point some enabled requirement
-names, each run once whatever number of requirements use it), runs them on the available
-cores, measures the metrics, judges each requirement x procedure x operating point, and
-returns the results dict documented in docs/results-schema.md.
-
-The steps live beside this module: ``campaign_plan`` (the runs), ``campaign_pool`` (process
-pool and progress bar), ``campaign_verdicts`` (rows and statuses) and ``linear_requirements``
-(``source = "linear"``); this module assembles the results.
+The campaign's steps, each public so ``compliance.check`` composes them: the requirement set is
+vetted once (``requirements.vetting.vet``: loosening and conflicts), :func:`execute_runs` plans
+every procedure x operating point some enabled requirement names (each run once, whatever number
+of requirements use it) and runs them on the one executor, ``campaign.judge`` judges each
+requirement x procedure x operating point, ``campaign.uncertainty`` bands the verdicts, and
+:func:`assemble` makes the results dict documented in docs/results-schema.md.
+:func:`run_campaign` runs them in that order for a caller that wants the dict (sweeps, the gate).
 """
 
 from __future__ import annotations
@@ -16,39 +15,45 @@ import datetime as _dt
 import importlib
 import platform
 import time
+from dataclasses import dataclass
 
 from compliance.model.force_limit import check_load_force
 from compliance.simulation.scenario import scenario_load
 from compliance.files.display import display_path
 from compliance.model.identity import identity_dict
-from compliance import __version__
+from compliance.version import __version__
 from compliance.campaign.plan import Job, plan
 from compliance.campaign.executor import execute
 from compliance.processes import available_cores
 from compliance.campaign.judge import judge, sample_dict
 from compliance.errors import InputError
-from compliance.requirements.consistency import consistency_findings
-from compliance.requirements.tightening import check_tightening
 from compliance.requirements.requirement_set import RequirementSet
+from compliance.requirements.vetting import Vetting, vet
+from compliance.results.keys import RequestKey
 from compliance.campaign.basis import verdict_qualifier
 from compliance.campaign.coverage import case_coverage, unjudged
 from compliance.campaign.uncertainty import local_bands, ranged_parameters
+from compliance.results.check_result import RESULTS_SCHEMA
 from compliance.requirements.verdict import Basis, Severity, Status, overall_status
 
 __all__ = [
     "RESULTS_SCHEMA",
+    "CampaignRuns",
     "Job",
+    "assemble",
     "available_cores",
+    "check_loads",
     "execute",
+    "execute_runs",
     "judge",
     "plan",
     "plant_section",
     "run_campaign",
+    "run_records",
     "summary_section",
     "versions_section",
 ]
 
-RESULTS_SCHEMA = "govcheck-results/1"
 
 # --------------------------------------------------------------------------- results
 def versions_section() -> dict:
@@ -132,9 +137,95 @@ def plant_section(cfg) -> dict:
     }
 
 
+@dataclass(frozen=True)
+class CampaignRuns:
+    """The campaign's runs (planned jobs in order) and what each produced."""
+
+    jobs: tuple
+    outcomes: tuple
+    workers: int  # workers actually used
+    started: float  # time.perf_counter() when the campaign began (for the results' timing)
+
+    @property
+    def by_key(self) -> dict:
+        """``procedure@operating_point`` -> outcome."""
+        return {j.key: o for j, o in zip(self.jobs, self.outcomes)}
+
+
+def check_loads(cfg, reqset: RequirementSet) -> None:
+    """A load no cylinder of this plant can hold is a typo, not a test (``InputError`` naming the point)."""
+    for op in reqset.operating_points.values():
+        check_load_force(cfg, scenario_load(cfg, op), f"{reqset.path}: operating_points.{op.name}.load = {op.load_text!r}")
+
+
+def execute_runs(cfg, reqset: RequirementSet, *, workers: int | None = None, progress: bool = True,
+                 scheduler: str | None = None) -> CampaignRuns:
+    """Plan the runs a requirement set needs and execute them (the campaign step).
+
+    Raises
+    ------
+    InputError
+        A load beyond the plant's cylinders, or a procedure that cannot run on this plant
+        (e.g. steps leaving the stroke).
+    """
+    t0 = time.perf_counter()
+    check_loads(cfg, reqset)
+    jobs = plan(reqset)
+    outcomes, used = execute(cfg, reqset, jobs, workers=workers, progress=progress, scheduler=scheduler)
+    for j, o in zip(jobs, outcomes):
+        if o.error and o.error_kind == "InputError":
+            raise InputError(f"{reqset.path}: run {j.key}: {o.error}")
+    return CampaignRuns(tuple(jobs), tuple(outcomes), used, t0)
+
+
+def run_records(runs: CampaignRuns, reqset: RequirementSet) -> list[dict]:
+    """The results' ``runs``: every run's values (by request key), traces, marks and notes."""
+    out = []
+    for j, o in zip(runs.jobs, runs.outcomes):
+        proc = reqset.procedures[j.procedure]
+        out.append({
+            "id": j.key,
+            "procedure": j.procedure,
+            "operating_point": j.operating_point,
+            "kind": proc.kind,
+            "title": proc.title,
+            "error": o.error,
+            "notes": o.notes,
+            "metrics": {k: [sample_dict(s, RequestKey.parse(k).metric) for s in v] for k, v in o.samples.items()},
+            "traces": o.traces,
+            "marks": o.marks,
+            "wall_time": o.wall_time,
+        })
+    return out
+
+
+def assemble(cfg, reqset: RequirementSet, runs: CampaignRuns, entries: list[dict], notes: list[str], vetting: Vetting,
+             bands: dict | None, command_line: str | None = None) -> dict:
+    """The results dict of a judged campaign (schema ``govcheck-results/1``, docs/results-schema.md)."""
+    results = {
+        "schema": RESULTS_SCHEMA,
+        "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+        "command_line": command_line,
+        "versions": versions_section(),
+        "plant": plant_section(cfg),
+        "requirement_set": reqset.as_dict(),
+        "summary": summary_section(entries, notes, bands),
+        "coverage": {"unjudged": unjudged(reqset, runs.jobs, runs.outcomes, entries)},
+        "findings": list(vetting.findings),
+        "uncertainty": bands,
+        "requirements": entries,
+        "runs": run_records(runs, reqset),
+        "timing": {"wall": time.perf_counter() - runs.started, "runs": len(runs.jobs), "workers": runs.workers,
+                   "run_wall_sum": sum(o.wall_time for o in runs.outcomes)},
+    }
+    results["summary"]["qualifier"] = verdict_qualifier(results)
+    return results
+
+
 def run_campaign(cfg, reqset: RequirementSet, *, workers: int | None = None, progress: bool = True,
-                 command_line: str | None = None, uncertainty: str | None = None) -> dict:
-    """Check a plant against a requirement set.
+                 command_line: str | None = None, uncertainty: str | None = None, allow_conflicts: bool = False,
+                 scheduler: str | None = None) -> dict:
+    """Check a plant against a requirement set: vet, run, judge, band (``compliance.check`` adds the rest).
 
     Parameters
     ----------
@@ -149,6 +240,10 @@ def run_campaign(cfg, reqset: RequirementSet, *, workers: int | None = None, pro
     uncertainty : {"local", None}
         Bands on the verdicts from the plant file's declared ranges by local sensitivities
         (``compliance.campaign.uncertainty``); None (default): point values only.
+    allow_conflicts : bool
+        Judge a set whose mandatory limits conflict (else ``InputError`` before any simulation).
+    scheduler : str, optional
+        Run on Dask (``local:N`` or ``tcp://host:port``) instead of the local process pool.
 
     Returns
     -------
@@ -158,55 +253,13 @@ def run_campaign(cfg, reqset: RequirementSet, *, workers: int | None = None, pro
     Raises
     ------
     InputError
-        A requirement file loosens an inherited limit without ``allow_loosen``, or a
-        procedure cannot run on this plant (e.g. steps leaving the stroke).
+        A requirement file loosens an inherited limit without ``allow_loosen``, two mandatory limits
+        conflict, or a procedure cannot run on this plant (e.g. steps leaving the stroke).
     """
-    t0 = time.perf_counter()
-    stroke = cfg.p("cylinder.stroke")
-    for req in reqset.requirements:  # fail fast on loosening, before any simulation
-        check_tightening(req, stroke)
-    for op in reqset.operating_points.values():  # a load no cylinder of this plant can hold is a typo, not a test
-        check_load_force(cfg, scenario_load(cfg, op), f"{reqset.path}: operating_points.{op.name}.load = {op.load_text!r}")
-    jobs = plan(reqset)
-    outcomes, used = execute(cfg, reqset, jobs, workers=workers, progress=progress)
-    for j, o in zip(jobs, outcomes):
-        if o.error and o.error_kind == "InputError":
-            raise InputError(f"{reqset.path}: run {j.key}: {o.error}")
-    entries, notes = judge(cfg, reqset, jobs, outcomes)
+    vetting = vet(reqset, cfg.p("cylinder.stroke"), allow_conflicts)  # fail fast, before any simulation
+    runs = execute_runs(cfg, reqset, workers=workers, progress=progress, scheduler=scheduler)
+    entries, notes = judge(cfg, reqset, list(runs.jobs), list(runs.outcomes), vetting.loosened)
     bands = None
     if uncertainty == "local" and ranged_parameters(cfg):
-        bands = local_bands(cfg, reqset, jobs, entries, workers=workers, progress=progress)
-    runs = []
-    for j, o in zip(jobs, outcomes):
-        proc = reqset.procedures[j.procedure]
-        runs.append({
-            "id": j.key,
-            "procedure": j.procedure,
-            "operating_point": j.operating_point,
-            "kind": proc.kind,
-            "title": proc.title,
-            "error": o.error,
-            "notes": o.notes,
-            "metrics": {k: [sample_dict(s, k.split("[")[0]) for s in v] for k, v in o.samples.items()},
-            "traces": o.traces,
-            "marks": o.marks,
-            "wall_time": o.wall_time,
-        })
-    results = {
-        "schema": RESULTS_SCHEMA,
-        "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
-        "command_line": command_line,
-        "versions": versions_section(),
-        "plant": plant_section(cfg),
-        "requirement_set": reqset.as_dict(),
-        "summary": summary_section(entries, notes, bands),
-        "coverage": {"unjudged": unjudged(reqset, jobs, outcomes, entries)},
-        "findings": consistency_findings(reqset, stroke),
-        "uncertainty": bands,
-        "requirements": entries,
-        "runs": runs,
-        "timing": {"wall": time.perf_counter() - t0, "runs": len(jobs), "workers": used,
-                   "run_wall_sum": sum(o.wall_time for o in outcomes)},
-    }
-    results["summary"]["qualifier"] = verdict_qualifier(results)
-    return results
+        bands = local_bands(cfg, reqset, list(runs.jobs), entries, workers=workers, progress=progress)
+    return assemble(cfg, reqset, runs, entries, notes, vetting, bands, command_line)

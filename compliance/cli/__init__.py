@@ -35,7 +35,7 @@ _COMMANDS = (
 
 def build_parser() -> argparse.ArgumentParser:
     """Build the argument parser with every available sub-command."""
-    from compliance import __version__
+    from compliance.version import __version__
     from compliance.cli.common import GovcheckParser
 
     parser = GovcheckParser(

@@ -5,9 +5,9 @@ from __future__ import annotations
 import shlex
 import sys
 
-from compliance.cli.common import (add_allow_conflicts, add_document_options, add_jobs, add_outputs, add_parser, add_plant_argument, add_quiet,
-                                   add_reproducible, document_options,
-                                   check_args_outputs, plant_source)
+from compliance.cli.common import (add_allow_conflicts, add_document_options, add_jobs, add_outputs, add_parser,
+                                   add_plant_argument, add_quiet, add_reproducible, check_args_outputs, document_options,
+                                   plant_source)
 
 
 def register(subparsers):
@@ -59,15 +59,6 @@ def register(subparsers):
     return p
 
 
-def renderer(args):
-    """The report renderer when --report/--pdf is asked for (imported lazily)."""
-    if not (args.report or args.pdf):
-        return None
-    from compliance.report.render import render_report
-
-    return render_report
-
-
 def command_line(args, name: str = "check", outputs: bool = True) -> str:
     """The command as given (reconstructed from the parsed arguments); without output paths if not ``outputs``."""
     parts = ["govcheck", name, plant_source(args), "--requirements", args.requirements]
@@ -83,116 +74,84 @@ def command_line(args, name: str = "check", outputs: bool = True) -> str:
     return shlex.join(parts)
 
 
-def finish_results(results: dict, args, name: str = "check") -> dict:
-    """Results as written: reproducible (fixed ``created``, no timings) with --reproducible / SOURCE_DATE_EPOCH."""
-    from compliance.files.reproducible import is_reproducible, make_reproducible
-
-    if not is_reproducible(getattr(args, "reproducible", False)):
-        return results
-    return make_reproducible(results, command_line(args, name, outputs=False))
-
-
-def monte_carlo(cfg, reqset, results: dict, args) -> None:
-    """Replace the verdicts' bands by a Monte Carlo of ``args.uncertainty`` plants and re-summarise."""
-    from compliance.campaign.basis import verdict_qualifier
-    from compliance.campaign.run import summary_section
-    from compliance.sweep.tolerance.uncertainty_mc import monte_carlo_bands
-
-    results["uncertainty"] = monte_carlo_bands(cfg, reqset, results, args.uncertainty, workers=args.jobs,
-                                               progress=not args.quiet)
-    results["summary"] = summary_section(results["requirements"], results["summary"]["notes"], results["uncertainty"])
-    results["summary"]["qualifier"] = verdict_qualifier(results)
-
-
-def check_uncertainty_option(args, cfg=None) -> None:
-    """``--uncertainty N``: at least 2 plants (or 0), and, given the plant, a plant file that declares ranges."""
-    from compliance.errors import InputError
-
-    if args.uncertainty is not None and (args.uncertainty == 1 or args.uncertainty < 0):
-        raise InputError(f"--uncertainty {args.uncertainty}: expected at least 2 plants (or 0 for point values)")
-    if args.uncertainty and cfg is not None:
-        from compliance.campaign.uncertainty import ranged_parameters
-
-        if not ranged_parameters(cfg):
-            raise InputError(f"{cfg.path or cfg.name}: --uncertainty {args.uncertainty}: the plant file gives no parameter "
-                             "a range (range = [low, high] with range_note, docs/requirements.md 'Uncertainty')")
-
-
-def run(args) -> int:
-    """Check outputs and inputs, run the campaign, print the table, write the outputs; exit code from the verdict."""
-    from compliance.campaign.results_files import summary_table, write_json, write_junit
-    from compliance.campaign.run import run_campaign
-    from compliance.cli.common import plant_from_args
-    from compliance.cli.progress import progress
+def _check_first(args) -> None:
+    """Outputs, options and SOURCE_DATE_EPOCH checked before any work (exit 2)."""
+    from compliance.cli.sweep import check_remedies_options
     from compliance.files.reproducible import fixed_created, is_reproducible
-    from compliance.cli.common import checked_requirements
-    from compliance.requirements.verdict import Overall
+    from compliance.pipeline.chain import check_uncertainty
 
-    check_uncertainty_option(args)
+    check_uncertainty(args.uncertainty)
     if args.appendix is not None and not (args.report or args.pdf):
         from compliance.errors import InputError
 
         raise InputError(f"--appendix {args.appendix}: shapes the report, and no report is asked for; add --report "
                          "FILE.html or --pdf FILE.pdf")
     args.appendix = args.appendix or "summary"
-    from compliance.cli.sweep import check_remedies_options
-
     check_args_outputs(args, (getattr(args, "save_remedy", None), "--save-remedy", (".toml",)))
     check_remedies_options(args)
     if is_reproducible(args.reproducible):
         fixed_created()  # a malformed SOURCE_DATE_EPOCH is refused before the work
-    render = renderer(args)
-    if args.remedies and args.remedies != "default":  # a bad sweep file is exit 2 before any simulation
-        from compliance.sweep.candidates.spec import load_sweep
 
-        load_sweep(args.remedies)
-    cfg = plant_from_args(args)
-    reqset = checked_requirements(args.requirements, [cfg.p("cylinder.stroke")], args)  # before any simulation
-    check_uncertainty_option(args, cfg)
-    stages = 1 + bool(args.linear) + (render is not None)
-    # the campaign reports its runs itself on a terminal; in a CI log these stage lines (and a heartbeat) show progress
-    with progress(stages, "check", quiet=args.quiet or sys.stderr.isatty(), unit="stage", first="campaign") as bar:
-        results = run_campaign(cfg, reqset, workers=args.jobs, progress=not args.quiet, command_line=command_line(args),
-                               uncertainty="local" if args.uncertainty is None else None)
-        if args.uncertainty:
-            monte_carlo(cfg, reqset, results, args)
-        bar.update(1)
-        if args.linear:
-            from compliance.linear.operating_points import linear_for_campaign
 
-            bar.set_postfix_str("linear analysis", refresh=False)
-            results["linear"] = linear_for_campaign(cfg, reqset)
-            bar.update(1)
-        if args.remedies:
-            from compliance.sweep.check_remedies import remedies_for_check
+def _print(result, args) -> None:
+    from compliance.campaign.results_files import summary_table
 
-            from compliance.cli.sweep import remedies_kwargs
-
-            results["remedies"] = remedies_for_check(cfg, reqset, args.remedies, workers=args.jobs, progress=not args.quiet,
-                                                     **remedies_kwargs(args))
-        results = finish_results(results, args)
-        table = summary_table(results)
-        if render is not None:
-            bar.set_postfix_str("report", refresh=False)
-            from compliance.campaign.results_files import results_json
-
-            doc = document_options(args, args.json, results_json(results) if args.json else None)
-            render(results, html_path=args.report, pdf_path=args.pdf, appendix=args.appendix, document=doc)
-            bar.update(1)
+    table = summary_table(result)
     if args.quiet:
         print(table.rstrip().splitlines()[-1])
-    else:
-        sys.stdout.write(table)
-        if args.remedies:
-            from compliance.sweep.summary_text import remedies_markdown
+        return
+    sys.stdout.write(table)
+    if result.remedies is not None:
+        from compliance.sweep.summary_text import remedies_markdown
 
-            sys.stdout.write("\n" + remedies_markdown(results["remedies"]))
+        sys.stdout.write("\n" + remedies_markdown(result.remedies))
+
+
+def run(args) -> int:
+    """Parse, call ``compliance.check``, print and write; exit 0 when every mandatory requirement passes, else 1."""
+    from compliance.cli.common import plant_from_args
+    from compliance.cli.progress import progress
+    from compliance.cli.sweep import remedies_kwargs, save_remedy
+    from compliance.files.reproducible import is_reproducible
+    from compliance.pipeline.chain import Check
+
+    _check_first(args)
+    cfg = plant_from_args(args)
+    uncertainty = "local" if args.uncertainty is None else args.uncertainty
+    prepared = Check.of(cfg, args.requirements, linear=args.linear, remedies=args.remedies, uncertainty=uncertainty,
+                        allow_conflicts=args.allow_conflicts)  # every input checked before any work
+    render = args.report or args.pdf
+    stages = ["campaign"] + ["linear analysis"] * bool(args.linear) + ["report"] * bool(render)
+    # the campaign reports its runs itself on a terminal; in a CI log these stage lines (and a heartbeat) show progress
+    with progress(len(stages), "check", quiet=args.quiet or sys.stderr.isatty(), unit="stage", first="campaign") as bar:
+        def on_stage(name):
+            if name in stages:
+                bar.update(1)
+                if stages.index(name) + 1 < len(stages):
+                    bar.set_postfix_str(stages[stages.index(name) + 1], refresh=False)
+
+        result = prepared.run(jobs=args.jobs, progress=not args.quiet, command_line=command_line(args),
+                              remedy_options=remedies_kwargs(args) if args.remedies else None, on_stage=on_stage)
+        if is_reproducible(args.reproducible):
+            result = result.made_reproducible(command_line(args, outputs=False))
+        if render:
+            from compliance.report.render import render_report
+
+            doc = document_options(args, args.json, result.json_text() if args.json else None)
+            render_report(result, html_path=args.report, pdf_path=args.pdf, appendix=args.appendix, document=doc)
+            on_stage("report")
+    _print(result, args)
     if args.remedies:
-        from compliance.cli.sweep import save_remedy
+        save_remedy(args, cfg, result.remedies)
+    write_outputs(result, args)
+    return 0 if result.passed else 1
 
-        save_remedy(args, cfg, results["remedies"])
+
+def write_outputs(result, args) -> None:
+    """The results JSON (``--json``) and JUnit XML (``--junit``)."""
+    from compliance.campaign.results_files import write_junit
+
     if args.json:
-        write_json(results, args.json)
+        result.to_json(args.json)
     if args.junit:
-        write_junit(results, args.junit)
-    return 0 if results["summary"]["status"] == Overall.PASS else 1
+        write_junit(result, args.junit)

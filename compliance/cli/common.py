@@ -183,19 +183,20 @@ def add_allow_conflicts(parser) -> None:
 
 
 def checked_requirements(source, strokes, args):
-    """Load the requirement set ``source`` and check its consistency for every stroke [m] of ``strokes`` (before any work).
+    """Load the requirement set ``source`` and vet it for every stroke [m] of ``strokes`` (before any work).
 
-    The one way every command that loads a requirement set checks it
-    (``compliance.requirements.consistency.check_consistency``): a conflict between mandatory
-    limits is exit 2 unless ``--allow-conflicts``.
+    For a command whose plant is not known before its work starts (``size``, ``sweep``, ``accept``);
+    the vetting is the one a check runs (``compliance.requirements.vetting.vet``, as
+    ``compliance.pipeline.chain.Check.of``): a loosened limit, or a conflict between mandatory limits
+    unless ``--allow-conflicts``, is exit 2.
     """
-    from compliance.requirements.consistency import check_consistency
     from compliance.requirements.loading import load_requirements
+    from compliance.requirements.vetting import vet
 
     reqset = source if hasattr(source, "requirements") else load_requirements(source)
     allow = bool(getattr(args, "allow_conflicts", False))
     for stroke in dict.fromkeys(strokes):
-        check_consistency(reqset, stroke, allow)
+        vet(reqset, stroke, allow)
     return reqset
 
 

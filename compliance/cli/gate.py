@@ -62,13 +62,13 @@ def _requirements_for(args, baseline_results):
         return load_requirements(args.requirements)
     if baseline_results is None:
         raise InputError("--requirements is needed when the baseline is a plant configuration")
-    rs = baseline_results["requirement_set"]
-    path = rs.get("path")
+    rs = baseline_results.requirement_set
+    path = rs.path
     if path and Path(path).is_file():
         return load_requirements(path)
-    if rs.get("name"):
+    if rs.name:
         try:
-            return load_requirements(rs["name"])
+            return load_requirements(rs.name)
         except InputError:
             pass
     raise InputError(f"{args.baseline}: requirement_set.path: '{path}' is not readable here; give --requirements")
@@ -79,7 +79,7 @@ def _check_allowed_ids(allowed, reqset, *results) -> None:
     known = {r.id for r in reqset.requirements} if reqset is not None else set()
     for res in results:
         if res is not None:
-            known |= {str(e.get("id")) for e in res.get("requirements", []) if isinstance(e, dict)}
+            known |= {e.id for e in res.requirements}
     for rid in allowed:
         if rid not in known:
             raise InputError(f"--allow-not-evaluated {rid}: no requirement with this ID in the comparison"
@@ -99,7 +99,7 @@ def run(args) -> int:
     """Obtain both results, compare, print, write; exit 1 when the gate trips."""
     from compliance.campaign.regression_gate import compare, gate_markdown, gate_table
     from compliance.campaign.results_files import read_results
-    from compliance.campaign.run import run_campaign
+    from compliance.pipeline.chain import Check
     from compliance.files.atomic import write_json_atomic, write_text_atomic
     from compliance.files.reproducible import is_reproducible, make_reproducible
     from compliance.model.config import load_plant
@@ -120,16 +120,16 @@ def run(args) -> int:
     configs = {name: load_plant(src) for name, src in sources.items() if not _is_results(src)}
     reqset = None
     if configs:
-        from compliance.cli.common import checked_requirements
-
-        reqset = checked_requirements(_requirements_for(args, base), [c.p("cylinder.stroke") for c in configs.values()], args)
-        if base is not None and reqset.digest != base["requirement_set"].get("digest"):
+        reqset = _requirements_for(args, base)
+        if base is not None and reqset.digest != base.requirement_set.digest:
             print(f"govcheck gate: note: {reqset.path} changed since the baseline was made "
-                  f"(digest {str(base['requirement_set'].get('digest'))[:12]} -> {reqset.digest[:12]})", file=sys.stderr)
+                  f"(digest {str(base.requirement_set.digest)[:12]} -> {reqset.digest[:12]})", file=sys.stderr)
     _check_allowed_ids(args.allow_not_evaluated, reqset, base, cand)
-    for name, cfg in configs.items():
-        results = run_campaign(cfg, reqset, workers=args.jobs, progress=not args.quiet,
-                               command_line=f"govcheck gate ({name} {sources[name]})")
+    # every side's inputs vetted (conflicts at each plant's stroke) before either is simulated
+    prepared = {name: Check.of(cfg, reqset, uncertainty=None, allow_conflicts=args.allow_conflicts)
+                for name, cfg in configs.items()}
+    for name, ready in prepared.items():
+        results = ready.run(jobs=args.jobs, progress=not args.quiet, command_line=f"govcheck gate ({name} {sources[name]})")
         base, cand = (results, cand) if name == "baseline" else (base, results)
     result = compare(base, cand, args.max_margin_loss, allow_not_evaluated=args.allow_not_evaluated)
     table = gate_table(result)

@@ -6,6 +6,7 @@ import argparse
 
 from compliance.cli.common import add_outputs, add_parser, add_plant_argument, add_quiet, add_reproducible, check_args_outputs
 from compliance.errors import InputError
+from compliance.presentation.quantities import fmt_quantity
 
 _PLOT_SUFFIXES = (".png", ".svg", ".pdf")
 
@@ -52,7 +53,8 @@ def register(subparsers):
                         "(default: the load curve)")
     add_outputs(p, "json", help={"json": "write everything as JSON to FILE.json"})
     p.add_argument("--governor-json", metavar="FILE.json", help="write only the HYGOV parameters as JSON (implies --governor)")
-    p.add_argument("--plot", metavar="FILE.png", help="write Bode, Nyquist, pole-zero and step plots (.png, .svg or .pdf)")
+    p.add_argument("--plot", metavar="FILE.png", help="write the report's figures of the analysis: Bode, closed-loop poles, the "
+                   "predicted step and, with --map, the time-constant map (.png, .svg or .pdf)")
     add_quiet(p, "print only the headline figures")
     add_reproducible(p)
     return p
@@ -95,27 +97,38 @@ def _study(args, governor: bool) -> dict:
     return out
 
 
-def _fmt(v, scale=1.0, digits=3, unit=""):
-    return "-" if v is None else f"{v*scale:.{digits}f} {unit}".rstrip()
+def _q(v, si: str, unit: str = "", decimals: int = 3, suffix: str = "") -> str:
+    return fmt_quantity(v, si, unit or si, decimals, suffix=suffix, none="-")
+
+
+def _load_text(op) -> str:
+    if op.load is None:
+        return "none"
+    force = fmt_quantity(op.load_force, "N", "kN", 2)
+    return f"curve ({force})" if isinstance(op.load, str) else force
 
 
 def _summary(cfg, a, flow_control=None) -> str:
     f, op = a.figures, a.op
     circuit = {True: ", flow-control valves in", False: ", flow-control valves out", None: ""}[flow_control]
-    load = "none" if op.load is None else (f"curve ({op.load_force/1e3:.2f} kN)" if isinstance(op.load, str) else f"{op.load_force/1e3:.2f} kN")
     lines = [
-        f"plant {cfg.name}: linear model at {op.position*1e3:.1f} mm, load {load}, valve slope '{a.info['gain']}'{circuit}",
-        f"  trim pressures p_A {op.pressure_a/1e5:.3f} bar abs, p_B {op.pressure_b/1e5:.3f} bar abs (p_A + p_B = p_s + p_atm)",
+        f"plant {cfg.name}: linear model at {_q(op.position, 'm', 'mm', 1)}, load {_load_text(op)}, valve slope "
+        f"'{a.info['gain']}'{circuit}",
+        f"  trim pressures p_A {_q(op.pressure_a, 'Pa', 'bar', 3, ' abs')}, p_B {_q(op.pressure_b, 'Pa', 'bar', 3, ' abs')} "
+        "(p_A + p_B = p_s + p_atm)",
         f"  states {', '.join(a.plant.state_labels)} ({a.info['unobservable_or_uncontrollable_states']} mode(s) not seen from u_d to x)",
-        f"  pneumatic natural frequency {_fmt(f['natural_frequency_hz'], 1, 2, 'Hz')} (analytic {_fmt(f['natural_frequency_analytic_hz'], 1, 2, 'Hz')}), "
-        f"damping {_fmt(f['pneumatic_damping_ratio'], 1, 3)}",
-        f"  plant velocity gain {_fmt(f['plant_velocity_gain'], 1e3, 2, 'mm/s per V')}, loop gain K_P*K_q {_fmt(f['loop_gain'], 1, 2, '1/s')}",
-        f"  time constant {_fmt(f['time_constant'], 1e3, 1, 'ms')} (step metric, sampled loop); dominant pole {_fmt(f['dominant_time_constant'], 1e3, 1, 'ms')}; "
-        f"first-order estimate (1 + K_q K_D)/(K_q K_P) {_fmt(f['first_order_time_constant'], 1e3, 1, 'ms')}",
-        f"  -3 dB bandwidth {_fmt(f['bandwidth_hz'], 1, 2, 'Hz')}; least closed-loop damping {_fmt(f['damping_ratio'], 1, 3)}; stable: {'yes' if f['stable'] else 'NO'}",
-        f"  gain margin {_fmt(f['gain_margin_db'], 1, 1, 'dB')} at {_fmt(f['phase_crossover_hz'], 1, 1, 'Hz')}, "
-        f"phase margin {_fmt(f['phase_margin_deg'], 1, 1, 'deg')} at {_fmt(f['gain_crossover_hz'], 1, 1, 'Hz')} (sampled loop; continuous "
-        f"{_fmt(f.get('gain_margin_db_continuous'), 1, 1, 'dB')}, {_fmt(f.get('phase_margin_deg_continuous'), 1, 1, 'deg')})",
+        f"  pneumatic natural frequency {_q(f['natural_frequency_hz'], 'Hz', 'Hz', 2)} (analytic "
+        f"{_q(f['natural_frequency_analytic_hz'], 'Hz', 'Hz', 2)}), damping {_q(f['pneumatic_damping_ratio'], '', '', 3)}",
+        f"  plant velocity gain {_q(f['plant_velocity_gain'], 'm/s', 'mm/s', 2, ' per V')}, loop gain K_P*K_q "
+        f"{_q(f['loop_gain'], '1/s', '1/s', 2)}",
+        f"  time constant {_q(f['time_constant'], 's', 'ms', 1)} (step metric, sampled loop); dominant pole "
+        f"{_q(f['dominant_time_constant'], 's', 'ms', 1)}; first-order estimate (1 + K_q K_D)/(K_q K_P) "
+        f"{_q(f['first_order_time_constant'], 's', 'ms', 1)}",
+        f"  -3 dB bandwidth {_q(f['bandwidth_hz'], 'Hz', 'Hz', 2)}; least closed-loop damping {_q(f['damping_ratio'], '', '', 3)}; "
+        f"stable: {'yes' if f['stable'] else 'NO'}",
+        f"  gain margin {_q(f['gain_margin_db'], 'dB', 'dB', 1)} at {_q(f['phase_crossover_hz'], 'Hz', 'Hz', 1)}, "
+        f"phase margin {_q(f['phase_margin_deg'], 'deg', 'deg', 1)} at {_q(f['gain_crossover_hz'], 'Hz', 'Hz', 1)} (sampled loop; "
+        f"continuous {_q(f.get('gain_margin_db_continuous'), 'dB', 'dB', 1)}, {_q(f.get('phase_margin_deg_continuous'), 'deg', 'deg', 1)})",
         "  closed-loop poles: " + ", ".join(f"{p[0]:.2f}{p[1]:+.2f}j" for p in a.data["poles"]["closed_loop"]),
     ]
     tau = f["time_constant"]
@@ -195,62 +208,12 @@ def run(args) -> int:
 
 
 def _plot(a, path, omap=None) -> None:
-    """Bode (loop), Nyquist, closed-loop pole-zero map, predicted step and, with --map, the time-constant map."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    import numpy as np
-
-    d = a.data
-    fig, ax = plt.subplots(2, 3, figsize=(15, 8.5))
-    fhz = np.array(d["bode"]["frequency_hz"])
-    ax[0, 0].semilogx(fhz, d["bode"]["loop_discrete_magnitude_db"], label="loop L (sampled)")
-    ax[0, 0].semilogx(fhz, d["bode"]["closed_loop_magnitude_db"], label="closed loop T")
-    ax[0, 0].axhline(0, color="k", lw=0.5)
-    ax[0, 0].axhline(-3, color="k", lw=0.5, ls=":")
-    ax[0, 0].set(xlabel="frequency [Hz]", ylabel="magnitude [dB]", title="Bode magnitude")
-    ax[0, 0].legend()
-    ax[1, 0].semilogx(fhz, d["bode"]["loop_discrete_phase_deg"], label="loop L (sampled)")
-    ax[1, 0].semilogx(fhz, d["bode"]["closed_loop_phase_deg"], label="closed loop T")
-    ax[1, 0].axhline(-180, color="k", lw=0.5)
-    ax[1, 0].set(xlabel="frequency [Hz]", ylabel="phase [deg]", title="Bode phase")
-    re, im = np.array(d["nyquist"]["loop_real"]), np.array(d["nyquist"]["loop_imag"])
-    ax[0, 1].plot(re, im, label="L(jw)")
-    ax[0, 1].plot(re, -im, ls="--", lw=0.7)
-    ax[0, 1].plot([-1], [0], "r+", ms=12)
-    ax[0, 1].set(xlim=(-3, 1), ylim=(-3, 3), xlabel="Re", ylabel="Im", title="Nyquist (sampled loop)")
-    p = np.array(d["poles"]["closed_loop"])
-    z = np.array(d["poles"]["closed_loop_zeros"]).reshape(-1, 2)
-    ax[1, 1].plot(p[:, 0], p[:, 1], "x", label="closed-loop poles")
-    if z.size:
-        ax[1, 1].plot(z[:, 0], z[:, 1], "o", mfc="none", label="zeros")
-    pp = np.array(d["poles"]["plant_minimal"])
-    ax[1, 1].plot(pp[:, 0], pp[:, 1], "k.", label="plant poles")
-    ax[1, 1].set(xlabel="Re [1/s]", ylabel="Im [rad/s]", title="pole-zero map", xlim=(min(-50, p[:, 0].min() * 1.1 if p.size else -50), 5))
-    ax[1, 1].legend(fontsize=8)
-    ax[0, 2].plot(d["step"]["time"], np.array(d["step"]["position"]) * 1e3, label="sampled loop")
-    ax[0, 2].plot(d["step"]["time_continuous"], np.array(d["step"]["position_continuous"]) * 1e3, ls="--", label="continuous")
-    ax[0, 2].set(xlabel="time [s]", ylabel="position [mm]", title=f"predicted {abs(d['step']['size'])*1e3:.0f} mm step")
-    ax[0, 2].legend()
-    if omap is not None:
-        tau = np.array([[np.nan if v is None else v * 1e3 for v in row] for row in omap.values["time_constant"]])
-        im_ = ax[1, 2].imshow(tau, aspect="auto", origin="lower", cmap="viridis")
-        ax[1, 2].set_xticks(range(len(omap.positions)), [f"{100*x/omap.positions[-1]:.0f}" for x in omap.positions])
-        ax[1, 2].set_yticks(range(len(omap.loads)), ["none" if v is None else (v if isinstance(v, str) else f"{v/1e3:.1f}") for v in omap.loads])
-        ax[1, 2].set(xlabel="stroke [%]", ylabel="load [kN]", title="time constant [ms]")
-        fig.colorbar(im_, ax=ax[1, 2])
-    else:
-        ax[1, 2].axis("off")
-    fig.suptitle(f"{a.op.position*1e3:.1f} mm, load {a.op.load_force/1e3:.2f} kN: "
-                 f"tau {a.figures['time_constant']*1e3:.0f} ms" if a.figures["time_constant"] else "")
-    fig.tight_layout()
-    import io
-
+    """The report's figures of this analysis on one page (Bode, poles, predicted step; with --map the time-constant map)."""
     from compliance.files.atomic import write_bytes_atomic
+    from compliance.report.figures_linear import analysis_page
+    from compliance.results.linear import LinearAnalysisRecord, OperatingMapRecord
 
-    buf = io.BytesIO()
-    fmt = path.rsplit(".", 1)[-1].lower()
-    fig.savefig(buf, format=fmt, metadata={"Date": None} if fmt == "svg" else ({"CreationDate": None} if fmt == "pdf" else {}))
-    plt.close(fig)
-    write_bytes_atomic(path, buf.getvalue())
+    analysis = LinearAnalysisRecord.from_dict(a.to_dict(), "linear analysis")
+    grid = OperatingMapRecord.from_dict(omap.to_dict(), "operating map") if omap is not None else None
+    page = analysis_page(analysis, fmt_quantity(a.op.position, "m", "mm", 1), grid, fmt=path.rsplit(".", 1)[-1].lower())
+    write_bytes_atomic(path, page)

@@ -61,8 +61,8 @@ def merge_linear(docs) -> dict:
 
 def run(args) -> int:
     """Render the report(s); print where they were written."""
-    from compliance.report.content import check_results
     from compliance.report.render import VALIDATION_SCHEMA, check_validation, render_report, render_validation_report
+    from compliance.results.check_result import CheckResult
 
     html = args.report
     if not html and not args.pdf:
@@ -78,14 +78,14 @@ def run(args) -> int:
             raise InputError("a validation report needs --report (the PDF is made from it)")
         render_validation_report(data, html, args.pdf, workers=args.jobs, scheduler=scheduler)
     else:
-        check_results(data, str(args.results))
+        result = CheckResult.from_dict(data, str(args.results))
         if args.linear:
-            data["linear"] = merge_linear([(p, read_json(p, "linear analysis")) for p in args.linear])
+            result = result.with_(linear=merge_linear([(p, read_json(p, "linear analysis")) for p in args.linear]))
         if args.validation:
             val = read_json(args.validation, "validation")
             check_validation(val, str(args.validation))
-            data["validation"] = val
-        render_report(data, html, args.pdf, workers=args.jobs, appendix=args.appendix,
+            result = result.with_(validation=val)
+        render_report(result, html, args.pdf, workers=args.jobs, appendix=args.appendix,
                       document=document_options(args, args.results), scheduler=scheduler)
     written = [p for p in (html, args.pdf) if p]
     print("report: " + ", ".join(written))

@@ -294,7 +294,7 @@ def run(args) -> int:
     """Check every input and output, simulate, then write the run, its sidecar and the plot."""
     from compliance.files.atomic import write_bytes_atomic, write_text_atomic
     from compliance.files.outputs import check_outputs
-    from compliance.simulation import simulate
+    from compliance.plants import simulate
 
     _check_output(args.output)
     check_outputs((args.output, "-o/--output"), (args.plot, "--plot", PLOT_SUFFIXES))

@@ -96,7 +96,6 @@ def run(args) -> int:
     from compliance.files.atomic import write_text_atomic
     from compliance.files.shipped import resolve_shipped
     from compliance.model.config import load_plant
-    from compliance.requirements.verdict import Overall
     from compliance.sweep.sizing.duty_file import load_duty
     from compliance.sweep.sizing.size_servo import size_servo, time_constant_target
     from compliance.sweep.sizing.throttle_tuning import tune_throttles
@@ -118,26 +117,24 @@ def run(args) -> int:
         if args.out:
             write_text_atomic(args.out, text)
         return 0
-    from compliance.campaign.results_files import summary_table, write_json
-    from compliance.campaign.run import run_campaign
+    from compliance.campaign.results_files import summary_table
+    from compliance.pipeline.chain import Check
 
-    results = run_campaign(cfg, reqset, workers=args.jobs, progress=not args.quiet)
-    results["sizing"] = {"duty": duty.path, "record": rec, "throttles": tune}
-    if args.remedies:
-        from compliance.sweep.check_remedies import remedies_for_check
-
-        results["remedies"] = remedies_for_check(cfg, reqset, None, workers=args.jobs, progress=not args.quiet,
-                                                 **remedies_kwargs(args))
+    prepared = Check.of(cfg, reqset, uncertainty=None, remedies="default" if args.remedies else None,
+                        allow_conflicts=args.allow_conflicts)
+    results = prepared.run(jobs=args.jobs, progress=not args.quiet,
+                           remedy_options=remedies_kwargs(args) if args.remedies else None)
+    results = results.with_(sizing={"duty": duty.path, "record": rec, "throttles": tune})
     table = summary_table(results)
     sys.stdout.write(table.rstrip().splitlines()[-1] + "\n" if args.quiet else table)
     if args.remedies and not args.quiet:
         from compliance.sweep.summary_text import remedies_markdown
 
-        sys.stdout.write("\n" + remedies_markdown(results["remedies"]))
+        sys.stdout.write("\n" + remedies_markdown(results.remedies))
     if args.out:
         write_text_atomic(args.out, text)
     if args.remedies:
-        save_remedy(args, cfg, results["remedies"])
+        save_remedy(args, cfg, results.remedies)
     if args.json:
-        write_json(results, args.json)
-    return 0 if results["summary"]["status"] == Overall.PASS else 1
+        results.to_json(args.json)
+    return 0 if results.passed else 1

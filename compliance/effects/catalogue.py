@@ -1,9 +1,10 @@
 """The ordered effect registry and the compiled hooks composed from the effects' terms.
 
 Each effect is one module of this package: its declaration (``EFFECT``), its slot constants in
-the compiled core and its compiled term functions. Registering one is its entry in ``MODULES``
-below (and its name in the import above it): the order is the order of the parameter-vector
-entries (``compliance.model.vector_slots``), so a new effect goes last.
+the compiled core, its compiled term functions and the Python hooks of a structural effect
+(``compliance.effects.structure``). Registering one is its entry in ``MODULES`` below (and its
+name in the import above it); a new effect goes last, its ``slot`` after every existing
+parameter-vector entry (``compliance.model.vector_slots`` computes the layout from the declarations).
 
 Bounds are physical ranges cut where the pinned RK4 step (1 ms for plant A) would go unstable:
 the fastest eigenvalue of each effect times the step stays below ~2 (RK4's limit is 2.8), e.g.
@@ -20,7 +21,8 @@ Hooks: ``plant_rhs`` (``compliance.model.assembly``) calls each hook below once;
 the chain of the terms the effects declare for it (``Effect.terms``), in declared order, each
 term called only while its effect's flag is set, so an effect that is off costs one compiled
 branch. Effects that change the structure of the model (a state, a node, a
-second body) are composed in ``plant_rhs`` itself from their modules' kernels.
+second body) are composed in ``plant_rhs`` itself from their modules' kernels, and declare
+their rest state, trim and replay restart through ``Effect`` hooks.
 """
 
 from __future__ import annotations
@@ -163,7 +165,7 @@ HOOKS = {
 def compose(hook: str, modules=MODULES):
     """The compiled chain of the effects' terms for ``hook``, in declared order.
 
-    Each term is called only while its effect's flag (``P_<SHORT>_ON`` of its module) is set.
+    Each term is called only while its effect's flag (index ``Effect.slot``, ``P_<SHORT>_ON`` of its module) is set.
 
     Raises
     ------
@@ -177,7 +179,7 @@ def compose(hook: str, modules=MODULES):
     chain, then = HOOKS[hook]
     for m in modules:
         if hook in m.EFFECT.terms:
-            chain = then(chain, getattr(m, f"P_{m.EFFECT.short.upper()}_ON"), m.EFFECT.terms[hook])
+            chain = then(chain, m.EFFECT.slot, m.EFFECT.terms[hook])
     return chain
 
 

@@ -23,6 +23,7 @@ EFFECT = Effect(
     name="external_leakage",
     meaning="laminar leak from each chamber to atmosphere (fittings, rod seals)",
     short="el",
+    slot=P_EL_ON,
     params=(Param("conductance", "kg/(s*Pa)", "leak mass flow per gauge pressure, each side", 1e-10, (1e-13, 1e-8), True,
                   slot="k", aliases=("k_ext",)),),
     states=(),

@@ -23,6 +23,7 @@ EFFECT = Effect(
     name="internal_leakage",
     meaning="laminar leak across the piston seals from side A to side B",
     short="il",
+    slot=P_IL_ON,
     params=(Param("conductance", "kg/(s*Pa)", "leak mass flow per pressure difference", 1e-10, (1e-13, 1e-8), True,
                   slot="k", aliases=("k_int",)),),
     states=(),

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from numba import njit
 
-from compliance.effects.base import Effect, State
+from compliance.effects.base import Effect, Rest, State
 from compliance.effects.param import Param
 from compliance.physics.valve_flow import iso6358_mass_flow
 
@@ -15,21 +15,30 @@ P_LD_COND = 78
 S_PLA = 13
 S_PLB = 14
 
+
+def rest(P, y, at: Rest) -> None:
+    """Hook ``rest``: no flow at rest, so each hose at its chamber's pressure."""
+    y[S_PLA] = at.pressure_a
+    y[S_PLB] = at.pressure_b
+
+
 EFFECT = Effect(
     name="line_dynamics",
     meaning="hoses between valve and cylinders add volume and a flow restriction",
     short="ld",
+    slot=P_LD_ON,
     params=(
         Param("volume", "m^3", "hose volume per side", 2e-4, (1e-4, 5e-3), True, slot="vol", aliases=("V_line",)),
         Param("conductance", "m^3/(s*Pa)", "sonic conductance of each hose", 3e-8, (1e-9, 1e-7), True, slot="cond",
               aliases=("C_line",)),
     ),
-    states=(State("line_pressure_a", "PLA", S_PLA), State("line_pressure_b", "PLB", S_PLB)),
+    states=(State("line_pressure_a", "PLA", S_PLA, "pressure"), State("line_pressure_b", "PLB", S_PLB, "pressure")),
     signature="chamber pressures respond later and smoother than the valve command; the loop is less damped",
     signals=("pressure_a", "pressure_b", "valve_command"),
     explanation="the hoses between valve and cylinders add volume and a restriction (hose volume {v} per side)",
     fit_grid={"volume": (1e-4, 5e-4, 2e-3), "conductance": (1e-8, 3e-8, 1e-7)},
     draw={"volume": (1e-4, 6e-4, True), "conductance": (5e-9, 3e-8, True)},
+    rest=rest,
 )
 
 

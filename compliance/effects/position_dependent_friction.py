@@ -5,8 +5,8 @@ varies along the stroke (wear, a slight taper or ovality) changes the squeeze an
 friction at each position (Parker O-Ring Handbook ORD 5700, 2021, sec. 5, running friction).
 The seal bench data (Zillen, TU Delft: friction of one seal stroked at 1-7 bar) shows its
 friction changing with position at every pressure; the bench diagnosis declares the same
-physics as ``position_dependent_friction`` with the same gradient
-(``compliance.diagnosis.friction_bench.position``). In the servo both Stribeck levels (and the
+physics, expanded to second order about the runs' median position, as its own effect
+``friction_along_stroke`` (``compliance.diagnosis.friction_bench.position``). In the servo both Stribeck levels (and the
 breakaway force of the piecewise model) of each cylinder are scaled by the factor at its own
 piston position, taken linear about mid-stroke (our choice; the bench adds a curvature term
 about the median of its runs) and never below ``MIN_FACTOR``.
@@ -45,6 +45,7 @@ EFFECT = Effect(
     name="position_dependent_friction",
     meaning="the seal's friction level changes along the stroke (squeeze varying with the bore)",
     short="xf",
+    slot=P_XF_ON,
     # +-10 /m moves the level by +-0.8 at the ends of a 0.16 m stroke: the bench's +-40 /m over its 40 mm travel
     params=(Param("position_gradient", "1/m", "relative change of both friction levels per metre of travel at mid-stroke",
                   0.0, (-10.0, 10.0), slot="grad"),),

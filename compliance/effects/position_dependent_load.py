@@ -22,6 +22,7 @@ EFFECT = Effect(
     name="position_dependent_load",
     meaning="the load changes along the stroke (gate hydraulic torque stiffness)",
     short="pl",
+    slot=P_PL_ON,
     params=(Param("stiffness", "N/m", "added closing force per metre of opening (the core: about mid-stroke; the diagnosis: about the test's start)", 0.0, (-1.5e5, 1.5e5), slot="k",
                   aliases=("kL",)),),
     states=(),

@@ -34,6 +34,7 @@ EFFECT = Effect(
     name="pressure_dependent_friction",
     meaning="seal friction rises with the pressure behind the seals: F_C and F_S scale by 1 + k (mean gauge pressure)",
     short="pf",
+    slot=P_PF_ON,
     # a lip seal's friction is its contact pressure times area; the pressure behind the lip adds to the
     # contact pressure, so both levels scale with it (Belforte et al. 2003) and the Stribeck shape is kept;
     # 5e-6 /Pa (0.5 per bar) nearly triples the friction at the mean gauge pressure of an 8 bar supply

@@ -16,6 +16,7 @@ EFFECT = Effect(
     name="valve_null_flow",
     meaning="the servo valve passes flow near its null: its lands leak, so pressure builds inside the nominal dead zone",
     short="nf",
+    slot=P_NF_ON,
     params=(
         Param("null_opening", "", "relative opening through which each land leaks at null (leakage / underlap)", 0.003,
               (0.0, 0.05), slot="a0"),
@@ -27,7 +28,6 @@ EFFECT = Effect(
     signals=("position", "pressure_a", "pressure_b", "valve_command"),
     # linear treatment: no state; at the trim (valve at null) the leaks' flow-pressure slope enters the state
     # Jacobian through plant_rhs, and the input column is measured beyond the dead-zone edge (linear/trim.flow_columns)
-    plant_b=True,  # acts on the command about the valve centre: plant B's 0-10 V valve alike
     explanation="the servo valve leaks across its lands near null, so the loop keeps a pressure gain inside the "
                 "nominal dead zone (leak opening {v} of full opening per land)",
     fit_grid={"null_opening": (0.001, 0.003, 0.01), "null_width": (0.1, 0.3, 0.65)},

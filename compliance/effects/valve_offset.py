@@ -18,10 +18,16 @@ def valve_command(P, u):
     return u + P[P_VO_OFF]  # valve null shift
 
 
+def trim_null(P, null):
+    """Hook ``trim_null``: the command that puts the shifted valve at its null [V]."""
+    return null - (P[P_VO_OFF] if P[P_VO_ON] else 0.0)
+
+
 EFFECT = Effect(
     name="valve_offset",
     meaning="null shift of the servo valve: the valve sees the command plus an offset",
     short="vo",
+    slot=P_VO_ON,
     params=(Param("offset", "V", "voltage added to the command at the valve", 0.0, (-1.5, 1.5), slot="off", aliases=("u0",)),),
     states=(),
     signature="asymmetric response up vs down; the holding command sits off the compensated null",
@@ -31,4 +37,5 @@ EFFECT = Effect(
     draw={"offset": (0.05, 0.4, True)},
     draw_signed=True,
     terms={"valve_command": valve_command},
+    trim_null=trim_null,
 )

@@ -16,7 +16,7 @@ def display_path(path: str | None) -> str | None:
     package = Path(__file__).resolve().parent.parent / "data"
     try:
         rel = p.relative_to(package)
-        from compliance import __version__
+        from compliance.version import __version__
 
         return f"{rel.stem} (reference {rel.parts[0][:-1]}, govcheck {__version__})"
     except ValueError:

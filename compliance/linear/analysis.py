@@ -24,6 +24,7 @@ from compliance.model.pid_controller import first_order_filter_gain
 from compliance.errors import InputError
 from compliance.model.vector_slots import P_BV, P_MASS, P_NFR, P_STROKE
 from compliance.files.jsonable import json_number, jsonable  # the one JSON cleaner (re-exported for linear/*)
+from compliance.plants import kind_of
 from compliance.linear.trim import TrimPoint, linearise_plant, minimal_realisation, pneumatic_stiffness, trim
 
 PADE_ORDER = 3  # delays as 3rd-order Pade: phase error < 1 deg up to omega*T = 2 (well beyond crossover)
@@ -197,6 +198,7 @@ def analyse(cfg: PlantConfig, position: float, load: float | str | None = None, 
     Parameters
     ----------
     cfg : PlantConfig
+        A plant whose kind has the closed-loop linear model (``PlantKind.linear_support``: the PID servo).
     position : float
         Operating point [m].
     load : float, "curve" or None
@@ -211,9 +213,7 @@ def analyse(cfg: PlantConfig, position: float, load: float | str | None = None, 
     detail : bool
         False skips the arrays and the continuous-time step and margins (operating maps).
     """
-    if cfg.options.get("controller.type", "pid") != "pid":
-        raise InputError(f"{cfg.path or cfg.name}: controller.type = '{cfg.options['controller.type']}': the linear "
-                         f"closed-loop analysis covers the PID of seed 000 only (the plant alone: linear_trim.linearise_plant)")
+    kind_of(cfg).check_linear(cfg)
     op = trim(cfg, position, load, flow_control=flow_control)
     A, B, C, names, info = linearise_plant(op, cfg, gain)
     plant = control.ss(A, B, C, [[0.0]], states=names, inputs=["u_d_V"], outputs=["position_m"])

@@ -27,7 +27,8 @@ from compliance.linear.governor_formats import GovernorModel
 from compliance.linear.maps import nonlinear_step
 from compliance.model.config import PlantConfig
 from compliance.model.pid_controller import stall_error
-from compliance.simulation import Scenario, simulate
+from compliance.plants import simulate
+from compliance.simulation import Scenario
 from compliance.simulation.profiles import Profile
 from compliance.simulation.scenario import stroke_start_pressures
 

@@ -21,7 +21,8 @@ from compliance.errors import InputError
 from compliance.files.jsonable import jsonable
 from compliance.linear.analysis import analyse
 from compliance.simulation.profiles import steps
-from compliance.simulation import Scenario, simulate
+from compliance.plants import simulate
+from compliance.simulation import Scenario
 
 TAU_WINDOW = (0.10, 0.25)  # IEC 61362 servo-positioner time constant window [s] (seed 000 section 1)
 DEFAULT_LOADS = (-2300.0, 0.0, 2000.0, 4000.0, 6000.0, 8000.0, 10000.0, 12000.0)  # [N], seed 000 figs. 9-12 range

@@ -27,9 +27,8 @@ from compliance.model.assembly import plant_rhs
 from compliance.model.config import PlantConfig
 from compliance.model.plant_vector import load_curve_arrays, parameter_vector
 from compliance.model.rest_state import initial_state
-from compliance.effects.linkage_compliance import S_V2, S_X2
 from compliance.model.vector_slots import (AUX_NAMES, EFFECT_SLOTS, N_AUX, N_STATES, P_FRM, P_UCEN, PARAM_NAMES,
-                                           S_PA, S_PB, S_V, S_X, S_Z1, S_Z2, STATE_NAMES)
+                                           S_PA, S_PB, S_V, S_X, S_Z1, S_Z2, SHADOWS, STATE_INDEX, STATE_NAMES)
 
 __all__ = ["INPUT", "OPENING_INPUT", "OUTPUTS", "STATE_UNITS", "active_states", "labelled", "operating_point",
            "to_nlsys", "to_statespace", "valve_command_for_opening"]
@@ -58,17 +57,16 @@ def labelled(name: str, units: dict = STATE_UNITS) -> str:
 def active_states(P: np.ndarray) -> list[int]:
     """Indices of the states that move for this parameter vector (state-vector order).
 
-    x, v, p_A, p_B always; the LuGre bristle of each body (bristle_2 only with a compliant linkage,
-    otherwise it copies bristle_1, as position_2/velocity_2 copy position/velocity); the declared
-    states of every effect switched on.
+    x, v, p_A, p_B always; the LuGre bristle of each body (bristle_2 only while an effect frees it,
+    ``Effect.frees``: a compliant linkage; otherwise it copies bristle_1, as position_2/velocity_2
+    copy position/velocity, ``vector_slots.SHADOWS``); the declared states of every effect switched on.
     """
     keep = {S_X, S_V, S_PA, S_PB}
-    linkage = bool(P[EFFECT_SLOTS["linkage_compliance"][0]])
+    on = [eff for eff in ALL_EFFECTS if P[EFFECT_SLOTS[eff.name][0]]]
     if P[P_FRM] == 0.0:  # LuGre (compliance.model.assembly._body_friction)
-        keep |= {S_Z1, S_Z2} if linkage else {S_Z1}
-    for eff in ALL_EFFECTS:
-        if P[EFFECT_SLOTS[eff.name][0]]:
-            keep |= {s.index for s in eff.states}
+        keep |= {S_Z1} | ({STATE_INDEX[n] for eff in on for n in eff.frees} & {S_Z2})
+    for eff in on:
+        keep |= {s.index for s in eff.states}
     return sorted(keep)
 
 
@@ -122,6 +120,7 @@ def to_nlsys(cfg: PlantConfig, *, load: float | str | None = None, flow_control:
     P0 = parameter_vector(cfg, load=load, flow_control=flow_control)
     lx, ly = load_curve_arrays(cfg)
     keep = np.array(active_states(P0))
+    kept = set(keep.tolist())
     template = initial_state(cfg, P0, 0.5 * cfg.p("cylinder.stroke"))
     index = {n: i for i, n in enumerate(PARAM_NAMES)}
     defaults = {n: float(P0[index[n]]) for n in _PLANT_PARAMS}
@@ -142,10 +141,9 @@ def to_nlsys(cfg: PlantConfig, *, load: float | str | None = None, flow_control:
         P = _vector(params)
         y = template.copy()
         y[keep] = x
-        if S_Z2 not in keep:  # shadow copies of the rigid linkage (assembly.plant_rhs writes them alike)
-            y[S_Z2] = y[S_Z1]
-        if S_X2 not in keep:
-            y[S_X2], y[S_V2] = y[S_X], y[S_V]
+        for copy, of in SHADOWS.items():  # shadow copies of the rigid linkage (assembly.plant_rhs writes them alike)
+            if copy not in kept:
+                y[copy] = y[of]
         u0 = float(np.ravel(u)[0])
         cmd = valve_command_for_opening(P, u0) if by_opening else u0
         dy = np.zeros(N_STATES)

@@ -9,7 +9,8 @@
   and the bristles held (a shut valve and pre-sliding friction leave them free otherwise), and the
   answer refused when it is not a physical rest state (:func:`check_physical`).
 
-Plant B's state feedback (``controller.type = "state_feedback"``) is not offered here.
+A plant kind without govcheck's closed-loop linear model (plant B's state feedback,
+``PlantKind.linear_support``) is refused.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ from compliance.errors import InputError
 from compliance.linear.nlsys import OPENING_INPUT, to_nlsys
 from compliance.model.config import PlantConfig
 from compliance.model.pid_controller import dead_zone_compensation, saturate
+from compliance.plants import kind_of
 
 __all__ = ["CONTROLLER_STATES", "check_physical", "closed_loop_nlsys", "controller_nlsys", "find_rest_point"]
 
@@ -56,9 +58,7 @@ def controller_nlsys(cfg: PlantConfig, *, name: str = "controller"):
     """
     import control
 
-    if cfg.options.get("controller.type", "pid") != "pid":
-        raise InputError(f"{cfg.path or cfg.name}: controller.type '{cfg.options['controller.type']}' has no "
-                         "python-control form here (the PID only)")
+    kind_of(cfg).check_linear(cfg)  # a plant kind without the PID has no python-control form here
     defaults = {k: float(cfg.p(v)) for k, v in _CTRL_KEYS.items()}
     if defaults["filter_hz"] <= 0.0:
         raise InputError(f"{cfg.path or cfg.name}: controller.filter_cutoff must be > 0 for the continuous controller")

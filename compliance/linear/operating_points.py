@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from compliance.model.config import PlantConfig
 from compliance.errors import InputError
+from compliance.plants import kind_of
 
 
 def linear_for_campaign(cfg: PlantConfig, reqset, *, with_map: bool = True, workers: int | None = None) -> dict:
@@ -13,7 +14,8 @@ def linear_for_campaign(cfg: PlantConfig, reqset, *, with_map: bool = True, work
     Parameters
     ----------
     cfg : PlantConfig
-        A PID-controlled plant (the state-feedback plant B has no closed-loop linear model here).
+        A plant whose kind has the closed-loop linear model (``PlantKind.linear_support``: the PID servo);
+        any other gets a note and no analyses.
     reqset : RequirementSet
         Its operating points with an initial position are analysed (critical points).
     with_map : bool
@@ -31,9 +33,9 @@ def linear_for_campaign(cfg: PlantConfig, reqset, *, with_map: bool = True, work
     from compliance.simulation.scenario import scenario_load
 
     out: dict = {"schema": "govcheck-linear/1", "analyses": [], "notes": []}
-    if cfg.options["controller.type"] != "pid":
-        out["notes"].append(f"linear closed-loop analysis covers PID plants; {cfg.name} uses "
-                            f"controller.type = '{cfg.options['controller.type']}' (see docs/plant-b.md for its design model)")
+    why = kind_of(cfg).linear_support(cfg)
+    if why is not None:  # a plant kind without govcheck's closed-loop linear model
+        out["notes"].append(f"{cfg.name}: {why}")
         return out
     stroke = cfg.p("cylinder.stroke")
     seen, tasks = set(), []

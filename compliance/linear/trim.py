@@ -20,22 +20,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from compliance.effects.base import Balance
 from compliance.effects.catalogue import ALL_EFFECTS
+from compliance.effects.structure import trim_balance, trim_null, trim_states
 from compliance.model.config import PlantConfig
 from compliance.errors import InputError
-from compliance.effects.heat_transfer import S_TA, S_TB
-from compliance.effects.line_dynamics import S_PLA, S_PLB
-from compliance.effects.linkage_compliance import P_LK_K, P_LK_ON, S_V2, S_X2
-from compliance.effects.pressure_dependent_friction import P_PF_ON
-from compliance.effects.supply_droop import S_PSUP
-from compliance.effects.valve_dynamics import P_VD_ON, P_VD_WN, S_SP, S_SV
-from compliance.effects.valve_offset import P_VO_OFF, P_VO_ON
 from compliance.model.vector_slots import (EFFECT_SLOTS, N_AUX, N_STATES, P_AREA_CAP, P_AREA_ROD, P_ARR, P_BV, P_DZN, P_DZP,
                                            P_FC, P_FRM, P_FS, P_GAMMA, P_KV2, P_PATM, P_PS, P_STROKE, P_TS, P_UCEN, P_USAT,
-                                           P_V0, P_VD_STAGE, P_VLIM, S_PA, S_PB, S_V, S_X, S_Z1, S_Z2, STATE_NAMES)
+                                           P_V0, P_VD_STAGE, P_VLIM, S_PA, S_PB, S_V, S_X, S_Z1, S_Z2, SHADOWS, STATE_INDEX,
+                                           STATE_NAMES)
 from compliance.model.assembly import plant_rhs
 from compliance.model.plant_vector import load_curve_arrays, parameter_vector
-from compliance.model.rest_state import initial_state, load_force
+from compliance.model.rest_state import initial_state, load_force, pneumatic_forces
 
 GAIN_CHOICES = ("mean", "opening", "closing")
 REL_STEP = 1e-6  # central-difference step relative to each state's scale (truncation ~1e-12, rounding ~1e-10)
@@ -123,15 +119,14 @@ def trim(cfg: PlantConfig, position: float, load: float | str | None = None, *, 
     # a linear valve gain commutes with the valve's lag: filtering the command (spool stage) or the
     # opening it asks for (opening stage) is the same linear model, so both linearise as the spool
     P[P_VD_STAGE] = 0.0
-    linkage = bool(P[P_LK_ON]) and P[P_ARR] == 0.0
-    x2 = position
-    f_here = load_force_at(cfg, P, position)
-    for _ in range(50 if linkage else 1):  # fixed point; contracts while the linkage is stiffer than the load curve
-        # with linkage compliance each cylinder carries half the gate-ring load at its own position
-        f = 0.5 * (f_here + load_force_at(cfg, P, x2)) if linkage else f_here
-        pa, pb, cap_closing, cap_opening = _rest_pressures(P, f)
-        if linkage:  # 2A1 at rest without friction: f1 + K (x2 - x) = F(x)/2
-            x2 = position + (0.5 * f_here - (pa * P[P_AREA_CAP] - pb * P[P_AREA_ROD])) / P[P_LK_K]
+    balance = Balance(position=position, tandem=bool(P[P_ARR] == 0.0), load=lambda x: load_force_at(cfg, P, x),
+                      pressures=lambda f: _rest_pressures(P, f), piston_force=lambda pa, pb: pneumatic_forces(P, pa, pb)[0])
+    shared = trim_balance(P, balance)  # an effect that shares the load between two bodies (a compliant linkage)
+    if shared is None:
+        f = load_force_at(cfg, P, position)
+        (pa, pb, cap_closing, cap_opening), states = _rest_pressures(P, f), {}
+    else:
+        f, (pa, pb, cap_closing, cap_opening), states = shared
     ps, patm = P[P_PS], P[P_PATM]
     if not (patm <= pa <= ps and patm <= pb <= ps):
         raise InputError(
@@ -140,10 +135,10 @@ def trim(cfg: PlantConfig, position: float, load: float | str | None = None, *, 
             f"((p_s - p_atm) x area)"
         )
     y = initial_state(cfg, P, position, (pa, pb))
-    y[S_X2] = x2
-    null = P[P_UCEN] - (P[P_VO_OFF] if P[P_VO_ON] else 0.0)
-    if P[P_VD_ON]:
-        y[S_SP] = null
+    for index, value in states.items():
+        y[index] = value
+    null = trim_null(P, P[P_UCEN])  # the effects' shift of the valve's null (valve_offset)
+    trim_states(P, y, null)  # the effects' states at the trim (a spool at the null)
     Pl = viscous_parameters(P)
     dy = rhs(Pl, y, null, cfg)
     scale = state_scales(Pl)
@@ -166,9 +161,9 @@ def viscous_parameters(P: np.ndarray) -> np.ndarray:
     """Parameter vector whose friction is only the viscous term b*v (variable-viscous model, F_S = F_C = 0).
 
     With F_S = F_C = 0 and no limit speed, seed 000 eq. (7) reduces to F = b*v; the stick band,
-    the Stribeck dip and the LuGre bristles (Canudas de Wit 1995) are switched off, and so is the
-    pressure-dependent Coulomb increment (a Coulomb term too). For the piecewise Stribeck model
-    of seed 001 eq. (8) the viscous part is k_v2*v.
+    the Stribeck dip and the LuGre bristles (Canudas de Wit 1995) are switched off, and so are the
+    effects' friction-level terms (``friction_level`` hook: factors on the static and Coulomb
+    levels, gone with them). For the piecewise Stribeck model of seed 001 eq. (8) the viscous part is k_v2*v.
     """
     Pl = P.copy()
     if Pl[P_FRM] == 2.0:
@@ -177,7 +172,9 @@ def viscous_parameters(P: np.ndarray) -> np.ndarray:
     Pl[P_FS] = 0.0
     Pl[P_FC] = 0.0
     Pl[P_VLIM] = 0.0
-    Pl[P_PF_ON] = 0.0
+    for eff in ALL_EFFECTS:
+        if "friction_level" in eff.terms:
+            Pl[EFFECT_SLOTS[eff.name][0]] = 0.0
     return Pl
 
 
@@ -197,16 +194,28 @@ def rhs(P: np.ndarray, y: np.ndarray, u: float, cfg: PlantConfig) -> np.ndarray:
 
 
 def state_scales(P: np.ndarray) -> np.ndarray:
-    """Typical magnitude of each state (used for step sizes and for balancing)."""
+    """Typical magnitude of each state (used for step sizes and for balancing); an effect's states by their
+    declared ``State.scale``."""
+    scales = {"stroke": P[P_STROKE], "speed": 0.1,  # m/s, the order of the full-stroke speeds
+              "pressure": P[P_PS], "temperature": P[P_TS], "command": max(P[P_USAT], 1.0)}
     s = np.ones(N_STATES)
-    s[[S_X, S_X2]] = P[P_STROKE]
-    s[[S_V, S_V2]] = 0.1  # m/s, the order of the full-stroke speeds
-    s[[S_PA, S_PB, S_PSUP, S_PLA, S_PLB]] = P[P_PS]
-    s[[S_TA, S_TB]] = P[P_TS]
+    s[S_X] = scales["stroke"]
+    s[S_V] = scales["speed"]
+    s[[S_PA, S_PB]] = scales["pressure"]
     s[[S_Z1, S_Z2]] = 1e-5
-    s[S_SP] = max(P[P_USAT], 1.0)
-    s[S_SV] = max(P[P_USAT], 1.0) * max(P[P_VD_WN], 1.0)
+    for eff in ALL_EFFECTS:
+        for st in eff.states:
+            s[st.index] = st.scale(P, scales) if callable(st.scale) else scales[st.scale]
     return s
+
+
+def _command_state(P: np.ndarray) -> tuple[int, list[int]] | None:
+    """(index of the state carrying the valve command to the ports, its effect's state indices) of an
+    effect switched on that declares one (``Effect.command_state``: a spool), or None."""
+    for eff in ALL_EFFECTS:
+        if eff.command_state and P[EFFECT_SLOTS[eff.name][0]]:
+            return STATE_INDEX[eff.command_state], [st.index for st in eff.states]
+    return None
 
 
 def kept_states(P: np.ndarray) -> list[int]:
@@ -232,7 +241,7 @@ def state_jacobian(op: TrimPoint, cfg: PlantConfig, keep: list[int]) -> np.ndarr
     for j, s in enumerate(keep):
         h = REL_STEP * scale[s]
         lo, hi = -h, h
-        if s in (S_X, S_X2):
+        if s == S_X or SHADOWS.get(s) == S_X:  # a position: never across an end of the stroke
             if y0[s] - h < 0.0:
                 lo = 0.0 - y0[s]
             if y0[s] + h > L:
@@ -241,8 +250,9 @@ def state_jacobian(op: TrimPoint, cfg: PlantConfig, keep: list[int]) -> np.ndarr
         ym = y0.copy()
         yp[s] += hi
         ym[s] += lo
-        if s == S_X and not (P[P_LK_ON] and P[P_ARR] == 0.0):
-            yp[S_X2], ym[S_X2] = yp[S_X], ym[S_X]  # the second cylinder moves with the first
+        for copy, of in SHADOWS.items():  # a state that does not move on its own follows its original
+            if of == s and copy not in keep:
+                yp[copy], ym[copy] = yp[s], ym[s]
         J[:, j] = ((rhs(P, yp, u, cfg) - rhs(P, ym, u, cfg)) / (hi - lo))[keep]
     return J
 
@@ -270,15 +280,15 @@ def flow_columns(op: TrimPoint, cfg: PlantConfig, keep: list[int]) -> tuple[np.n
     slope at null; with a meter-out throttle in series it is the small-opening slope.
     """
     P, y0, null = op.params, op.state, op.valve_null
-    spool = bool(P[P_VD_ON])
+    carrier = _command_state(P)
 
     def at(u):
-        if not spool:
+        if carrier is None:
             return rhs(P, y0, u, cfg)
         y = y0.copy()
-        y[S_SP] = u  # the spool carries the command to the ports
+        y[carrier[0]] = u  # the spool carries the command to the ports
         d = rhs(P, y, null, cfg)
-        d[[S_SP, S_SV]] = 0.0  # the spool's own rows are not a flow effect
+        d[carrier[1]] = 0.0  # the spool's own rows are not a flow effect
         return d
 
     cols = []
@@ -307,7 +317,7 @@ def input_column(op: TrimPoint, cfg: PlantConfig, keep: list[int], gain: str = "
     b = {"mean": 0.5 * (b_open + b_close), "opening": b_open, "closing": b_close}[gain]
     info = {"gain": gain, "opening_per_volt": {"opening": k_open, "closing": k_close}}
     P = op.params
-    if not P[P_VD_ON]:
+    if _command_state(P) is None:
         return b, None, info
     # spool on: u_d drives the spool (unity static gain), the spool drives the flows with b
     h = 1e-6 * max(P[P_USAT], 1.0)
@@ -321,8 +331,9 @@ def linearise_plant(op: TrimPoint, cfg: PlantConfig, gain: str = "mean"):
     A = state_jacobian(op, cfg, keep)
     B, spool_col, info = input_column(op, cfg, keep, gain)
     if spool_col is not None:
-        j = keep.index(S_SP)
-        rows = [i for i, s in enumerate(keep) if s not in (S_SP, S_SV)]
+        carrier, own = _command_state(op.params)
+        j = keep.index(carrier)
+        rows = [i for i, s in enumerate(keep) if s not in own]
         A[rows, j] = spool_col[rows]
     C = np.zeros((1, len(keep)))
     C[0, keep.index(S_X)] = 1.0

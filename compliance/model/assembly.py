@@ -319,3 +319,22 @@ def friction_level_at(P, x, pa, pb):
 def load_terms_at(P, x, force):
     """Closing ``force`` [N] plus the effects' load terms at position ``x`` [m], as in ``plant_rhs``."""
     return LOAD_FORCE(P, x, P[P_STROKE], force)
+
+
+def second_body(P, y) -> tuple[float, float, bool]:
+    """(position [m], speed [m/s], linked) of cylinder 2A2 as ``plant_rhs`` sees it.
+
+    Its own states while a compliant linkage couples the tandem pair (``linked``), else 2A1's
+    (the rigid pair moves as one body; a single cylinder has no second body).
+    """
+    if P[P_LK_ON] != 0.0 and P[P_ARR] == 0.0:
+        return y[S_X2], y[S_V2], True
+    return y[S_X], y[S_V], False
+
+
+@njit(cache=True, error_model="numpy")
+def settle_valve(P, y, u_valve):
+    """Put the valve's lag states at rest under the command ``u_valve`` [V] (in place): the spool of
+    ``valve_dynamics`` where that command holds it (``valve_lag_input``); nothing while it is off."""
+    if P[P_VD_ON] != 0.0:
+        y[S_SP] = valve_lag_input(P, u_valve)

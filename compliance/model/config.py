@@ -21,7 +21,7 @@ from compliance.files.atomic import write_text_atomic
 from compliance.files.shipped import resolve_shipped
 from compliance.model.assumptions import read_assumptions
 from compliance.model.config_fields import SECTIONS, atmosphere_of, effect_values, load_curve_field, section_values
-from compliance.model.parameters import BASE_BY_KEY, BASE_PARAMS, OPTIONS
+from compliance.model.parameters import BASE_BY_KEY, BASE_PARAMS, OPTIONS, used_by_model
 from compliance.model.identity import parse_identity
 from compliance.model.toml_file import read_toml
 
@@ -225,9 +225,9 @@ def _check_physical(cfg: PlantConfig, where: str) -> None:
         raise InputError(f"{where}: valve.flow_law = '{law}' needs {need} > 0")
     limiter = [k for k in ("controller.setpoint_opening_rate", "controller.setpoint_closing_rate", "controller.end_zone_rate")
                if p[k] > 0.0]
-    if limiter and cfg.options["controller.type"] != "pid":
+    if limiter and not used_by_model("controller.kp", cfg.options):  # the PID's parameters are read only when it runs
         raise InputError(f"{where}: {limiter[0]}: the set-point rate limiter is an option of the PID controller "
-                         f"(controller.type = 'pid'), not of '{cfg.options['controller.type']}'")
+                         f"(controller.type = 'pid'), which this configuration does not run")
     if p["controller.end_zone_rate"] > 0.0 and not 0.0 < p["controller.end_zone_width"] < 0.5 * p["cylinder.stroke"]:
         raise InputError(f"{where}: controller.end_zone_width must be > 0 and below half the stroke when "
                          "controller.end_zone_rate is set")

@@ -177,9 +177,10 @@ def stall_error(cfg: PlantConfig, direction: str = "opening") -> float:
     zmd, i.e. at u_d = zmd*lc/(zmd' + lc/md'), so at |e| = that / K_P (derivative and integral
     terms are ~0 at rest). With zme, me for the closing direction; without smoothing (lc = 0) the
     mismatch of the valve and compensator dead zones divided by K_P. Paper values: 0.86 mm.
+    The band of the configuration's PID; a plant kind without it says so (``PlantKind.stall_error``).
     """
     p = cfg.params
-    if cfg.options["controller.type"] != "pid" or p["controller.kp"] <= 0.0:
+    if p["controller.kp"] <= 0.0:
         return 0.0
     side = "positive" if direction == "opening" else "negative"
     lc, kp = p["controller.compensation_width"], p["controller.kp"]

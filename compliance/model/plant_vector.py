@@ -10,9 +10,9 @@ import math
 
 import numpy as np
 
+from compliance.effects import EFFECTS
 from compliance.errors import InputError
 from compliance.model.config import PlantConfig
-from compliance.effects.linkage_compliance import P_LK_ON
 from compliance.model.vector_slots import (BASE_SLOTS, EFFECT_SLOTS, N_PARAMS, P_AREA_CAP, P_AREA_ROD, P_ARR,
                                            P_FC_ON, P_FJ, P_FRM, P_KV1, P_LAW, P_LOAD, P_LOADMODE, P_NFR, P_RL_CLOSE,
                                            P_RL_END_RATE, P_RL_ON, P_RL_OPEN, P_VD, P_VD_STAGE)
@@ -36,8 +36,9 @@ def parameter_vector(cfg: PlantConfig, *, load: float | str | None = None, flow_
     Raises
     ------
     InputError
-        Piecewise Stribeck friction that would aid the motion; linkage compliance on a single
-        cylinder; a load curve asked for but not defined.
+        Piecewise Stribeck friction that would aid the motion; an effect switched on without the
+        options it needs (``Effect.requires``: linkage compliance on a single cylinder); a load
+        curve asked for but not defined.
     """
     p = cfg.params
     P = np.zeros(N_PARAMS)
@@ -77,8 +78,10 @@ def parameter_vector(cfg: PlantConfig, *, load: float | str | None = None, flow_
             f"{cfg.path or cfg.name}: friction.breakaway_force - friction.low_speed_coefficient * friction.critical_velocity "
             f"= {P[P_FJ] - P[P_KV1] * P[P_VD]:g} N; seed 001 eq. (8) needs it >= 0 (friction never aids the motion)"
         )
-    if P[P_LK_ON] and not tandem:
-        raise InputError(f"{cfg.path or cfg.name}: effect linkage_compliance needs cylinder.arrangement = 'tandem'")
+    for name in cfg.effects:
+        for option, value in EFFECTS[name].requires.items():
+            if cfg.options[option] != value:
+                raise InputError(f"{cfg.path or cfg.name}: effect {name} needs {option} = '{value}'")
     return P
 
 

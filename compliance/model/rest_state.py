@@ -9,13 +9,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from compliance.effects.base import Rest
+from compliance.effects.structure import at_rest, hold_at_rest
 from compliance.model.config import PlantConfig
 from compliance.model.plant_vector import load_curve_arrays
-from compliance.effects.heat_transfer import S_TA, S_TB
-from compliance.effects.line_dynamics import S_PLA, S_PLB
-from compliance.effects.linkage_compliance import P_LK_K, P_LK_ON, S_X2
-from compliance.effects.supply_droop import S_PSUP
-from compliance.model.assembly import friction_level_at, load_terms_at
+from compliance.model.assembly import friction_level_at, load_terms_at, second_body
 from compliance.model.vector_slots import (N_STATES, P_AREA_CAP, P_AREA_ROD, P_ARR, P_BV, P_CSTOP, P_FC, P_FRM, P_FS, P_KSTOP,
                                            P_LOAD, P_LOADMODE, P_NFR, P_PATM, P_PS, P_SIG0, P_STROKE, P_TS, P_VS, S_PA, S_PB,
                                            S_X, S_Z1, S_Z2)
@@ -40,44 +38,42 @@ def pneumatic_forces(P: np.ndarray, pa: float, pb: float) -> tuple[float, float]
     return single_force(pa, pb, P[P_AREA_CAP], P[P_AREA_ROD], P[P_PATM]), 0.0  # seed 001 eq. (9)
 
 
+def rest_of(P: np.ndarray, y: np.ndarray, lx: np.ndarray, ly: np.ndarray) -> Rest:
+    """The servo at rest as the effects' rest hooks read it: position, pressures, forces and load of ``y``."""
+    # positional and unconverted: a replay builds one at every restart
+    return Rest(y[S_X], y[S_PA], y[S_PB], P[P_PS], P[P_TS], P[P_STROKE], P[P_ARR] == 0.0,
+                pneumatic_forces(P, y[S_PA], y[S_PB]), lambda at: load_force(P, at, lx, ly))
+
+
 def set_rest_internal_states(P: np.ndarray, y: np.ndarray, lx: np.ndarray, ly: np.ndarray, v: float = 0.0) -> None:
     """Set the unmeasured mechanical states consistent with position, speed and pressures (in place).
 
     A servo found at rest with given pressures is held there: the net force sits in the
-    static friction (LuGre bristles deflected, Canudas de Wit et al. 1995) and a compliant
-    linkage carries its share of the load. Without this a recording that starts from measured
-    pressures would slip at t = 0 and a relaxed linkage under load would jump.
+    static friction (LuGre bristles deflected, Canudas de Wit et al. 1995) and the effects that
+    share the load take their share (``Effect.hold``: a compliant linkage). Without this a
+    recording that starts from measured pressures would slip at t = 0 and a relaxed linkage under
+    load would jump.
 
     Parameters
     ----------
     P : ndarray
         Parameter vector.
     y : ndarray
-        State; reads x, p_A, p_B; writes x2 (linkage compliance) and z1, z2 (LuGre).
+        State; reads x, p_A, p_B; writes the load-sharing states (a compliant linkage's x2) and z1, z2 (LuGre).
     lx, ly : ndarray
         Load curve (``load_curve_arrays``).
     v : float
         Speed [m/s]; sliding bristles sit at the steady deflection g(v)/sigma0.
     """
     x = y[S_X]
-    f1, f2 = pneumatic_forces(P, y[S_PA], y[S_PB])
-    linkage = P[P_LK_ON] != 0.0 and P[P_ARR] == 0.0
-    x2 = x
-    load1 = 0.5 * load_force(P, x, lx, ly)  # each cylinder carries half the gate-ring load (plant_rhs)
-    if linkage:
-        # both bodies rest with equal friction shares: f1 + f_link - F(x)/2 = f2 - f_link - F(x2)/2,
-        # f_link = K (x2 - x); fixed point in x2 (contracts while K exceeds the load stiffness)
-        for _ in range(50):
-            x2_new = x + 0.5 * (f2 - f1 + load1 - 0.5 * load_force(P, x2, lx, ly)) / P[P_LK_K]
-            x2_new = min(max(x2_new, 0.0), P[P_STROKE])  # a link too soft to carry it leaves 2A2 on its end stop
-            if abs(x2_new - x2) < 1e-12:
-                x2 = x2_new
-                break
-            x2 = x2_new
-        y[S_X2] = x2
+    rest = rest_of(P, y, lx, ly)
+    f1, f2 = rest.piston_forces
+    hold_at_rest(P, y, rest)  # the load-sharing states (a compliant linkage's 2A2)
+    x2, _, linkage = second_body(P, y)  # the second body as plant_rhs sees it (2A1 itself when rigidly coupled)
     if not (P[P_FRM] == 0.0 and P[P_SIG0] > 0.0):
         return
-    f_load = load1 + 0.5 * load_force(P, x2, lx, ly) if linkage else load_force(P, x, lx, ly)
+    # each cylinder of a compliant linkage carries half the gate-ring load at its own position (plant_rhs)
+    f_load = 0.5 * load_force(P, x, lx, ly) + 0.5 * load_force(P, x2, lx, ly) if linkage else load_force(P, x, lx, ly)
     net = f1 + f2 - f_load + end_stop_force(x, 0.0, P[P_STROKE], P[P_KSTOP], P[P_CSTOP])
     n = P[P_NFR] if not linkage else 2.0
     z = (net / n - P[P_BV] * v) / P[P_SIG0]
@@ -93,12 +89,12 @@ def initial_state(cfg: PlantConfig, P: np.ndarray, x0: float, pressures: tuple[f
 
     This is the practice emulator's convention (ANSWERS.md) and the trim a test bench
     reaches after holding a position. Given ``pressures`` (p_A, p_B) [Pa abs] replace the
-    balance; either way the bristles and a compliant linkage start deflected so that the
-    servo is held where it is (``set_rest_internal_states``).
+    balance; the effects put their states at rest (``Effect.rest``); either way the bristles and
+    the load-sharing states start deflected so that the servo is held where it is
+    (``set_rest_internal_states``).
     """
     y = np.zeros(N_STATES)
     y[S_X] = x0
-    y[S_X2] = x0
     lx, ly = load_curve_arrays(cfg)
     f_load = load_force(P, x0, lx, ly)
     ps, patm = P[P_PS], P[P_PATM]
@@ -117,10 +113,6 @@ def initial_state(cfg: PlantConfig, P: np.ndarray, x0: float, pressures: tuple[f
     pb = min(max(pb, lo), ps)
     y[S_PA] = pa
     y[S_PB] = pb
-    y[S_TA] = P[P_TS]
-    y[S_TB] = P[P_TS]
-    y[S_PSUP] = ps
-    y[S_PLA] = pa
-    y[S_PLB] = pb
+    at_rest(P, y, rest_of(P, y, lx, ly))  # the effects' states at rest (gas at T_s, reservoir at p_s, ...)
     set_rest_internal_states(P, y, lx, ly)  # held at rest: bristles carry the net force, the link its share
     return y

@@ -48,7 +48,8 @@ N_CTRL = len(_NAMES)
 (C_MODE, C_COMP, C_FF, C_KX, C_KV, C_KA, C_D0, C_D1, C_D2, C_N0, C_AO_LX, C_AO_LV, C_AO_POLE, C_AO_IN, C_AO_SX, C_AO_SV,
  C_FO_L, C_FO_POLE, C_FO_IN, C_FO_SV, C_AREA_RATIO, C_PATM, C_LOAD_PRESSURE, C_FORCE_GAIN, C_FORCE_RATE_GAIN, C_VISCOUS, C_RATE_ALPHA, C_VEL_ALPHA, C_KP, C_KI, C_KD, C_PID_ALPHA,
  C_TS) = range(N_CTRL)
-MODES = {"pid": 0.0, "state_feedback": 1.0}
+STATE_FEEDBACK = 1.0  # C_MODE of the seed 001 controller; 0.0: the configuration's PID on the same loop (comparison)
+MODES = {"pid": 0.0, "state_feedback": STATE_FEEDBACK}
 # "inverse": G_f(s) = -1/(K_0 G(s)) with the valve -> force path an integrator (the default);
 # "static": F_f^ through the loop's static force gain (fails: docs/plant-b.md, kept for that figure)
 COMPENSATION_FORMS = {"inverse": 1.0, "static": 2.0}
@@ -119,8 +120,8 @@ def controller_vector(cfg: PlantConfig, *, mode: str | None = None, compensation
     Parameters
     ----------
     cfg : PlantConfig
-    mode : {"pid", "state_feedback"}, optional
-        Default ``controller.type``.
+    mode : {"state_feedback", "pid"}, optional
+        The seed 001 state feedback (default), or the configuration's PID on the same loop (comparison).
     compensation, feedforward : bool, optional
         Default ``controller.friction_compensation`` / ``controller.feedforward``.
     x0 : float, optional
@@ -133,11 +134,12 @@ def controller_vector(cfg: PlantConfig, *, mode: str | None = None, compensation
     """
     if compensation_form not in COMPENSATION_FORMS:
         raise InputError(f"compensation form '{compensation_form}' is not one of {', '.join(COMPENSATION_FORMS)}")
-    mode = cfg.options["controller.type"] if mode is None else mode
+    mode = "state_feedback" if mode is None else mode
     if mode not in MODES:
         raise InputError(f"controller mode '{mode}' is not one of {', '.join(MODES)}")
+    state_feedback = MODES[mode] == STATE_FEEDBACK
     if compensation is None:  # the configured compensation belongs to the state feedback only
-        comp = cfg.options["controller.friction_compensation"] == "true" and mode == "state_feedback"
+        comp = cfg.options["controller.friction_compensation"] == "true" and state_feedback
     else:
         comp = bool(compensation)
     ff = cfg.options["controller.feedforward"] == "true" if feedforward is None else bool(feedforward)
@@ -156,13 +158,13 @@ def controller_vector(cfg: PlantConfig, *, mode: str | None = None, compensation
     C[C_PID_ALPHA] = first_order_filter_gain(p("controller.filter_cutoff"), ts)
     C[C_FF] = 1.0 if ff else 0.0
     where = cfg.path or cfg.name
-    needs_sf = mode == "state_feedback" or comp
+    needs_sf = state_feedback or comp
     if needs_sf:
         poles, gains, ao, fo, force_gain = _state_feedback_design(cfg, model, where)
     else:
         gains, poles, force_gain = np.zeros(3), np.zeros(0), 0.0
         ao = fo = design.ReducedObserver(np.zeros(2), -1.0, np.zeros(1), np.zeros(2))
-    if comp and mode != "state_feedback":
+    if comp and not state_feedback:
         raise InputError(f"{where}: controller.friction_compensation needs controller.type = 'state_feedback' (seed 001 fig. 6)")
     C[C_KX], C[C_KV], C[C_KA] = gains
     _pack_observers(C, ao, fo)

@@ -12,10 +12,12 @@ from compliance.model.parameters import BASE_PARAMS
 
 # ---- parameter vector ------------------------------------------------------------------------
 # Entries are never renumbered: numba caches compiled kernels with these integers frozen in and
-# does not notice when this module changes, so new entries are appended (a new effect's after the
-# last one). Base parameters fill their declared ``slot`` (``parameters.BASE_PARAMS``); the other
-# core entries are computed by ``parameter_vector``.
-_CORE_HEAD = (
+# does not notice when this module changes. Each effect declares where its entries start
+# (``Effect.slot``: its flag, then its parameters in declared order); the core's entries below fill
+# the other indices in order, so a new core entry is appended here and a new effect takes the first
+# index after every existing entry. Base parameters fill their declared ``slot``
+# (``parameters.BASE_PARAMS``); the other core entries are computed by ``parameter_vector``.
+_CORE = (
     # geometry and mass
     "stroke", "area_cap", "area_rod", "dead_volume", "mass", "arrangement", "n_friction",
     # air
@@ -33,30 +35,40 @@ _CORE_HEAD = (
     "load_mode", "load_const",
     # controller
     "kp", "ki", "kd", "ts", "filt_hz", "lc", "cdz_pos", "cdz_neg", "cslope_pos", "cslope_neg", "u_lim",
-)
-_CORE_TAIL = (
     # piecewise Stribeck friction, seed 001 eq. (8)
     "f_breakaway", "kv_low", "v_critical", "kv_high",
     # valve dynamics stage: 0 the spool filters the command (before the dead zone), 1 the lag acts on the opening
     "vd_stage",
+    # set-point rate limiter of the PID loop
+    "rl_on", "rl_open", "rl_close", "rl_end_rate", "rl_end_width", "rl_lead",
 )
-# the first effects' entries sit between the head and the tail (their indices predate the tail)
-_EFFECTS_BEFORE_TAIL = 11
 
 
-def _effect_entries(effects) -> list[str]:
-    """Flag then parameters of each effect: ``<short>_on``, ``<short>_<slot>``."""
-    return [n for e in effects for n in (f"{e.short}_on", *(f"{e.short}_{p.slot}" for p in e.params))]
+def _layout(effects, core) -> tuple[str, ...]:
+    """Entry names by index: each effect's ``<short>_on``, ``<short>_<param slot>`` from its declared
+    ``slot``, the core's entries in order in the indices left free.
+
+    Raises
+    ------
+    ValueError
+        Two effects claim one index, or the entries leave a gap.
+    """
+    taken: dict[int, str] = {}
+    for e in effects:
+        for i, name in enumerate((f"{e.short}_on", *(f"{e.short}_{p.slot}" for p in e.params))):
+            if e.slot < 0 or e.slot + i in taken:
+                raise ValueError(f"effect {e.name}: entry {name} at index {e.slot + i} "
+                                 + ("(no slot declared)" if e.slot < 0 else f"is taken by {taken[e.slot + i]}"))
+            taken[e.slot + i] = name
+    rest = iter(core)
+    names = [taken[i] if i in taken else next(rest, None) for i in range(len(taken) + len(core))]
+    if None in names:
+        raise ValueError(f"parameter-vector entries leave a gap at index {names.index(None)}: "
+                         "an effect's slot must be the first index after every existing entry")
+    return tuple(names)
 
 
-# set-point rate limiter of the PID loop (appended after every effect's entries: their indices predate it)
-_RATE_LIMITER = ("rl_on", "rl_open", "rl_close", "rl_end_rate", "rl_end_width", "rl_lead")
-# effects declared after these 12 go after the rate limiter's entries (fixed count: no index may move)
-_EFFECTS_BEFORE_LIMITER = 12
-
-PARAM_NAMES = (*_CORE_HEAD, *_effect_entries(ALL_EFFECTS[:_EFFECTS_BEFORE_TAIL]), *_CORE_TAIL,
-               *_effect_entries(ALL_EFFECTS[_EFFECTS_BEFORE_TAIL:_EFFECTS_BEFORE_LIMITER]), *_RATE_LIMITER,
-               *_effect_entries(ALL_EFFECTS[_EFFECTS_BEFORE_LIMITER:]))
+PARAM_NAMES = _layout(ALL_EFFECTS, _CORE)
 N_PARAMS = len(PARAM_NAMES)
 PI = {n: i for i, n in enumerate(PARAM_NAMES)}
 
@@ -151,8 +163,13 @@ if sorted(_STATE_SLOTS) != list(range(len(_STATE_SLOTS))):
     raise ValueError(f"state indices must be 0..n-1 without gaps, got {sorted(_STATE_SLOTS)}")
 STATE_NAMES = tuple(_STATE_SLOTS[i][0] for i in range(len(_STATE_SLOTS)))
 N_STATES = len(STATE_NAMES)
+STATE_INDEX = {n: i for i, n in enumerate(STATE_NAMES)}
 S_X, S_V, S_PA, S_PB, S_Z1, S_Z2 = 0, 1, 2, 3, 6, 7
 # an effect's states: the constants S_<slot> its module writes out (e.g. compliance.effects.heat_transfer.S_TA)
+
+# state -> the state it copies while it does not move on its own: 2A2's bristle copies 2A1's unless an
+# effect frees it (``Effect.frees``), an effect's shadowing state copies its core state while the effect is off
+SHADOWS = {S_Z2: S_Z1, **{s.index: STATE_INDEX[s.shadows] for e in ALL_EFFECTS for s in e.states if s.shadows}}
 
 # ---- auxiliary outputs of the right-hand side ---------------------------------------------------
 AUX_NAMES = ("friction_force", "load_force", "flow_a", "flow_b", "opening", "pneumatic_force", "supply_flow")

@@ -27,7 +27,8 @@ from compliance.papers.plant_a_fig8 import fig8, format_fig8
 from compliance.metrics import find_steps, speed_extremes, step_response, stroke_time
 from compliance.simulation.scenario import stroke_start_pressures
 from compliance.simulation.profiles import Profile, steps
-from compliance.simulation import Scenario, simulate
+from compliance.simulation import Scenario
+from compliance.plants import simulate
 
 SETTLING_BAND = 0.05  # fraction of the actual change
 SETTLING_TOLERANCE = 0.35  # relative

@@ -19,7 +19,8 @@ import numpy as np
 
 from compliance.metrics import find_steps, step_response
 from compliance.model.config import PlantConfig
-from compliance.simulation import Scenario, simulate
+from compliance.simulation import Scenario
+from compliance.plants import simulate
 from compliance.simulation.profiles import steps
 
 X0_FRACTION = 0.4

@@ -94,12 +94,13 @@ def _path_figure(runs: dict, path: Path) -> None:
     import matplotlib.pyplot as plt
 
     from compliance.report.figures_tracking import draw_path
+    from compliance.results.runs import Trace
 
     fig, axes = plt.subplots(1, 3, figsize=(12, 3.6), gridspec_kw={"width_ratios": [1, 1, 1.6]})
     for name, r in runs.items():
         tr = [t for t in r["traces"] if t.get("kind") == "path3d"][0]
         if name == "PID":
-            draw_path(axes[0], axes[2], tr, label="PID", color=_COLORS[name], errors=False)
+            draw_path(axes[0], axes[2], Trace.from_dict(tr), label="PID", color=_COLORS[name], errors=False)
             axes[0].set_title("PID (the error is visible at this scale)", fontsize=9)
         else:
             axes[2].plot(tr["time"], np.asarray(tr["path_deviation"]) * MM, color=_COLORS[name], lw=1.0, label=name)

@@ -13,8 +13,10 @@ the report's (typographic minus, ``≤``, units typeset).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 from compliance.metrics.catalogue import METRICS
-from compliance.units.formatting import fmt_margin_pct, fmt_value, unit_text
+from compliance.presentation.numbers import fmt_margin_pct, fmt_value, unit_text
 
 __all__ = ["OPEN_LIMIT", "limit_as_written", "metric_text", "resolved_limit", "row_texts"]
 
@@ -63,16 +65,17 @@ def _typeset(text: str) -> str:
     return text.replace("<=", "\u2264").replace(">=", "\u2265")
 
 
-def limit_as_written(entry: dict, *, unicode: bool = True) -> str:
+def limit_as_written(entry, *, unicode: bool = True) -> str:
     """A requirement's limit as written, with the resolved value beside a limit relative to the stroke.
 
-    ``entry`` is a results file's requirement entry (``limit_text`` as written, ``limit_display``
-    resolved, ``limit`` SI or None when open): ``<= 1 %stroke (1.60 mm)``; in the report
-    ``≤ 1 % stroke (1.60 mm)`` and an open limit in words.
+    ``entry`` is a requirement's verdict (a ``RequirementVerdict``, or a site's entry as its JSON
+    has it) with ``limit_text`` as written, ``limit_display`` resolved and ``limit`` SI or None when
+    open: ``<= 1 %stroke (1.60 mm)``; in the report ``≤ 1 % stroke (1.60 mm)`` and an open limit in words.
     """
-    written, shown = entry.get("limit_text") or "", entry.get("limit_display") or ""
+    get = entry.get if isinstance(entry, Mapping) else lambda k: getattr(entry, k)
+    written, shown = get("limit_text") or "", get("limit_display") or ""
     if unicode:
-        if entry.get("limit") is None:
+        if get("limit") is None:
             return OPEN_LIMIT
         written, shown = _typeset(written).replace(" .. ", " \u2013 "), _typeset(shown)
     text = written or shown

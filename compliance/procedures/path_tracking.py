@@ -17,6 +17,7 @@ from compliance.errors import InputError
 from compliance.procedures.kinds import KINDS, TRACKING, Kind, parse_setting
 from compliance.procedures.outcomes import MAX_TRACE_POINTS, TRACE_COLUMNS, Sample, downsample
 from compliance.metrics.path_tracking import axis_metrics, path_deviation, robot_metrics
+from compliance.plants import kind_of
 from compliance.tracking.paths import AXES, circle, helix, stroke_path
 from compliance.tracking.robot import cartesian_robot, run_robot
 from compliance.simulation.state_feedback_loop import AxisReference, simulate_axis
@@ -55,15 +56,6 @@ def _settings(cfg: PlantConfig, kind: Kind, options: dict) -> dict:
         elif isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v < 0:
             raise InputError(f"procedure '{kind.name}'.{k}: expected a non-negative number in SI units, got {v!r}")
     return out
-
-
-def _controller_choice(cfg, s):
-    if s["pid"]:
-        return "pid", False
-    comp = cfg.options["controller.friction_compensation"] == "true" and not s["without_compensation"]
-    if cfg.options["controller.type"] != "state_feedback":
-        return cfg.options["controller.type"], False
-    return "state_feedback", comp
 
 
 def run_procedure(cfg: PlantConfig, procedure_name: str, **options) -> dict:
@@ -106,8 +98,7 @@ def run_procedure(cfg: PlantConfig, procedure_name: str, **options) -> dict:
     x0 = 0.5 * stroke if x0 is None else float(_value(x0, stroke))
     noise = {k: float(options.get(k, 0.0) or 0.0) for k in ("position_noise", "position_quantum", "pressure_noise")}
     seed = int(options.get("seed", 0) or 0)
-    mode, comp = _controller_choice(cfg, s)
-    ctrl_text = "PID" if mode == "pid" else ("state feedback + friction compensation" if comp else "state feedback")
+    mode, comp, ctrl_text = kind_of(cfg).axis_controller(cfg, s)  # the plant kind's controller on the tracking loop
     if procedure_name == "axis_tracking":
         res = _run_axis(cfg, s, x0, options.get("load"), mode, comp, noise, seed)
     else:

@@ -63,7 +63,8 @@ def simulate_run(cfg, duration, x0, *, reference=None, command=None, load=None, 
 
     ``pressures``: initial chamber pressures (p_A, p_B) [Pa]; None = at rest balancing the load.
     """
-    from compliance.simulation import Scenario, simulate
+    from compliance.simulation import Scenario
+    from compliance.plants import simulate
 
     return simulate(cfg, Scenario(duration, x0, reference=reference, command=command, load=load, flow_control=flow_control,
                                   initial_pressures=pressures))

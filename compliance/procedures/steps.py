@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from compliance import metrics as M
-from compliance.model.pid_controller import stall_error
+from compliance.plants import kind_of
 from compliance.errors import InputError
 from compliance.procedures.scenarios import add_drive_samples, closed_loop_trace, full_command_stroke, start_position, stroke
 from compliance.procedures.outcomes import Sample, request_key
@@ -126,7 +126,8 @@ def run_steps(cfg, proc, op, requests, out):
     wanted.update({request_key(m, o): (m, o) for m, o in requests if "steps" in M.METRICS[m].kinds})
     sat = {+1: flow_saturation_voltage(cfg, +1, op.flow_control), -1: flow_saturation_voltage(cfg, -1, op.flow_control)}
     centre = cfg.p("valve.centre_voltage")
-    stall = {+1: stall_error(cfg, "opening"), -1: stall_error(cfg, "closing")}
+    kind = kind_of(cfg)
+    stall = {+1: kind.stall_error(cfg, "opening"), -1: kind.stall_error(cfg, "closing")}
     per_opts: dict = {}
     for key, (metric, opts) in wanted.items():
         okey = request_key("", opts)

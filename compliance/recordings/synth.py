@@ -22,7 +22,8 @@ from compliance.model.config import PlantConfig
 from compliance.errors import InputError
 from compliance.simulation.profiles import Profile
 from compliance.recordings.reader import sidecar_path
-from compliance.simulation import Scenario, SensorNoise, simulate
+from compliance.simulation import Scenario, SensorNoise
+from compliance.plants import simulate
 
 CANONICAL_COLUMNS = ("time", "position", "reference", "valve_command", "pressure_a", "pressure_b", "supply_pressure")
 

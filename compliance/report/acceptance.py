@@ -5,18 +5,18 @@ ASME PTC 29-2005 (R2020) test reports): scope and references, the equipment and 
 the test conditions, the instrumentation and method, the results against the guarantees, the
 departures from the test code, the conditions not tested, the conclusions with a disposition
 per failure, the parties, the revision history and the signatures. This module builds each of
-those sections from the results dict alone (no simulation here); the template lays them out.
+those sections from the check's result alone (no simulation here); the template lays them out.
 """
 
 from __future__ import annotations
 
-from compliance.errors import InputError
 from compliance.metrics import METRICS
 from compliance.metrics.catalogue import STEP_OPTION_DEFAULTS
+from compliance.presentation.quantities import fmt_quantity
 from compliance.presentation.values import limit_as_written, metric_text
 from compliance.requirements.verdict import Status
-from compliance.units.amounts import parse_amount
-from compliance.units.formatting import fmt_value, unit_text
+from compliance.results.check_result import CheckResult
+from compliance.presentation.numbers import fmt_value, unit_text
 
 # The plant paper as its own text gives it (title, laboratory, university); the copy used names no
 # authors, venue or year, so the citation says so instead of guessing them.
@@ -47,20 +47,20 @@ SMALL_HYDRO = ("IEC 62006:2010, Hydraulic machines \u2013 Acceptance tests of sm
 MARGIN_CRITERION = {"phase_margin_deg": 30.0, "gain_margin_db": 6.0}
 
 
-def standards_cited(results: dict) -> list[str]:
+def standards_cited(result: CheckResult) -> list[str]:
     """The governor standards the requirement file cites, each by its edition."""
     seen = []
-    for e in results["requirement_set"].get("requirements") or []:
-        std = str(e.get("standard") or "").replace("ANSI/", "")
+    for e in result.requirement_set.requirements:
+        std = str(e.standard or "").replace("ANSI/", "")
         for key, text in STANDARDS.items():
             if key.replace(" ", "") in std.replace(" ", "") and text not in seen:
                 seen.append(text)
     return seen
 
 
-def paper_citation(results: dict) -> str | None:
+def paper_citation(result: CheckResult) -> str | None:
     """The source paper of a reference plant, fully cited (``None`` for a user's plant)."""
-    name = str(results["plant"].get("name") or "")
+    name = str(result.plant.name or "")
     if name.startswith("plant-a"):
         return PLANT_A_PAPER
     if name.startswith("plant-b"):
@@ -68,25 +68,24 @@ def paper_citation(results: dict) -> str | None:
     return None
 
 
-def scope(results: dict) -> dict:
+_PROCEDURE_WORDS = {"steps": "small-step response (dead time, time constant, settling, positioning accuracy)",
+                    "full_stroke": "full-stroke opening and closing times and speeds",
+                    "independent_adjustment": "independent adjustment of the opening and closing speeds",
+                    "sine": "tracking of a sinusoidal set-point", "dead_band": "dead band (slow triangular set-point)",
+                    "hold": "holding a load (drift, limit cycle)"}
+
+
+def scope(result: CheckResult) -> dict:
     """What the report covers and what it does not (a servo-positioner test, not a governor test)."""
-    kinds = {p.get("kind") for p in (results["requirement_set"].get("procedures") or {}).values()}
-    covered = []
-    names = {"steps": "small-step response (dead time, time constant, settling, positioning accuracy)",
-             "full_stroke": "full-stroke opening and closing times and speeds",
-             "independent_adjustment": "independent adjustment of the opening and closing speeds",
-             "sine": "tracking of a sinusoidal set-point", "dead_band": "dead band (slow triangular set-point)",
-             "hold": "holding a load (drift, limit cycle)"}
-    for k in ("steps", "full_stroke", "independent_adjustment", "sine", "dead_band", "hold"):
-        if k in kinds:
-            covered.append(names[k])
-    covered += sorted(str(k).replace("_", " ") for k in kinds if k and k not in names)
-    standards = standards_cited(results)
+    kinds = {p.kind for p in result.requirement_set.procedures.values()}
+    covered = [words for k, words in _PROCEDURE_WORDS.items() if k in kinds]
+    covered += sorted(str(k).replace("_", " ") for k in kinds if k and k not in _PROCEDURE_WORDS)
+    standards = standards_cited(result)
     if not standards:  # not a governor servo (plant B's robot): no gate, no turbine, no small-hydro code
         return {"object": "the servo-pneumatic positioning system as modelled: valves, cylinders and the position "
                           "controller", "covered": covered,
                 "excluded": ["tests of the built system", "paths, loads and supply conditions other than the ones of "
-                             "section 2.1"], "standards": [], "paper": paper_citation(results)}
+                             "section 2.1"], "standards": [], "paper": paper_citation(result)}
     return {
         "object": "the servo-positioner alone: proportional valve, cylinders, meter-out flow-control valves and the "
                   "position controller, driving the wicket-gate ring against the modelled gate load",
@@ -96,33 +95,27 @@ def scope(results: dict) -> dict:
                      "emergency and quick closure (shut-down devices, closure on loss of air, power or signal)",
                      "the turbine, penstock and generator"],
         "standards": standards + [SMALL_HYDRO],
-        "paper": paper_citation(results),
+        "paper": paper_citation(result),
     }
 
 
-def _position_mm(op: dict, stroke: float | None) -> str:
-    x = op.get("initial_position")
-    if x is None:
-        return "\u2013"
-    try:
-        si = parse_amount(x, "m", "operating point").resolve(stroke or 0.0)
-    except (InputError, TypeError, ValueError):
-        return unit_text(str(x))
-    return fmt_value(si * 1e3, "mm", 3)
+def _position_text(op) -> str:
+    """An operating point's SI position (resolved when the result was made) in mm; as written when unresolved."""
+    if op.position is not None:
+        return fmt_quantity(op.position, "m", "mm")
+    return unit_text(op.initial_position) if op.initial_position is not None else "\u2013"
 
 
-def _load_text(op: dict, params: dict) -> str:
-    ld = op.get("load")
-    if ld is None:
+def _load_text(op, curve_assumed: bool) -> str:
+    if op.load is None:
         return "none"
-    if ld == "curve":
-        return "gate load curve (assumed)" if params.get("_curve_assumed") else "gate load curve"
-    if ld == "nominal":
-        f = params.get("load.nominal_force")
-        return f"nominal, {fmt_value(f / 1e3, 'kN', 3)}" if isinstance(f, (int, float)) else "nominal"
-    if isinstance(ld, (int, float)):
-        return fmt_value(ld / 1e3, "kN", 3) + (" closing" if ld > 0 else " opening" if ld < 0 else "")
-    return str(op.get("load_text") or ld)
+    if op.on_curve:
+        return "gate load curve (assumed)" if curve_assumed else "gate load curve"
+    if op.load == "nominal":
+        return f"nominal, {fmt_quantity(op.load_force, 'N', 'kN')}" if op.load_force is not None else "nominal"
+    if op.load_force is not None:
+        return fmt_quantity(op.load_force, "N", "kN") + (" closing" if op.load_force > 0 else " opening" if op.load_force < 0 else "")
+    return str(op.load_text or op.load)
 
 
 def _throttles(flag, configured: bool) -> str:
@@ -131,123 +124,111 @@ def _throttles(flag, configured: bool) -> str:
     return "in" if flag else "out"
 
 
-def conditions(results: dict) -> dict:
+def conditions(result: CheckResult) -> dict:
     """Supply, temperature, the operating points (position, load, throttles in or out) and the procedures' circuits."""
-    plant = results["plant"]
-    params = {p.get("key"): p.get("value") for p in plant.get("parameters") or [] if isinstance(p, dict)}
-    curve = plant.get("load_curve") or {}
-    params["_curve_assumed"] = str(curve.get("source") or "assumed") == "assumed" if curve else False
-    configured = str((plant.get("options") or {}).get("flow_control.installed", "false")).lower() == "true"
-    supply = params.get("air.supply_pressure")
-    rows = []
-    for name, op in (results["requirement_set"].get("operating_points") or {}).items():
-        rows.append({"name": name, "title": op.get("title") or "", "position": _position_mm(op, params.get("cylinder.stroke")),
-                     "load": _load_text(op, params), "throttles": _throttles(op.get("flow_control"), configured)})
+    plant = result.plant
+    curve_assumed = plant.load_curve is not None and plant.load_curve.assumed
+    configured = str(plant.options.get("flow_control.installed", "false")).lower() == "true"
+    rows = [{"name": name, "title": op.title or "", "position": _position_text(op), "load": _load_text(op, curve_assumed),
+             "throttles": _throttles(op.flow_control, configured)}
+            for name, op in result.requirement_set.operating_points.items()]
     procs = []
-    for name, p in (results["requirement_set"].get("procedures") or {}).items():
-        fc = (p.get("settings") or {}).get("flow_control")
+    for name, p in result.requirement_set.procedures.items():
+        fc = p.settings.get("flow_control")
         if fc is not None:
             procs.append(f"{name}: flow-control valves {'in' if fc else 'out'} whatever the operating point says")
     return {
-        "supply": fmt_value(supply / 1e5, "bar", 3) + " abs" if isinstance(supply, (int, float)) else "\u2013",
-        "temperature": fmt_value(params.get("air.supply_temperature") - 273.15, "\u00b0C", 3)
-        if isinstance(params.get("air.supply_temperature"), (int, float)) else "\u2013",
-        "atmosphere": fmt_value(params["air.atmospheric_pressure"] / 1e5, "bar", 4) + " abs"
-        if isinstance(params.get("air.atmospheric_pressure"), (int, float)) else "\u2013",
+        "supply": fmt_quantity(plant.value("air.supply_pressure"), "Pa", "bar", suffix=" abs"),
+        "temperature": fmt_quantity(plant.value("air.supply_temperature"), "K", "\u00b0C"),
+        "atmosphere": fmt_quantity(plant.value("air.atmospheric_pressure"), "Pa", "bar", digits=4, suffix=" abs"),
         "throttles_configured": "in" if configured else "out",
         "operating_points": rows, "procedure_circuits": procs,
-        "curve_assumed": params["_curve_assumed"],
+        "curve_assumed": curve_assumed,
     }
 
 
-def method_rows(results: dict) -> list[dict]:
+def method_rows(result: CheckResult) -> list[dict]:
     """The instrumentation and method table: how each figure is obtained (solver, sampling, filters, thresholds)."""
-    params = {p.get("key"): p.get("value") for p in results["plant"].get("parameters") or [] if isinstance(p, dict)}
+    value = result.plant.value
     rows = [{"item": "Measurement", "how": "none: every figure is computed by simulating the model (no transducer, "
                                            "no uncertainty of measurement)"}]
-    if isinstance(params.get("simulation.step"), (int, float)):
+    if isinstance(value("simulation.step"), (int, float)):
         rows.append({"item": "Solver", "how": f"fixed-step fourth-order Runge\u2013Kutta, step "
-                                              f"{fmt_value(params['simulation.step'] * 1e3, 'ms', 3)}"})
-    if isinstance(params.get("controller.sample_time"), (int, float)):
-        ts = params["controller.sample_time"]
-        rows.append({"item": "Controller and recording", "how": f"sampled every {fmt_value(ts * 1e3, 'ms', 3)} "
-                                                                 f"({fmt_value(1 / ts, 'Hz', 3)}), zero-order hold on the valve command"})
-    if params.get("controller.filter_cutoff"):
-        rows.append({"item": "Position filter", "how": f"first order, cut-off {fmt_value(params['controller.filter_cutoff'], 'Hz', 3)}"})
-    used = []
-    for e in results["requirements"]:
-        if e["metric"] not in used:
-            used.append(e["metric"])
+                                              f"{fmt_quantity(value('simulation.step'), 's', 'ms')}"})
+    ts = value("controller.sample_time")
+    if isinstance(ts, (int, float)):
+        rows.append({"item": "Controller and recording", "how": f"sampled every {fmt_quantity(ts, 's', 'ms')} "
+                                                                 f"({fmt_quantity(1 / ts, 'Hz', 'Hz')}), zero-order hold on the valve command"})
+    if value("controller.filter_cutoff"):
+        rows.append({"item": "Position filter", "how": f"first order, cut-off {fmt_quantity(value('controller.filter_cutoff'), 'Hz', 'Hz')}"})
+    used = list(dict.fromkeys(e.metric for e in result.requirements))
     for m in used:
         info = METRICS.get(m)
         if info is None:
             continue
         rows.append({"item": m.replace("_", " ").capitalize(), "how": info.meaning})
     if any(m in used for m in ("dead_time", "time_constant", "settling_time")):
-        for key in ("detect", "settling_band", "final_window"):
+        for key, item in (("detect", "Motion detection"), ("settling_band", "Settling band"), ("final_window", "Settled window")):
             unit, default, meaning = STEP_OPTION_DEFAULTS[key]
-            given = sorted({str(v) for e in results["requirements"] for k, v in (e.get("options") or {}).items() if k == key})
-            rows.append({"item": {"detect": "Motion detection", "settling_band": "Settling band",
-                                  "final_window": "Settled window"}[key],
-                         "how": f"{meaning}: {', '.join(unit_text(g) for g in given) if given else unit_text(default)}"})
+            given = sorted({str(v) for r in result.requirement_set.requirements for k, v in r.options.items() if k == key})
+            rows.append({"item": item, "how": f"{meaning}: {', '.join(unit_text(g) for g in given) if given else unit_text(default)}"})
     return rows
 
 
-def not_tested(results: dict) -> list[str]:
+def not_tested(result: CheckResult) -> list[str]:
     """Conditions a test code would cover that these results do not."""
-    cond = conditions(results)
-    out = [f"Supply pressure other than {cond['supply']} (in particular the minimum supply pressure at which the "
-           "strokes must still be met), and supply droop during a stroke.",
-           f"Air temperatures other than {cond['temperature']}; seal friction at low temperature.",
-           "Fail-safe behaviour: closure or hold on loss of air supply, electrical power or the position signal.",
-           "End-of-stroke cushioning and the gate's closing time in its last per cent (cushion time).",
-           "Repeatability over several strokes, wear, and leakage of valves and seals (not modelled unless an effect "
-           "adds it).",
-           "Operating points other than the ones listed in section 2.1 (other positions, loads, circuits)."]
-    return out
+    cond = conditions(result)
+    return [f"Supply pressure other than {cond['supply']} (in particular the minimum supply pressure at which the "
+            "strokes must still be met), and supply droop during a stroke.",
+            f"Air temperatures other than {cond['temperature']}; seal friction at low temperature.",
+            "Fail-safe behaviour: closure or hold on loss of air supply, electrical power or the position signal.",
+            "End-of-stroke cushioning and the gate's closing time in its last per cent (cushion time).",
+            "Repeatability over several strokes, wear, and leakage of valves and seals (not modelled unless an effect "
+            "adds it).",
+            "Operating points other than the ones listed in section 2.1 (other positions, loads, circuits)."]
 
 
-def code_deviations(results: dict) -> list[str]:
+def code_deviations(result: CheckResult) -> list[str]:
     """Departures from a test code (IEC 60308 / ASME PTC 29 field tests) that this report makes, stated as such."""
     out = ["The servo-positioner is simulated, not measured: the figures carry the model's assumptions (section 3.2) "
            "instead of a measurement uncertainty."]
-    ops = results["requirement_set"].get("operating_points") or {}
-    if any(op.get("flow_control") is False for op in ops.values()):
+    metrics = {e.metric for e in result.requirements}
+    if any(op.flow_control is False for op in result.requirement_set.operating_points.values()):
         out.append("Small-step figures (time constant) are taken with the flow-control valves out of the circuit at the "
                    "operating points marked \u2018out\u2019 in section 2.1, as the servo-positioner is specified; the "
                    "installed circuit is used for the strokes.")
-    if any(e["metric"] in ("max_speed", "max_opening_speed", "max_closing_speed") for e in results["requirements"]):
+    if metrics & {"max_speed", "max_opening_speed", "max_closing_speed"}:
         out.append("Speeds are the peak of a centred 20 ms difference of the position, not a chart reading of the "
                    "stroke; start-of-stroke surges therefore count.")
-    if any(e["metric"] in ("opening_time", "closing_time") for e in results["requirements"]):
+    if metrics & {"opening_time", "closing_time"}:
         out.append("Opening and closing times are twice the time between 25 % and 75 % of the stroke (the linear part), "
                    "not end to end; the cushioned end of the stroke is not part of them.")
-    for e in results["requirement_set"].get("requirements") or []:
-        note = str(e.get("note") or "")
+    for e in result.requirement_set.requirements:
+        note = str(e.note or "")
         if "Assumption:" in note:
-            out.append(f"{e['id']}: " + note[note.index("Assumption:") + len("Assumption:"):].strip())
+            out.append(f"{e.id}: " + note[note.index("Assumption:") + len("Assumption:"):].strip())
     return out
 
 
-def conclusions(results: dict) -> list[dict]:
+def conclusions(result: CheckResult) -> list[dict]:
     """One row per requirement needing a decision: the finding and an empty disposition (accept / rework / waive)."""
     out = []
-    for e in results["requirements"]:
-        if e["status"] not in (Status.FAIL, Status.UNCERTAIN, Status.NOT_EVALUATED, Status.OPEN):
+    for e in result.requirements:
+        if e.status not in (Status.FAIL, Status.UNCERTAIN, Status.NOT_EVALUATED, Status.OPEN):
             continue
-        w = e.get("worst") or {}
-        value = metric_text(w.get("value"), e["metric"]) if w else "\u2013"
-        if e["status"] == Status.OPEN:
+        w = e.worst
+        value = metric_text(w.value, e.metric) if w is not None else "\u2013"
+        if e.status == Status.OPEN:
             finding = f"no limit set; value found {value}"
-        elif e["status"] == Status.NOT_EVALUATED:
+        elif e.status == Status.NOT_EVALUATED:
             finding = "not evaluated (see its page)"
         else:
-            finding = f"{value} against {limit_as_written(e)}" + (f" at {w.get('operating_point')}" if w.get("operating_point") else "")
-        out.append({"id": e["id"], "status": e["status"], "severity": e["severity"], "finding": finding})
+            finding = f"{value} against {limit_as_written(e)}" + (f" at {w.operating_point}" if w and w.operating_point else "")
+        out.append({"id": e.id, "status": e.status, "severity": e.severity, "finding": finding})
     return out
 
 
-def parties(identity: dict) -> list[dict]:
+def parties(identity) -> list[dict]:
     """Who the document involves: purchaser, supplier, test engineer, witness (blanks where not given)."""
     return [{"role": "Purchaser / plant owner", "name": identity.get("owner")},
             {"role": "Supplier of the servo-positioner", "name": identity.get("supplier")},

@@ -1,79 +1,37 @@
-"""Results dict (docs/results-schema.md) -> what the compliance report shows.
+"""A check's result (``compliance.results.CheckResult``) -> what the compliance report shows.
 
-Checks the keys the report needs (bad input -> ``InputError`` naming the key), formats numbers
-with units, groups runs by procedure and lists the figures to draw. No rendering here: the
-figures are produced by :mod:`compliance.report.figures` from the specs built below, the
-text by the jinja2 templates.
+A results dict is read into the typed result at this edge (bad input -> ``InputError`` naming the
+key); the rest reads the result: numbers formatted with units, runs grouped by procedure, the
+figures to draw listed. No rendering here: the figures are produced by
+:mod:`compliance.report.figures` from the specs built below, the text by the jinja2 templates.
 """
 
 from __future__ import annotations
 
 import hashlib
-import shlex
 
-from compliance.errors import InputError
 from compliance.presentation.values import limit_as_written, metric_text, row_texts
 from compliance.report.requirement_pages import TOLERANCE_METRICS, reader_text
 from compliance.requirements.verdict import Basis, Overall, Status
-from compliance.units.formatting import fmt_num, unit_text
+from compliance.results.check_result import CheckResult
+from compliance.presentation.numbers import fmt_num, unit_text
 
-RESULTS_SCHEMA = "govcheck-results/1"
 SOURCES = ("paper", "assumed", "derived", "user")
 
-_REQUIRED = {
-    "plant": ("name", "digest", "parameters"),
-    "requirement_set": ("name", "path", "digest", "requirements"),
-    "summary": ("status", "counts"),
-}
-_REQ_KEYS = ("id", "title", "metric", "status", "severity", "limit_text", "rows")
-_RUN_KEYS = ("id", "procedure", "operating_point", "kind", "traces")
 
-
-def _need(obj, key, where, typ=None):
-    if not isinstance(obj, dict) or key not in obj:
-        raise InputError(f"{where}: key '{key}' is missing (expected a govcheck results file, schema '{RESULTS_SCHEMA}')")
-    v = obj[key]
-    if typ is not None and not isinstance(v, typ):
-        raise InputError(f"{where}: key '{key}' should be a {typ.__name__ if isinstance(typ, type) else 'list'}, "
-                         f"got {type(v).__name__}")
-    return v
-
-
-def check_results(results, where: str = "results") -> None:
-    """Check a results dict has everything the report needs.
+def as_result(results, where: str = "results") -> CheckResult:
+    """The typed result to report on: a ``CheckResult`` as it is, a results dict read (and checked) at this edge.
 
     Raises
     ------
     InputError
         Wrong schema version, or a missing / mistyped key (named with its path).
     """
-    if not isinstance(results, dict):
-        raise InputError(f"{where}: expected a JSON object (a govcheck results file), got {type(results).__name__}")
-    schema = _need(results, "schema", where)
-    if schema != RESULTS_SCHEMA:
-        raise InputError(f"{where}: key 'schema' is '{schema}'; this govcheck reads '{RESULTS_SCHEMA}' "
-                         "(re-run 'govcheck check' to regenerate the results)")
-    for section, keys in _REQUIRED.items():
-        sec = _need(results, section, where, dict)
-        for k in keys:
-            _need(sec, k, f"{where}: {section}")
-    reqs = _need(results, "requirements", where, list)
-    for i, e in enumerate(reqs):
-        for k in _REQ_KEYS:
-            _need(e, k, f"{where}: requirements[{i}]")
-    runs = results.get("runs") or []
-    if not isinstance(runs, list):
-        raise InputError(f"{where}: key 'runs' should be a list, got {type(runs).__name__}")
-    for i, r in enumerate(runs):
-        for k in _RUN_KEYS:
-            _need(r, k, f"{where}: runs[{i}]")
-    from compliance.campaign.results_files import check_numbers
-
-    check_numbers(results, where)
+    return results if isinstance(results, CheckResult) else CheckResult.from_dict(results, where)
 
 
 # --------------------------------------------------------------------------- formatting
-# the one formatter and status-word table live in compliance/units/formatting.py
+# the one formatter and status-word table live in compliance/presentation/numbers.py
 
 def setting_text(v) -> str:
     """A procedure setting as a reader reads it: units typeset, yes/no, lists joined."""
@@ -107,103 +65,100 @@ def status_class(status: str | None) -> str:
 
 
 # --------------------------------------------------------------------------- sections
-def summary_rows(results: dict) -> list[dict]:
+_NO_TEXTS = {"value": "\u2013", "limit": None, "margin": "\u2013", "margin_pct": None}  # a requirement without a worst case
+
+
+def summary_rows(result: CheckResult) -> list[dict]:
     """One row per requirement: worst value, limit, margin, status, where the worst case was."""
     out = []
-    run_ids = {r.get("id") for r in results.get("runs") or []}
-    for e in results["requirements"]:
-        w = e.get("worst") or {}
-        d = row_texts(w, e["metric"]) if w else {}
-        reason = None
-        if e["status"] == Status.NOT_EVALUATED:
-            reason = "; ".join(sorted({r.get("reason") for r in e["rows"] if r.get("reason")})) or "not evaluated"
-        where = None
-        if w:
-            where = w.get("run") or f"{w.get('procedure')}@{w.get('operating_point')}"
+    run_ids = {r.id for r in result.runs}
+    for e in result.requirements:
+        w = e.worst
+        d = row_texts(w.as_dict(), e.metric) if w is not None else _NO_TEXTS
+        reason = "; ".join(e.not_evaluated_reasons()) or "not evaluated" if e.status == Status.NOT_EVALUATED else None
+        where = (w.run or f"{w.procedure}@{w.operating_point}") if w is not None else None
         out.append({
-            "id": e["id"], "title": e["title"], "metric": e["metric"], "severity": e["severity"],
-            "source": e.get("source", "simulation"), "standard": e.get("standard"), "clause": e.get("clause"),
-            "limit_text": e["limit_text"],
-            "limit": limit_as_written(e),
-            "value": d.get("value", "\u2013"), "margin": d.get("margin", "\u2013") if w.get("margin") is not None else "\u2013",
-            "margin_pct": d.get("margin_pct"), "status": e["status"], "where": where, "which": w.get("which"),
-            "procedure": w.get("procedure"), "operating_point": w.get("operating_point"), "reason": reason,
-            "anchor": "run-" + _slug(where) if where in run_ids else None,
-            "note": e.get("note"), "loosened": e.get("loosened") or [],
+            "id": e.id, "title": e.title, "metric": e.metric, "severity": e.severity, "source": e.source,
+            "standard": e.standard, "clause": e.clause, "limit_text": e.limit_text, "limit": limit_as_written(e),
+            "value": d["value"], "margin": d["margin"] if w is not None and w.margin is not None else "\u2013",
+            "margin_pct": d["margin_pct"], "status": e.status, "where": where, "which": w and w.which,
+            "procedure": w and w.procedure, "operating_point": w and w.operating_point, "reason": reason,
+            "anchor": "run-" + _slug(where) if where in run_ids else None, "note": e.note, "loosened": list(e.loosened),
             # how the verdict is known and how sure it is (campaign.basis, campaign.uncertainty)
-            "basis": BASIS_WORDS.get(str(e.get("basis")), str(e.get("basis")).replace("_", " ")) if e.get("basis") else None,
-            "basis_key": e.get("basis"), "basis_reason": w.get("basis_reason"),
-            "band": band_text(e.get("band"), e["metric"]), "band_pct": e.get("band"),
-            "coverage": e.get("coverage"),
+            "basis": BASIS_WORDS.get(e.basis, str(e.basis).replace("_", " ")) if e.basis else None,
+            "basis_key": e.basis, "basis_reason": w and w.basis_reason,
+            "band": band_text(e.band, e.metric), "band_pct": e.band, "coverage": e.coverage,
         })
     return out
 
 
-# how a verdict is known (the verdict work's ``basis`` key; absent in older results)
+# how a verdict is known
 BASIS_WORDS = {Basis.MODELLED: "modelled", Basis.BY_CONSTRUCTION: "by construction", Basis.NOT_EVALUATED: "not evaluated",
                Basis.ASSUMED: "assumed"}
 
 
 def band_text(band, metric: str) -> str | None:
-    """A verdict's value band under the declared parameter uncertainty (``{"low", "high"}``, SI) as text."""
-    if not isinstance(band, dict) or band.get("low") is None or band.get("high") is None:
+    """A verdict's value band under the declared parameter uncertainty (SI) as text."""
+    if band is None or band.low is None or band.high is None:
         return None
-    lo, hi = metric_text(band["low"], metric), metric_text(band["high"], metric)
-    return f"band {lo} to {hi}"
+    return f"band {metric_text(band.low, metric)} to {metric_text(band.high, metric)}"
 
 
-def _run_evidence(results: dict, run_id: str) -> list[dict]:
+def _run_evidence(result: CheckResult, run_id: str) -> list[dict]:
     """Requirement rows judged on one run, with every sample measured for them."""
     rows = []
-    for e in results["requirements"]:
-        for r in e["rows"]:
-            if r.get("run") != run_id:
+    for e in result.requirements:
+        for r in e.rows:
+            if r.run != run_id:
                 continue
-            d = row_texts(r, e["metric"])
-            samples = []
-            for s in r.get("samples") or []:
-                samples.append({"label": s.get("label"), "value": s.get("display") or metric_text(s.get("value"), e["metric"]),
-                                "excluded": not s.get("eligible", True) or s.get("value") is None, "reason": s.get("reason")})
-            rows.append({"id": e["id"], "metric": e["metric"], "value": d.get("value"), "which": r.get("which"),
-                         "limit": d.get("limit") or ("open" if e.get("limit") is None else e["limit_text"]), "margin": d.get("margin") if r.get("margin") is not None else "\u2013",
-                         "margin_pct": d.get("margin_pct"), "status": r.get("status"), "reason": r.get("reason"),
-                         "samples": samples})
+            d = row_texts(r.as_dict(), e.metric)
+            samples = [{"label": s.label, "value": s.display or metric_text(s.value, e.metric),
+                        "excluded": not s.eligible or s.value is None, "reason": s.reason} for s in r.samples]
+            rows.append({"id": e.id, "metric": e.metric, "value": d["value"], "which": r.which,
+                         "limit": d["limit"] or ("open" if e.limit is None else e.limit_text),
+                         "margin": d["margin"] if r.margin is not None else "\u2013", "margin_pct": d["margin_pct"],
+                         "status": r.status, "reason": r.reason, "samples": samples})
     return rows
 
 
-def _tolerance(results: dict, run_id: str):
+def _tolerance(result: CheckResult, run_id: str):
     """Smallest position tolerance [m] a requirement applies to this run (the error band), or None."""
-    tol = []
-    for e in results["requirements"]:
-        if e["metric"] not in TOLERANCE_METRICS:
-            continue
-        for r in e["rows"]:
-            lim = r.get("limit")
-            if r.get("run") == run_id and lim:
-                tol.append(max(lim))
+    tol = [max(r.limit) for e in result.requirements if e.metric in TOLERANCE_METRICS
+           for r in e.rows if r.run == run_id and r.limit]
     return min(tol) if tol else None
 
 
-def _params_by_key(results: dict) -> dict:
-    return {p.get("key"): p.get("value") for p in results["plant"]["parameters"] if isinstance(p, dict)}
-
-
-def valve_marks(results: dict) -> dict:
-    """Valve full-opening voltage and dead zone [V] for the command panels (from the plant)."""
-    p = _params_by_key(results)
+def valve_marks(result: CheckResult) -> dict:
+    """Valve full-opening voltage, dead zone, centre and command limit [V] for the command panels (from the plant)."""
+    v = result.plant.value
     out = {}
-    if p.get("valve.saturation_voltage"):
-        out["saturation_voltage"] = p["valve.saturation_voltage"]
-    if p.get("valve.dead_zone_positive") or p.get("valve.dead_zone_negative"):
-        out["dead_zone"] = [p.get("valve.dead_zone_positive") or 0.0, p.get("valve.dead_zone_negative") or 0.0]
-    if p.get("valve.centre_voltage"):
-        out["centre_voltage"] = p["valve.centre_voltage"]
-    if p.get("valve.command_limit"):
-        out["command_limit"] = p["valve.command_limit"]
+    if v("valve.saturation_voltage"):
+        out["saturation_voltage"] = v("valve.saturation_voltage")
+    if v("valve.dead_zone_positive") or v("valve.dead_zone_negative"):
+        out["dead_zone"] = [v("valve.dead_zone_positive") or 0.0, v("valve.dead_zone_negative") or 0.0]
+    for name in ("centre_voltage", "command_limit"):
+        if v(f"valve.{name}"):
+            out[name] = v(f"valve.{name}")
     return out
 
 
-def procedure_sections(results: dict, start: int = 1) -> tuple[list[dict], list[dict]]:
+def _run_item(result: CheckResult, run, start: int, specs: list) -> dict:
+    """A run of the appendix: its operating point, notes, evidence and figures (their specs appended to ``specs``)."""
+    figs = []
+    tol = _tolerance(result, run.id)
+    for tr in run.traces:
+        fid = f"fig-{start + len(specs)}"
+        specs.append({"id": fid, "kind": "trace", "trace": tr, "marks": run.marks, "run_kind": run.kind, "tolerance": tol})
+        figs.append({"id": fid, "label": tr.label or run.id, "points": tr.points, "samples": tr.samples})
+    op = result.requirement_set.operating_points.get(run.operating_point)
+    return {"id": run.id, "anchor": "run-" + _slug(run.id), "operating_point": run.operating_point,
+            "op_title": op and op.title, "initial_position": op and op.initial_position,
+            "load": op and (op.load_text if op.load_text is not None else op.load), "flow_control": op and op.flow_control,
+            "error": run.error, "notes": list(run.notes), "evidence": _run_evidence(result, run.id), "figures": figs,
+            "tolerance": tol, "wall_time": run.wall_time}
+
+
+def procedure_sections(result: CheckResult, start: int = 1) -> tuple[list[dict], list[dict]]:
     """Runs grouped by procedure (in the requirement set's order) and the figure specs.
 
     Returns
@@ -212,40 +167,19 @@ def procedure_sections(results: dict, start: int = 1) -> tuple[list[dict], list[
         ``figure_specs`` items: ``{"id", "kind": "trace", "trace", "marks", "run_kind",
         "tolerance"}``; a section's runs refer to their figures by ``id``.
     """
-    rs = results["requirement_set"]
-    procs = rs.get("procedures") or {}
-    ops = rs.get("operating_points") or {}
-    runs = results.get("runs") or []
-    order = list(procs) + sorted({r["procedure"] for r in runs} - set(procs))
+    procs, ops = result.requirement_set.procedures, list(result.requirement_set.operating_points)
+    order = list(procs) + sorted({r.procedure for r in result.runs} - set(procs))
     specs, sections = [], []
     for pname in order:
-        pruns = [r for r in runs if r["procedure"] == pname]
+        pruns = sorted((r for r in result.runs if r.procedure == pname),
+                       key=lambda r: ops.index(r.operating_point) if r.operating_point in ops else len(ops))
         if not pruns:
             continue
-        p = procs.get(pname) or {}
-        op_order = list(ops)
-        pruns.sort(key=lambda r: op_order.index(r["operating_point"]) if r["operating_point"] in op_order else len(op_order))
-        items = []
-        for run in pruns:
-            figs = []
-            tol = _tolerance(results, run["id"])
-            for j, tr in enumerate(run.get("traces") or []):
-                fid = f"fig-{start + len(specs)}"
-                specs.append({"id": fid, "kind": "trace", "trace": tr, "marks": run.get("marks") or [],
-                              "run_kind": run["kind"], "tolerance": tol})
-                figs.append({"id": fid, "label": tr.get("label") or run["id"], "points": tr.get("points"),
-                             "samples": tr.get("samples")})
-            op = ops.get(run["operating_point"]) or {}
-            items.append({"id": run["id"], "anchor": "run-" + _slug(run["id"]), "operating_point": run["operating_point"],
-                          "op_title": op.get("title"), "initial_position": op.get("initial_position"),
-                          "load": op.get("load_text") if op.get("load_text") is not None else op.get("load"),
-                          "flow_control": op.get("flow_control"), "error": run.get("error"), "notes": run.get("notes") or [],
-                          "evidence": _run_evidence(results, run["id"]), "figures": figs, "tolerance": tol,
-                          "wall_time": run.get("wall_time")})
-        settings = p.get("settings") or {}
-        sections.append({"name": pname, "anchor": "proc-" + _slug(pname), "title": p.get("title") or pname,
-                         "kind": p.get("kind") or pruns[0]["kind"], "settings": settings, "note": p.get("note"),
-                         "runs": items})
+        p = procs.get(pname)
+        items = [_run_item(result, run, start, specs) for run in pruns]
+        sections.append({"name": pname, "anchor": "proc-" + _slug(pname), "title": (p and p.title) or pname,
+                         "kind": (p and p.kind) or pruns[0].kind, "settings": p.settings if p else {},
+                         "note": p and p.note, "runs": items})
     return sections, specs
 
 
@@ -258,24 +192,20 @@ def _slug(text: str) -> str:
     return (out.strip("-") or "x")[:60] + "-" + hashlib.sha1(text.encode("utf-8")).hexdigest()[:8]
 
 
-def parameter_rows(results: dict) -> list[dict]:
+def parameter_rows(result: CheckResult) -> list[dict]:
     """Appendix table: every parameter the selected model uses, with value, unit, meaning and source."""
-    from compliance.report.signoff import used_by_model
+    from compliance.model.parameters import used_by_model
 
     rows = []
-    options = results["plant"].get("options") or {}
-    for p in sorted(results["plant"]["parameters"], key=lambda q: str(q.get("key"))):
-        if not used_by_model(str(p.get("key")), options):
+    for p in sorted(result.plant.parameters, key=lambda q: q.key):
+        if not used_by_model(p.key, result.plant.options):
             continue  # a law or controller not selected: not part of this model
-        src = p.get("source") or "\u2013"
-        rows.append({"key": p.get("key"), "value": fmt_num(p.get("value"), 6), "unit": unit_text(p.get("unit", "")) or "\u2013",
-                     "meaning": reader_text(p.get("meaning")), "source": src, "source_class": src if src in SOURCES else "other"})
+        src = p.source or "\u2013"
+        rows.append({"key": p.key, "value": fmt_num(p.value, 6), "unit": unit_text(p.unit) or "\u2013",
+                     "meaning": reader_text(p.meaning), "source": src, "source_class": src if src in SOURCES else "other"})
     return rows
 
 
-def command_text(results: dict) -> str:
+def command_text(result: CheckResult) -> str:
     """The exact command line that produced the results."""
-    c = results.get("command_line") or results.get("command")
-    if isinstance(c, list):
-        return shlex.join(str(x) for x in c)
-    return str(c) if c else "not recorded"
+    return result.command_line or "not recorded"

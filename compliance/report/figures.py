@@ -1,7 +1,7 @@
 """Report figures of procedure runs: reference and position, error, valve command, pressures.
 
-Each function takes the plain-JSON trace and marks of the results dict (SI units: s, m, V,
-Pa abs) and returns an inline SVG fragment (:func:`compliance.report.svg.to_svg`). Titles and
+Each function takes a run's trace and marks as the check's result holds them
+(``compliance.results.runs.Trace`` and ``Mark``; SI units: s, m, V, Pa abs) and returns an inline SVG fragment (:func:`compliance.report.svg.to_svg`). Titles and
 captions are written by the HTML template (escaped), not inside the figures; the only text a
 figure draws is axis labels, legends and short mark labels of our own.
 """
@@ -19,9 +19,9 @@ BAR = 1e-5  # [Pa] -> [bar] for display
 OPEN_LOOP_KINDS = ("full_stroke", "independent_adjustment")
 
 
-def _arr(trace: dict, key: str):
-    """Trace column as a float array, or None when absent or all non-finite."""
-    v = trace.get(key)
+def _arr(trace, key: str):
+    """Trace signal as a float array, or None when absent or all non-finite."""
+    v = trace.signal(key)
     if v is None:
         return None
     a = np.asarray([np.nan if x is None else x for x in v], dtype=float)
@@ -65,7 +65,7 @@ def _plot(ax, t, y, **kw):
 
 
 def _marks_of(marks, label):
-    return [m for m in marks if m.get("trace") == label]
+    return [m for m in marks if m.trace == label]
 
 
 def _shade(ax, t0, t1, color, alpha=0.12, label=None):
@@ -107,8 +107,7 @@ def trace_figure(trace: dict, marks: list, kind: str, prefix: str, *, tolerance=
         Time-constant limits [s]: each step's window of allowed 63.2 % instants (from the end of
         its dead time) is shaded on the position panel, beside the 63.2 % point measured.
     """
-    label = trace.get("label")
-    mk = _marks_of(marks, label) if label is not None else []
+    mk = _marks_of(marks, trace.label)
     t = _arr(trace, "time")
     if compact:
         fig, axes = new_figure("trace_short" if compact == "short" else "trace_compact", 3, 1, sharex=True, gridspec_kw={"height_ratios": [1.5, 1.0, 1.0], "hspace": 0.12})
@@ -145,9 +144,9 @@ def trace_figure(trace: dict, marks: list, kind: str, prefix: str, *, tolerance=
 def _position_panel(ax_x, ax_e, t, x, r, mk, closed_loop):
     """Panel 1: set-point and position [mm], the judged windows shaded on panels 1 and 2."""
     for m in mk:
-        if m["type"] in ("final_window", "tracking_window", "hold_window"):
+        if m.type in ("final_window", "tracking_window", "hold_window"):
             for ax in (ax_x, ax_e):
-                _shade(ax, m["value"][0], m["value"][1], COLORS["window"], 0.10)
+                _shade(ax, m.value[0], m.value[1], COLORS["window"], 0.10)
     if closed_loop:
         _plot(ax_x, t, r * MM, color=COLORS["reference"], lw=0.9, ls=(0, (4, 2)), label="set-point")
     if x is not None:
@@ -191,9 +190,9 @@ def _tau_window(ax, mk, window) -> None:
     lo, hi = window
     first = True
     for m in mk:
-        if m.get("type") != "motion_start" or m.get("value") is None:
+        if m.type != "motion_start" or m.value is None:
             continue
-        t0 = m["value"][0]
+        t0 = m.value[0]
         ax.axvspan(t0 + lo, t0 + hi, color=COLORS["band"], alpha=0.16, lw=0,
                    label=f"\u03c4 limit {lo:g}\u2013{hi:g} s after motion start" if first else None)
         first = False
@@ -261,7 +260,7 @@ def _position_marks(ax, mk) -> None:
         return name
 
     for m in mk:
-        typ, v = m.get("type"), m.get("value")
+        typ, v = m.type, m.value
         if v is None:
             continue
         if typ == "tau_632":
@@ -272,9 +271,9 @@ def _position_marks(ax, mk) -> None:
         elif typ == "motion_start":
             ax.plot(v[0], v[1] * MM, "^", ms=3.5, color=COLORS["error"], label=once("motion start"))
         elif typ == "band":
-            step_marks = [q for q in mk if q.get("step") == m.get("step")]
-            t0 = next((q["value"][0] for q in step_marks if q["type"] == "motion_start"), None)
-            t1 = next((q["value"][1] for q in step_marks if q["type"] == "final_window"), None)
+            step_marks = [q for q in mk if q.step == m.step]
+            t0 = next((q.value[0] for q in step_marks if q.type == "motion_start"), None)
+            t1 = next((q.value[1] for q in step_marks if q.type == "final_window"), None)
             if t0 is not None and t1 is not None:
                 ax.fill_between([t0, t1], v[0] * MM, v[1] * MM, color=COLORS["band"], alpha=0.18, lw=0,
                                 label=once("settling band"))

@@ -32,14 +32,14 @@ def stroke_pair_figure(traces: list, marks: list, prefix: str) -> str:
         t, x = _arr(tr, "time"), _arr(tr, "position")
         if t is None or x is None:
             continue
-        direction = str(tr.get("label") or "").rsplit(" ", 1)[-1]
+        direction = tr.direction
         c = colours.get(direction, COLORS["reference"])
         ax_x.plot(*decimate(t - t[0], x * MM), color=c, lw=1.1, label=f"{direction} stroke")
         v = np.gradient(x, t) * MM if t.size > 2 else np.zeros_like(x)
         ax_v.plot(*decimate(t - t[0], v), color=c, lw=0.9)
         for m in marks:
-            if m.get("trace") == tr.get("label") and m.get("type") == "stroke_points":
-                for tp, xp in m["value"]:
+            if m.trace == tr.label and m.type == "stroke_points":
+                for tp, xp in m.value:
                     ax_x.plot(tp - t[0], xp * MM, "o", ms=4, mfc="white", mec=COLORS["mark"], mew=1.2)
         drawn += 1
     if not drawn:

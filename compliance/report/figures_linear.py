@@ -1,7 +1,8 @@
 """Report figures of the linear analysis: operating maps, Bode diagrams, pole maps.
 
-Inputs are the plain-JSON forms written by ``compliance.linear.analysis`` (``LinearAnalysis.to_dict``)
-and ``compliance.linear.maps`` (``OperatingMap.to_dict``), in SI units (s, Hz, dB, deg, m, N).
+Inputs are the records of a linear analysis (``compliance.results.linear``: an analysis, the
+operating map), read from the documents ``compliance.linear.analysis`` and ``compliance.linear.maps``
+write, in SI units (s, Hz, dB, deg, m, N).
 """
 
 from __future__ import annotations
@@ -9,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.colors import ListedColormap
 
+from compliance.presentation.quantities import fmt_quantity, to_display
 from compliance.report.svg import COLORS, message_axes, new_figure, plain, styled, to_svg
 
 # one colour per critical point (Okabe-Ito and two more): eight distinct points in plant A
@@ -24,36 +26,36 @@ MAP_QUANTITIES = {  # name -> (label, unit, display scale, requirement-window ke
 
 
 def _load_labels(loads):
-    out = []
-    for ld in loads:
-        if ld is None:
-            out.append("none")
-        elif isinstance(ld, str):
-            out.append(ld)
-        else:
-            out.append(f"{ld / 1e3:+.1f} kN")
-    return out
+    return ["none" if ld is None else ld if isinstance(ld, str) else fmt_quantity(ld, "N", "kN", 1, signed=True)
+            for ld in loads]
 
 
 @styled
-def map_figure(omap: dict, name: str, prefix: str) -> str:
+def map_figure(omap, name: str, prefix: str) -> str:
     """Heat map of one linear figure over stroke x load, the requirement window outlined.
 
     Parameters
     ----------
-    omap : dict
+    omap : OperatingMapRecord
         ``positions`` [m], ``loads`` (N / "curve" / None), ``values[name][i][j]`` at load i,
         position j (None: no trim), ``window`` [s] for the time constant.
     name : str
         Key of ``MAP_QUANTITIES``.
     """
-    label, unit, scale, wkey = MAP_QUANTITIES[name]
     fig, ax = new_figure("map")
-    vals = omap.get("values", {}).get(name)
-    pos = np.asarray(omap.get("positions") or [], float)
+    if draw_map(fig, ax, omap, name):
+        fig.subplots_adjust(left=0.12, right=0.93, top=0.9, bottom=0.15)
+    return to_svg(fig, prefix)
+
+
+def draw_map(fig, ax, omap, name: str) -> bool:
+    """Draw the map of quantity ``name`` on ``ax`` (see :func:`map_figure`); False when the map lacks it."""
+    label, unit, scale, wkey = MAP_QUANTITIES[name]
+    vals = omap.values.get(name)
+    pos = np.asarray(omap.positions, float)
     if not vals or pos.size == 0:
         message_axes(ax, f"{label}: not in the results")
-        return to_svg(fig, prefix)
+        return False
     z = np.array([[np.nan if v is None else v * scale for v in row] for row in vals], float)
     cmap = ListedColormap(["#f7fbff", "#deebf7", "#c6dbef", "#9ecae1", "#6baed6", "#4292c6", "#2171b5", "#08519c"])
     cmap.set_bad("#e0e0e0")
@@ -62,15 +64,15 @@ def map_figure(omap: dict, name: str, prefix: str) -> str:
                        cmap=cmap, shading="flat", edgecolors="white", linewidth=0.6)
     ax.set_xlim(-0.5, pos.size - 0.5)
     ax.set_ylim(-0.5, len(vals) - 0.5)
-    ax.set_xticks(range(pos.size), [f"{x * 1e3:.0f}" for x in pos])
-    ax.set_yticks(range(len(vals)), [plain(x) for x in _load_labels(omap.get("loads") or [None] * len(vals))])
+    ax.set_xticks(range(pos.size), [fmt_quantity(x, "m", "mm", 0).split()[0] for x in pos])
+    ax.set_yticks(range(len(vals)), [plain(x) for x in _load_labels(omap.loads or [None] * len(vals))])
     ax.set_xlabel("position [mm]")
     ax.set_ylabel("closing load")
     ax.grid(False)
     cb = fig.colorbar(im, ax=ax, pad=0.015, fraction=0.04)
     cb.set_label(f"{label} [{unit}]")
     cb.outline.set_linewidth(0.4)
-    win = omap.get(wkey) if wkey else None
+    win = omap.window if wkey else None
     for i in range(z.shape[0]):
         for j in range(z.shape[1]):
             v = z[i, j]
@@ -86,8 +88,7 @@ def map_figure(omap: dict, name: str, prefix: str) -> str:
     if win is not None:
         ax.plot([], [], "s", mfc="none", mec=COLORS["limit"], label=f"outside {win[0] * scale:g}\u2013{win[1] * scale:g} {unit}")
         ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=2, borderaxespad=0.2)
-    fig.subplots_adjust(left=0.12, right=0.93, top=0.9, bottom=0.15)
-    return to_svg(fig, prefix)
+    return True
 
 
 def _cell(j, i, color):
@@ -102,58 +103,65 @@ def bode_figure(analyses: list, prefix: str) -> str:
 
     Parameters
     ----------
-    analyses : list of (label, dict)
-        ``dict`` is ``LinearAnalysis.to_dict()`` with ``bode`` arrays (frequency [Hz],
-        ``loop_discrete_magnitude_db`` / ``loop_magnitude_db``, ``..._phase_deg``).
+    analyses : list of (label, LinearAnalysisRecord)
+        Each with its ``bode`` arrays (frequency [Hz], loop magnitude [dB] and phase [deg], sampled where given).
     """
     fig, (am, ap) = new_figure("bode", 2, 1, sharex=True, gridspec_kw={"hspace": 0.1})
+    if draw_bode(am, ap, analyses):
+        fig.subplots_adjust(left=0.1, right=0.985, top=0.9, bottom=0.12)
+    return to_svg(fig, prefix)
+
+
+def draw_bode(am, ap, analyses: list) -> int:
+    """Draw the loop's Bode magnitude on ``am`` and phase on ``ap`` per analysis (see :func:`bode_figure`); the count drawn."""
     shown = 0
-    palette = PALETTE
     for k, (label, a) in enumerate(analyses):
-        b = a.get("bode") or {}
-        f = b.get("frequency_hz")
-        mag = b.get("loop_discrete_magnitude_db") or b.get("loop_magnitude_db")
-        ph = b.get("loop_discrete_phase_deg") or b.get("loop_phase_deg")
+        f, mag, ph = a.bode.frequency_hz, a.bode.loop_magnitude, a.bode.loop_phase
         if not f or not mag:
             continue
-        c = palette[k % len(palette)]
+        c = PALETTE[k % len(PALETTE)]
         am.semilogx(f, mag, color=c, label=plain(label))
         if ph:
             ap.semilogx(f, ph, color=c)
-        figs = a.get("figures") or {}
-        if figs.get("gain_crossover_hz") and figs.get("phase_margin_deg") is not None:
-            ap.plot(figs["gain_crossover_hz"], figs["phase_margin_deg"] - 180.0, "o", ms=3.5, mfc="white", mec=c)
+        figs = a.figures
+        if figs.gain_crossover_hz and figs.phase_margin_deg is not None:
+            ap.plot(figs.gain_crossover_hz, figs.phase_margin_deg - 180.0, "o", ms=3.5, mfc="white", mec=c)
         shown += 1
     if not shown:
         message_axes(am, "no Bode data in the results")
         message_axes(ap, "")
-        return to_svg(fig, prefix)
+        return 0
     am.axhline(0.0, color="#333333", lw=0.6)
     ap.axhline(-180.0, color="#333333", lw=0.6)
     am.set_ylabel("|L| [dB]")
     ap.set_ylabel("phase [deg]")
     ap.set_xlabel("frequency [Hz]")
     am.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=4, borderaxespad=0.2)
-    fig.subplots_adjust(left=0.1, right=0.985, top=0.9, bottom=0.12)
-    return to_svg(fig, prefix)
+    return shown
 
 
 @styled
 def pole_figure(analyses: list, prefix: str) -> str:
     """Closed-loop poles (continuous) at each critical point, with the 0.25 s time-constant line."""
     fig, ax = new_figure("map")
-    palette = PALETTE
+    if draw_poles(ax, analyses):
+        fig.subplots_adjust(left=0.1, right=0.985, top=0.8, bottom=0.16)
+    return to_svg(fig, prefix)
+
+
+def draw_poles(ax, analyses: list) -> int:
+    """Draw the closed-loop poles per analysis on ``ax`` (see :func:`pole_figure`); the count drawn."""
     shown = 0
     for k, (label, a) in enumerate(analyses):
-        poles = (a.get("poles") or {}).get("closed_loop")
+        poles = a.poles.closed_loop
         if not poles:
             continue
         p = np.asarray(poles, float).reshape(-1, 2)
-        ax.plot(p[:, 0], p[:, 1], "x", ms=5, mew=1.2, color=palette[k % len(palette)], label=plain(label))
+        ax.plot(p[:, 0], p[:, 1], "x", ms=5, mew=1.2, color=PALETTE[k % len(PALETTE)], label=plain(label))
         shown += 1
     if not shown:
         message_axes(ax, "no pole data in the results")
-        return to_svg(fig, prefix)
+        return 0
     ax.set_xscale("symlog", linthresh=10.0)
     ax.set_yscale("symlog", linthresh=10.0)
     for tau, ls in ((0.25, (0, (4, 2))), (0.10, ":")):
@@ -162,5 +170,46 @@ def pole_figure(analyses: list, prefix: str) -> str:
     ax.set_xlabel("real part [1/s] (symmetric log)")
     ax.set_ylabel("imaginary part [rad/s]")
     ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=3, borderaxespad=0.2)
-    fig.subplots_adjust(left=0.1, right=0.985, top=0.8, bottom=0.16)
-    return to_svg(fig, prefix)
+    return shown
+
+
+def _draw_step(ax, step) -> None:
+    """The predicted step of the linear loop (sampled and continuous) [mm against s]."""
+    if step is None or not step.time:
+        message_axes(ax, "no predicted step in the analysis")
+        return
+    ax.plot(step.time, to_display(np.asarray(step.position, float), "m", "mm"), color=COLORS["position"], label="sampled loop")
+    if step.time_continuous:
+        ax.plot(step.time_continuous, to_display(np.asarray(step.position_continuous, float), "m", "mm"), color=COLORS["reference"],
+                ls=(0, (4, 2)), label="continuous")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("position [mm]")
+    ax.set_title(f"predicted {fmt_quantity(abs(step.size), 'm', 'mm', 0)} step")
+    ax.legend(loc="lower right")
+
+
+@styled
+def analysis_page(analysis, label: str, omap=None, fmt: str = "png") -> bytes:
+    """One linear analysis on one page in the report's figures (``govcheck linear --plot``): the loop's Bode
+    diagram, the closed-loop poles, the predicted step and, with a map, the time-constant map; bytes of ``fmt``
+    (png, svg or pdf, without a date so the same analysis gives the same file)."""
+    import io
+
+    from matplotlib.figure import Figure
+
+    from compliance.report.svg import HEIGHTS_IN, WIDTH_IN
+
+    rows = 3 if omap else 2
+    fig = Figure(figsize=(WIDTH_IN, HEIGHTS_IN["bode"] + HEIGHTS_IN["map"] * (rows - 1)))
+    grid = fig.add_gridspec(rows + 1, 2, height_ratios=[1.0, 1.0] + [1.6] * (rows - 1), hspace=0.55, wspace=0.3)
+    am, ap = fig.add_subplot(grid[0, :]), None
+    ap = fig.add_subplot(grid[1, :], sharex=am)
+    draw_bode(am, ap, [(label, analysis)])
+    draw_poles(fig.add_subplot(grid[2, 0]), [(label, analysis)])
+    _draw_step(fig.add_subplot(grid[2, 1]), analysis.step)
+    if omap:
+        draw_map(fig, fig.add_subplot(grid[3, :]), omap, "time_constant")
+    buf = io.BytesIO()
+    meta = {"svg": {"Date": None}, "pdf": {"CreationDate": None}}.get(fmt, {})
+    fig.savefig(buf, format=fmt, metadata=meta, bbox_inches="tight", pad_inches=0.05)
+    return buf.getvalue()

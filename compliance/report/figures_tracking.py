@@ -14,12 +14,12 @@ _AXIS_COLORS = {"x": "#0072B2", "y": "#E69F00", "z": "#009E73"}
 
 
 def _arr(trace, key):
-    v = trace.get(key)
+    v = trace.signal(key)
     return None if v is None else np.asarray(v, float)
 
 
-def draw_path(ax_xy, ax_err, trace: dict, *, label="measured", color="#0072B2", errors=True) -> None:
-    """Draw one ``path3d`` trace on an xy axes (1:1) and an error-against-time axes."""
+def draw_path(ax_xy, ax_err, trace, *, label="measured", color="#0072B2", errors=True) -> None:
+    """Draw one ``path3d`` trace (a ``compliance.results.runs.Trace``) on an xy axes (1:1) and an error-against-time axes."""
     px, py = _arr(trace, "path_x"), _arr(trace, "path_y")
     if px is not None:
         ax_xy.plot(px * MM, py * MM, color="#555555", lw=0.8, label="reference path")
@@ -44,7 +44,7 @@ def path_figure(trace: dict, prefix: str) -> str:
 
     Parameters
     ----------
-    trace : dict
+    trace : Trace
         A trace with ``kind == "path3d"`` (``tracking_procedures._path_trace``): time [s],
         reference/position/error per axis, path_x/y/z, path_deviation [m].
     prefix : str

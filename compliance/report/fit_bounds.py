@@ -22,21 +22,21 @@ def at_bound(value, low, high, log: bool = False) -> bool:
     return value - low <= tol or high - value <= tol
 
 
-def effect_bound(p: dict) -> str | None:
-    """"at its fit bound" for a fitted effect parameter (``effect.name``) on a bound of its declaration."""
+def effect_bound(name: str, value, unit: str = "") -> str | None:
+    """"at its fit bound" for a fitted effect parameter ``name`` (``effect.param``) on a bound of its declaration."""
     from compliance.effects import EFFECTS
-    from compliance.units.formatting import fmt_si
+    from compliance.presentation.numbers import fmt_si
 
-    effect, _, name = str(p.get("name") or "").partition(".")
+    effect, _, param = str(name or "").partition(".")
     eff = EFFECTS.get(effect)
-    if eff is None or not name or p.get("value") is None:
+    if eff is None or not param or value is None:
         return None
     try:
-        spec = eff.param(name)
+        spec = eff.param(param)
     except (KeyError, ValueError):
         return None
     lo, hi = spec.bounds
-    if at_bound(p["value"], lo, hi, bool(getattr(spec, "log_scale", False))):
-        edge = lo if abs(p["value"] - lo) <= abs(p["value"] - hi) else hi
-        return f"at its fit bound ({fmt_si(edge, p.get('unit') or '')}): not determined by the recording"
+    if at_bound(value, lo, hi, bool(getattr(spec, "log_scale", False))):
+        edge = lo if abs(value - lo) <= abs(value - hi) else hi
+        return f"at its fit bound ({fmt_si(edge, unit or '')}): not determined by the recording"
     return None

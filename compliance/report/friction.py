@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from compliance.presentation.quantities import fmt_quantity, to_display
 from compliance.report.fit_bounds import at_bound
 from compliance.report.svg import styled, to_svg
 
@@ -42,13 +43,14 @@ def seal_figures(seal, prefix: str = "fric") -> list[tuple[str, str]]:
     for ax, i in zip(axes[0], picks):
         r = runs[i]
         span = r.time <= min(r.time[-1], r.time[0] + 25.0)
-        ax.plot(r.position[span] * 1e3, r.friction[span], color="k", lw=0.6, label="measured")
-        ax.plot(r.position[span] * 1e3, predict(r, base)[span], color="tab:blue", lw=0.7, label="before: baseline law")
+        x_mm = to_display(r.position[span], "m", "mm")
+        ax.plot(x_mm, r.friction[span], color="k", lw=0.6, label="measured")
+        ax.plot(x_mm, predict(r, base)[span], color="tab:blue", lw=0.7, label="before: baseline law")
         if win is not None:
-            ax.plot(r.position[span] * 1e3, predict(r, win)[span], color="tab:orange", lw=0.7, label="after: with the added physics")
+            ax.plot(x_mm, predict(r, win)[span], color="tab:orange", lw=0.7, label="after: with the added physics")
         ax.set_xlabel("position [mm]")
         ax.set_ylabel("friction F \u2212 p\u00b7A [N]")
-        ax.set_title(f"{r.name} ({r.pressure / 1e3:.0f} kPa gauge)", fontsize=8)
+        ax.set_title(f"{r.name} ({fmt_quantity(r.pressure, 'Pa', 'kPa', 0)} gauge)", fontsize=8)
         ax.grid(alpha=0.3)
     axes[0][0].legend(fontsize=7)
     fig.tight_layout()
@@ -75,7 +77,7 @@ def seal_figures(seal, prefix: str = "fric") -> list[tuple[str, str]]:
                 to_svg(fig, f"{prefix}-2")))
     plt.close(fig)
     fig, ax = plt.subplots(figsize=(5.5, 3.2))
-    p = np.array([r.pressure / 1e3 for r in runs])
+    p = to_display(np.array([r.pressure for r in runs]), "Pa", "kPa")
     w = 0.35 * (np.min(np.diff(p)) if p.size > 1 else 1.0)
     ax.bar(p - w / 2, base.rms_per_run(), width=w, color="tab:blue", label="before: baseline law")
     if win is not None:
@@ -99,7 +101,7 @@ DBIC_TEXT = ("\u0394BIC: Bayesian information criterion relative to the best law
 def _param_rows(params: list) -> list[dict]:
     """Fitted parameters with SI prefixes, standard errors and a flag when a value sits on its fit bound."""
     from compliance.diagnosis.friction_bench.fit import FIT_BOUNDS
-    from compliance.units.formatting import fmt_si
+    from compliance.presentation.numbers import fmt_si
 
     rows = []
     for p in params:
@@ -116,12 +118,12 @@ def _param_rows(params: list) -> list[dict]:
 
 def _seal_context(seal, sd: dict, index: int) -> dict:
     """What the report shows of one seal: finding, parameters with errors (SI prefixes), ranked laws, residual remarks."""
-    from compliance.units.formatting import fmt_dbic, fmt_num, fmt_si, fmt_value
+    from compliance.presentation.numbers import fmt_dbic, fmt_num, fmt_si, fmt_value
 
     win = next((e for e in sd["effects"] if e["name"] == sd["winner"]), None) if sd["winner"] else None
     params = _param_rows((win or {}).get("parameters") or [])
     ranked = [{"name": e["name"].replace("+", " + ").replace("_", " "), "k": e["k"], "chi2": fmt_num(e.get("chi2_per_residual"), 3),
-               "dbic": fmt_dbic(e.get("delta_bic")), "explained": fmt_value(100 * (e.get("explained_fraction") or 0), "%", 3),
+               "dbic": fmt_dbic(e.get("delta_bic")), "explained": fmt_quantity(e.get("explained_fraction") or 0, "", "%"),
                "params": "; ".join(f"{p['name'].replace('_', ' ')} {fmt_si(p['value'], p.get('unit') or '')}"
                                    for p in e["parameters"] if p.get("value") is not None)} for e in sd["effects"]]
     floor = (sd.get("noise_floor") or {}).get("value")
@@ -152,11 +154,11 @@ def _seal_context(seal, sd: dict, index: int) -> dict:
 
 def _holdout_context(h: dict | None) -> dict | None:
     """The held-out table of a seal (friction_holdout.holdout_table), formatted."""
-    from compliance.units.formatting import fmt_num, fmt_value
+    from compliance.presentation.numbers import fmt_num, fmt_value
 
     if not h:
         return None
-    rows = [{"run": r["run"], "p": fmt_value(r["pressure_gauge"] / 1e5, "bar", 3), "ins": fmt_value(r["in_sample_rms"], "N", 3),
+    rows = [{"run": r["run"], "p": fmt_quantity(r["pressure_gauge"], "Pa", "bar"), "ins": fmt_value(r["in_sample_rms"], "N", 3),
              "held": fmt_value(r["held_out_rms"], "N", 3), "ratio": fmt_num(r["ratio"], 3),
              "offset": fmt_value(r["held_out_offset"], "N", 2), "ratio0": fmt_num(r["ratio_without_offset"], 3),
              "noise": fmt_value(r["noise_floor"], "N", 2)} for r in h["runs"]]
@@ -186,7 +188,7 @@ def write_friction_report(diag, html_path, pdf_path=None, *, document: dict | No
 
     from compliance.report.render import _check_target, _common, _emit, file_sha256
     from compliance.report.signoff import document_block
-    from compliance.units.formatting import fmt_date
+    from compliance.presentation.numbers import fmt_date
 
     if html_path:
         html_path = _check_target(html_path, "--report")

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import jinja2
 
-from compliance import __version__
+from compliance.version import __version__
 from compliance.errors import InputError
 from compliance.files.atomic import write_bytes_atomic
 from compliance.files.display import display_path
@@ -33,7 +33,8 @@ from compliance.report import content as C
 from compliance.report import signoff as S
 from compliance.report.analysis_sections import linear_section, validation_section
 from compliance.report.requirement_pages import requirement_pages
-from compliance.units.formatting import fmt_date, fmt_margin_pct, fmt_num, fmt_si, status_word, unit_text
+from compliance.results.validation import ValidationRecord
+from compliance.presentation.numbers import fmt_date, fmt_margin_pct, fmt_num, fmt_si, status_word, unit_text
 
 TEMPLATES = resources.files("compliance.report") / "templates"
 VALIDATION_SCHEMA = "govcheck.validation/1"
@@ -45,7 +46,7 @@ def _draw(spec: dict, valve: dict | None = None) -> str:
     from compliance.report import figures, figures_linear
 
     k = spec["kind"]
-    if k == "trace" and spec["trace"].get("kind") == "path3d":
+    if k == "trace" and spec["trace"].kind == "path3d":
         from compliance.report.figures_tracking import path_figure  # plant B's 3-D path overlay and per-axis errors
 
         return path_figure(spec["trace"], spec["id"])
@@ -176,15 +177,15 @@ def _emit(template: str, ctx: dict, svgs: dict, html_path, pdf_path) -> dict:
     return {"html": t1 - t0, "pdf": t2 - t1}
 
 
-def _now(results: dict) -> str:
+def _now(created: str | None = None, reproducible: bool = False) -> str:
     """When the report was rendered; the results' fixed ``created`` for a reproducible run."""
-    if results.get("reproducible") or is_reproducible():
-        return results.get("created") or fixed_created()
+    if reproducible or is_reproducible():
+        return created or fixed_created()
     return _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
 
 
-def _common(results: dict) -> dict:
-    v = dict(results.get("versions") or {})
+def _common(versions, created: str | None = None, reproducible: bool = False) -> dict:
+    v = dict(versions or {})
     v.setdefault("govcheck", __version__)
     v.setdefault("python", platform.python_version())
     import matplotlib
@@ -193,80 +194,82 @@ def _common(results: dict) -> dict:
     v.setdefault("matplotlib (report)", matplotlib.__version__)
     v.setdefault("weasyprint (report)", weasyprint.__version__)
     v.setdefault("jinja2 (report)", jinja2.__version__)
-    return {"versions": v, "rendered": fmt_date(_now(results)), "govcheck_version": __version__}
+    return {"versions": v, "rendered": fmt_date(_now(created, reproducible)), "govcheck_version": __version__}
 
 
 # --------------------------------------------------------------------------- API
 APPENDIX_LEVELS = ("none", "summary", "full")
 
 
-def build_report(results: dict, workers: int | None = None, appendix: str = "summary",
+def build_report(results, workers: int | None = None, appendix: str = "summary",
                  document: dict | None = None, scheduler: str | None = None) -> tuple[dict, dict]:
     """Check the results and build the template context and the figures (no file written).
 
+    ``results``: a :class:`~compliance.results.CheckResult` (a results dict is read into one here).
     ``appendix``: ``none`` (sign-off page, requirement pages, linear and validation sections),
     ``summary`` (+ configuration, requirement file, command, versions) or ``full`` (+ every run
     with its figures). ``document``: see :func:`compliance.report.signoff.document_control`.
     """
     if appendix not in APPENDIX_LEVELS:
         raise InputError(f"--appendix {appendix}: expected one of {', '.join(APPENDIX_LEVELS)}")
-    C.check_results(results)
-    pages, specs = requirement_pages(results, 1)
-    sections, run_specs = C.procedure_sections(results, len(specs) + 1) if appendix == "full" else ([], [])
+    res = C.as_result(results)
+    pages, specs = requirement_pages(res, 1)
+    sections, run_specs = C.procedure_sections(res, len(specs) + 1) if appendix == "full" else ([], [])
     specs += run_specs
-    lin_ctx, lin_specs = linear_section(results.get("linear"), len(specs) + 1, results)
-    val_ctx, val_specs = validation_section(results.get("validation"), len(specs) + len(lin_specs) + 1)
-    svgs = draw_figures(specs + lin_specs + val_specs, C.valve_marks(results), workers, scheduler)
-    plant, rs, summary = results["plant"], results["requirement_set"], results["summary"]
+    lin_ctx, lin_specs = linear_section(res.linear_section, len(specs) + 1, res)
+    validation = ValidationRecord.from_dict(res.validation, "results.validation") if res.validation else None
+    val_ctx, val_specs = validation_section(validation, len(specs) + len(lin_specs) + 1)
+    svgs = draw_figures(specs + lin_specs + val_specs, C.valve_marks(res), workers, scheduler)
+    plant = res.plant
     ctx = {
-        **_common(results),
+        **_common(res.versions, res.created, bool(res.reproducible)),
         "plant": plant,
-        "identity": plant.get("identity") or {},
-        "rs": rs,
-        "summary": summary,
-        "verdict": summary["status"],
-        "qualified": S.qualified_verdict(results),
-        "created": fmt_date(results.get("created")),
-        "rows": C.summary_rows(results),
-        "basis": S.basis(results),
-        "failures": S.failures(results),
-        "not_evaluated": S.not_evaluated(results),
-        "assumptions": S.assumptions(results),
-        "doc": S.document_control(results, document),
-        "scope": A.scope(results),
-        "conditions": A.conditions(results),
-        "method": A.method_rows(results),
-        "not_tested": A.not_tested(results),
-        "code_deviations": A.code_deviations(results),
-        "conclusions": A.conclusions(results),
-        "parties": A.parties(plant.get("identity") or {}),
-        "remedies": results.get("remedies"),
+        "identity": plant.identity,
+        "rs": res.requirement_set,
+        "summary": res.summary,
+        "verdict": res.summary.status,
+        "qualified": S.qualified_verdict(res),
+        "created": fmt_date(res.created),
+        "rows": C.summary_rows(res),
+        "basis": S.basis(res),
+        "failures": S.failures(res),
+        "not_evaluated": S.not_evaluated(res),
+        "assumptions": S.assumptions(res),
+        "doc": S.document_control(res, document),
+        "scope": A.scope(res),
+        "conditions": A.conditions(res),
+        "method": A.method_rows(res),
+        "not_tested": A.not_tested(res),
+        "code_deviations": A.code_deviations(res),
+        "conclusions": A.conclusions(res),
+        "parties": A.parties(plant.identity),
+        "remedies": res.remedies,
         "pages": pages,
         "appendix": appendix,
         "sections": sections,
         "linear": lin_ctx,
         "validation": val_ctx,
-        "parameters": C.parameter_rows(results),
-        "options": sorted((plant.get("options") or {}).items()),
-        "effects": plant.get("effects") or [],
-        "load_curve": plant.get("load_curve"),
-        "provenance": sorted((plant.get("provenance") or {}).items()),
-        "command": C.command_text(results),
-        "timing": results.get("timing") or {},
+        "parameters": C.parameter_rows(res),
+        "options": sorted(plant.options.items()),
+        "effects": plant.effects,
+        "load_curve": plant.load_curve,
+        "provenance": sorted(plant.provenance.items()),
+        "command": C.command_text(res),
+        "timing": res.timing,
     }
     return ctx, svgs
 
 
-def render_report(results: dict, html_path=None, pdf_path=None, *, workers: int | None = None,
+def render_report(results, html_path=None, pdf_path=None, *, workers: int | None = None,
                   appendix: str = "summary", document: dict | None = None, scheduler: str | None = None) -> None:
     """Render the compliance report of a ``govcheck check`` results dict.
 
     Parameters
     ----------
-    results : dict
-        Results of ``compliance.campaign.run.run_campaign`` (schema ``govcheck-results/1``,
+    results : CheckResult or dict
+        The result of ``compliance.check`` (or its JSON object, schema ``govcheck-results/1``,
         docs/results-schema.md), optionally with ``linear`` (``govcheck linear --json``) and
-        ``validation`` (``compliance.validation.validate.validate``) entries.
+        ``validation`` (``compliance.validation.validate.validate``) sections.
     html_path, pdf_path : path, optional
         Where to write the HTML and the PDF; at least one.
     workers : int, optional
@@ -346,21 +349,21 @@ def render_validation_report(result: dict, html_path, pdf_path=None, *, workers:
     if pdf_path:
         _check_target(pdf_path, "--pdf")
     check_validation(result)
-    ctx, specs = validation_section(result, 1)
+    val = ValidationRecord.from_dict(result, "validation results")
+    ctx, specs = validation_section(val, 1)
     svgs = draw_figures(specs, None, workers, scheduler)
-    plant = dict(result.get("plant") or {})
-    plant["path"] = display_path(plant.get("path"))  # never an installation's absolute path
-    ctx["recording"] = dict(ctx["recording"], path=display_path(ctx["recording"].get("path")))
-    rec = ctx["recording"]
-    digest = rec.get("digest") or rec.get("sha256") or file_sha256(result.get("recording", {}).get("path"))
+    plant = dict(val.plant, path=display_path(val.plant.get("path")))  # never an installation's absolute path
+    rec = dict(val.recording, path=display_path(val.recording.get("path")))
+    ctx["recording"] = rec
+    digest = rec.get("digest") or rec.get("sha256") or file_sha256(val.recording.get("path"))
     files = [{"what": "Plant configuration", "path": plant.get("path") or plant.get("name"), "digest": plant.get("digest")},
              {"what": "Recording", "path": rec.get("path"), "digest": digest}]
     document = document or {}
-    ctx = {**_common({"versions": {"govcheck": (result.get("tool") or {}).get("version", __version__)}}),
-           "v": ctx, "plant": plant, "settings": C.readable_settings(result.get("settings") or {}),
-           "conditions": C.readable_settings(ctx.get("conditions") or {}), "windows": result.get("windows") or [],
-           "created": fmt_date(result.get("created")), "identity": document.get("identity") or {},
-           "doc": S.document_block(document.get("identity") or {}, files, document)}
+    identity = document.get("identity") or {}
+    ctx = {**_common({"govcheck": val.tool.get("version", __version__)}),
+           "v": ctx, "plant": plant, "settings": C.readable_settings(val.settings), "conditions": C.readable_settings(val.conditions),
+           "windows": val.windows, "created": fmt_date(val.created), "identity": identity,
+           "doc": S.document_block(identity, files, document)}
     _emit("validation.html.j2", ctx, svgs, html_path, pdf_path)
 
 

@@ -14,7 +14,7 @@ import re
 from compliance.metrics import METRICS
 from compliance.presentation.values import limit_as_written, metric_text
 from compliance.requirements.verdict import Status
-from compliance.units.formatting import fmt_margin_pct, fmt_value
+from compliance.presentation.numbers import fmt_margin_pct, fmt_value
 
 TOLERANCE_METRICS = ("max_positioning_error", "tracking_max_error", "steady_state_error")
 SPEED_METRICS = ("max_speed", "max_opening_speed", "max_closing_speed")
@@ -42,9 +42,9 @@ def reader_text(text) -> str:
     return _MODULE_REF_RE.sub(lambda m: f"govcheck's {m.group(1).replace('_', ' ')} analysis", text)
 
 
-def _step_facts(sample: dict, limit_si, metric: str) -> dict:
+def _step_facts(sample, limit_si, metric: str) -> dict:
     """Coverage of a step (fraction of the commanded step moved) and whether it can fail at all."""
-    d = sample.get("detail") or {}
+    d = sample.detail
     size, x0, x1 = d.get("size"), d.get("x_start"), d.get("x_final")
     out = {}
     if isinstance(size, (int, float)) and size and isinstance(x0, (int, float)) and isinstance(x1, (int, float)):
@@ -54,31 +54,29 @@ def _step_facts(sample: dict, limit_si, metric: str) -> dict:
     return out
 
 
-def _row_cells(e: dict, r: dict) -> dict:
+def _row_cells(e, r) -> dict:
     """A case row: value, margin, status, the per-step details (coverage, exclusions)."""
-    metric = e["metric"]
+    metric = e.metric
     steps, cannot = [], []
-    for s in r.get("samples") or []:
-        facts = _step_facts(s, r.get("limit"), metric)
-        excluded = not s.get("eligible", True)
-        txt = f"{s.get('label')}: {metric_text(s.get('value'), metric)}"
+    for s in r.samples:
+        facts = _step_facts(s, r.limit, metric)
+        txt = f"{s.label}: {metric_text(s.value, metric)}"
         if "covered" in facts:
             txt += f", moved {100 * facts['covered']:.0f} % of the step"
-        short = str(s.get("reason") or "not eligible").split(":")[0]  # the full reason is listed once under the table
-        if s.get("value") is None and s.get("reason"):
+        short = str(s.reason or "not eligible").split(":")[0]  # the full reason is listed once under the table
+        if s.value is None and s.reason:
             txt += f" (not measured: {short})"
-        elif excluded:
+        elif not s.eligible:
             txt += f" (excluded: {short})"
-        steps.append({"text": txt, "excluded": excluded or s.get("value") is None})
+        steps.append({"text": txt, "excluded": not s.eligible or s.value is None})
         cannot.append(facts.get("cannot_fail"))
     cannot_fail = bool(cannot) and all(c is True for c in cannot)
-    margin = None if r.get("margin") is None else metric_text(r["margin"], metric)
-    return {"req": e["id"], "procedure": r.get("procedure"), "ops": [r.get("operating_point")], "value": metric_text(r.get("value"), metric),
-            "which": r.get("which"), "margin": margin, "margin_pct": fmt_margin_pct(r.get("margin_pct")),
-            "status": r.get("status"), "reason": str(r.get("reason")).split(":")[0] if r.get("reason") else None,
-            "raw": r.get("value"), "raw_margin": r.get("margin"), "metric": metric,
-            "steps": steps, "cannot_fail": cannot_fail,
-            "run": r.get("run")}
+    margin = None if r.margin is None else metric_text(r.margin, metric)
+    return {"req": e.id, "procedure": r.procedure, "ops": [r.operating_point], "value": metric_text(r.value, metric),
+            "which": r.which, "margin": margin, "margin_pct": fmt_margin_pct(r.margin_pct),
+            "status": r.status, "reason": str(r.reason).split(":")[0] if r.reason else None,
+            "raw": r.value, "raw_margin": r.margin, "metric": metric, "steps": steps, "cannot_fail": cannot_fail,
+            "run": r.run}
 
 
 def _grouped(rows: list[dict]) -> list[dict]:
@@ -115,15 +113,13 @@ def _grouped(rows: list[dict]) -> list[dict]:
     return out
 
 
-def _pick_trace(run: dict, which: str | None) -> dict | None:
+def _pick_trace(run, which: str | None):
     """The trace of ``run`` that the worst case ``which`` was measured on.
 
     ``which`` names the direction first and, for the independent-adjustment runs, the valve
     changed ("closing time when opening valve x0.5" -> trace "... opening x0.5 closing").
     """
-    import re
-
-    traces = run.get("traces") or []
+    traces = run.traces
     if not traces:
         return None
     if which:
@@ -132,23 +128,23 @@ def _pick_trace(run: dict, which: str | None) -> dict | None:
         if m and words:
             want = f" {m.group(1)} {m.group(2)} {words[0]}"
             for tr in traces:
-                if str(tr.get("label") or "").endswith(want):
+                if tr.label.endswith(want):
                     return tr
         for tr in traces:
-            tail = str(tr.get("label") or "").rsplit(" ", 1)[-1]
+            tail = tr.label.rsplit(" ", 1)[-1]
             if tail and words and tail == words[0]:
                 return tr
         for tr in traces:
-            tail = str(tr.get("label") or "").rsplit(" ", 1)[-1]
+            tail = tr.label.rsplit(" ", 1)[-1]
             if tail and tail in which:
                 return tr
     return traces[0]
 
 
-def trace_words(label, run: dict) -> str:
+def trace_words(label, run) -> str:
     """What a trace shows, from its own label (the caption is made from the data drawn, never from the verdict)."""
     tail = str(label or "")
-    head = f"{run.get('procedure')}@{run.get('operating_point')}"
+    head = f"{run.procedure}@{run.operating_point}"
     tail = tail[len(head):].strip() if tail.startswith(head) else ""
     m = tail.split()
     if len(m) == 3 and m[1].startswith("x"):
@@ -158,24 +154,23 @@ def trace_words(label, run: dict) -> str:
     return f"{tail} stroke" if tail in ("opening", "closing") else tail
 
 
-def _stroke_partner(run: dict, tr: dict, entries: list) -> dict | None:
+def _stroke_partner(run, tr, entries: list):
     """The other direction's stroke when a page judges both opening and closing times on the same run."""
-    metrics = {e["metric"] for e in entries}
-    if not {"opening_time", "closing_time"} <= metrics:
+    if not {"opening_time", "closing_time"} <= {e.metric for e in entries}:
         return None
-    label = str(tr.get("label") or "")
+    label = tr.label
     for a, b in (("opening", "closing"), ("closing", "opening")):
         if label.endswith(" " + a):
             want = label[: -len(a)] + b
-            return next((t for t in run.get("traces") or [] if t.get("label") == want), None)
+            return next((t for t in run.traces if t.label == want), None)
     return None
 
 
-def _speed_excess(trace: dict, limit: float) -> dict | None:
+def _speed_excess(trace, limit: float) -> dict | None:
     """How far and how long the speed exceeds ``limit`` [m/s] in a trace (what matters for water hammer)."""
     import numpy as np
 
-    t, x = trace.get("time"), trace.get("position")
+    t, x = trace.signal("time"), trace.signal("position")
     if not t or not x or len(t) < 3:
         return None
     t = np.asarray(t, float)
@@ -192,8 +187,6 @@ def _speed_excess(trace: dict, limit: float) -> dict | None:
 
 def _distinct_reasons(reasons) -> list[str]:
     """One example of each kind of reason (reasons that differ only in their numbers are the same kind)."""
-    import re
-
     out, seen = [], set()
     for r in sorted(set(reasons)):
         for part in r.split("; "):
@@ -204,90 +197,102 @@ def _distinct_reasons(reasons) -> list[str]:
     return out
 
 
-def requirement_pages(results: dict, start: int = 1) -> tuple[list[dict], list[dict]]:
+_RANK = {Status.FAIL: 0, Status.NOT_EVALUATED: 1, Status.OPEN: 2, Status.PASS: 3, Status.DISABLED: 4}
+
+
+def _page_requirement(e) -> dict:
+    """A requirement on its page: what it rests on, its worst value against its limit, its grouped cases."""
+    cases = _grouped([_row_cells(e, r) for r in e.rows])
+    w = e.worst
+    info = METRICS.get(e.metric)
+    return {"id": e.id, "title": e.title, "status": e.status, "severity": e.severity, "metric": e.metric,
+            "meaning": info.meaning if info else "", "standard": e.standard, "clause": reader_text(e.clause),
+            "note": reader_text(e.note), "limit": limit_as_written(e),
+            "value": metric_text(w.value, e.metric) if w is not None else "\u2013",
+            "margin_pct": fmt_margin_pct(w.margin_pct if w is not None else None), "cases": cases,
+            "cannot_fail": sum(1 for c in cases if c["cannot_fail"]),
+            "not_evaluated": sum(len(c["ops"]) for c in cases if c["status"] == Status.NOT_EVALUATED)}
+
+
+def _figure(result, lead, entries, reqs, page, specs, start) -> None:
+    """The page's plot: the lead requirement's worst case with its limit drawn (spec appended to ``specs``)."""
+    w = lead.worst
+    run = result.run(w.run) if w is not None else None
+    tr = _pick_trace(run, w.which) if run else None
+    if tr is None:
+        return
+    fid = f"fig-{start + len(specs)}"
+    if tr.kind == "path3d":
+        specs.append({"id": fid, "kind": "trace", "trace": tr, "marks": (), "run_kind": run.kind})
+        page["figure"] = {"id": fid, "run": run.id, "procedure": run.procedure, "operating_point": run.operating_point,
+                          "which": w.which, "trace": tr.label, "limit_drawn": False}
+        return
+    lim = lead.rows[0].limit if lead.rows else None
+    spec = {"id": fid, "kind": "trace", "trace": tr, "marks": run.marks, "run_kind": run.kind,
+            "compact": "short" if len(entries) > 2 or sum(len(r["cases"]) for r in reqs) >= 3 else True,
+            "tolerance": max(lim) if lim and lead.metric in TOLERANCE_METRICS else None,
+            "speed_limit": max(lim) if lim and lead.metric in SPEED_METRICS else None,
+            "tau_window": tuple(lim) if lim and len(lim) == 2 and lead.metric == "time_constant" else None}
+    partner = _stroke_partner(run, tr, entries)
+    if partner is not None:  # opening and closing times on one page: both strokes drawn
+        spec = {"id": fid, "kind": "strokes", "traces": [tr, partner], "marks": run.marks}
+    elif lead.metric == "dead_band" and run.kind == "dead_band":  # the loop, with the width allowed
+        spec = {"id": fid, "kind": "dead_band", "trace": tr, "limit": max(lim) if lim else None}
+    specs.append(spec)
+    shown = [trace_words(t.label, run) for t in ([tr, partner] if partner is not None else [tr])]
+    page["figure"] = {"id": fid, "run": run.id, "procedure": run.procedure, "operating_point": run.operating_point,
+                      "which": " and ".join(x for x in shown if x), "trace": tr.label,
+                      "limit_drawn": any(spec.get(k) is not None for k in ("tolerance", "speed_limit", "limit")),
+                      "kind": spec["kind"], "tau": spec.get("tau_window") is not None,
+                      "band_scaled": spec.get("tolerance") is not None}
+    if spec.get("speed_limit"):
+        ex = _speed_excess(tr, spec["speed_limit"])
+        if ex and ex.get("duration"):
+            page["facts"].append(
+                f"In this worst case the speed exceeds {metric_text(spec['speed_limit'], lead.metric)} for "
+                f"{fmt_value(ex['duration'], 's', 3)} (from {fmt_value(ex['start'], 's', 3)} to {fmt_value(ex['end'], 's', 3)}), "
+                f"peaking at {metric_text(w.value, lead.metric)}; the gate travels "
+                f"{metric_text(ex['extra_travel'], 'max_positioning_error')} more than it would at the limit speed.")
+
+
+def requirement_pages(result, start: int = 1) -> tuple[list[dict], list[dict]]:
     """Pages of section 4 and their figure specs (ids from ``fig-{start}``).
 
     Requirements judged on exactly the same runs share a page (e.g. the opening/closing times
     of IEC 61362 and IEEE 125 on the same strokes); the page's plot is the worst case of its
     most critical requirement (a failure first).
     """
-    runs = {r["id"]: r for r in results.get("runs") or []}
     groups: dict = {}
-    for e in results["requirements"]:
-        key = (e.get("source", "simulation"), tuple(sorted({r.get("run") for r in e["rows"]})) or (e["id"],))
+    for e in result.requirements:
+        key = (e.source, tuple(sorted({r.run for r in e.rows})) or (e.id,))
         groups.setdefault(key, []).append(e)
-    rank = {Status.FAIL: 0, Status.NOT_EVALUATED: 1, Status.OPEN: 2, Status.PASS: 3, Status.DISABLED: 4}
     pages, specs = [], []
     for (source, _), entries in groups.items():
-        lead = min(entries, key=lambda e: rank.get(e["status"], 5))
-        reqs = []
-        for e in entries:
-            cases = _grouped([_row_cells(e, r) for r in e["rows"]])
-            w = e.get("worst") or {}
-            reqs.append({"id": e["id"], "title": e["title"], "status": e["status"], "severity": e["severity"],
-                         "metric": e["metric"], "meaning": (METRICS.get(e["metric"]).meaning if METRICS.get(e["metric"]) else ""),
-                         "standard": e.get("standard"), "clause": reader_text(e.get("clause")), "note": reader_text(e.get("note")),
-                         "limit": limit_as_written(e), "value": metric_text(w.get("value"), e["metric"]) if w else "\u2013",
-                         "margin_pct": fmt_margin_pct(w.get("margin_pct")), "cases": cases,
-                         "cannot_fail": sum(1 for c in cases if c["cannot_fail"]),
-                         "not_evaluated": sum(len(c["ops"]) for c in cases if c["status"] == Status.NOT_EVALUATED)})
-        reasons = _distinct_reasons(str(x) for e in entries for r in e["rows"] for x in
-                                    [r.get("reason")] + [s.get("reason") for s in r.get("samples") or []] if x and ":" in str(x))
-        page = {"anchor": "page-" + lead["id"], "ids": [e["id"] for e in entries], "title": lead["title"],
+        lead = min(entries, key=lambda e: _RANK.get(e.status, 5))
+        reqs = [_page_requirement(e) for e in entries]
+        reasons = _distinct_reasons(str(x) for e in entries for r in e.rows for x in
+                                    [r.reason] + [s.reason for s in r.samples] if x and ":" in str(x))
+        page = {"anchor": "page-" + lead.id, "ids": [e.id for e in entries], "title": lead.title,
                 "source": source, "reqs": reqs, "figure": None, "facts": [], "reasons": reasons,
                 "cases": [c for r in reqs for c in r["cases"]]}
-        w = lead.get("worst") or {}
-        run = runs.get(w.get("run"))
-        tr = _pick_trace(run, w.get("which")) if run else None
-        if tr is not None and tr.get("kind") != "path3d":
-            lim = w.get("limit") or ((lead.get("rows") or [{}])[0].get("limit"))
-            spec = {"id": f"fig-{start + len(specs)}", "kind": "trace", "trace": tr, "marks": run.get("marks") or [],
-                    "run_kind": run["kind"], "compact": "short" if len(entries) > 2 or sum(len(r["cases"]) for r in reqs) >= 3 else True, "tolerance": max(lim) if lim and lead["metric"] in TOLERANCE_METRICS else None,
-                    "speed_limit": max(lim) if lim and lead["metric"] in SPEED_METRICS else None,
-                    "tau_window": tuple(lim) if lim and len(lim) == 2 and lead["metric"] == "time_constant" else None}
-            partner = _stroke_partner(run, tr, entries)
-            if partner is not None:  # opening and closing times on one page: both strokes drawn
-                spec = {"id": spec["id"], "kind": "strokes", "traces": [tr, partner], "marks": run.get("marks") or []}
-            elif lead["metric"] == "dead_band" and run["kind"] == "dead_band":  # the loop, with the width allowed
-                spec = {"id": spec["id"], "kind": "dead_band", "trace": tr, "limit": max(lim) if lim else None}
-            specs.append(spec)
-            shown = [trace_words(t.get("label"), run) for t in ([tr, partner] if partner is not None else [tr])]
-            page["figure"] = {"id": spec["id"], "run": run["id"], "procedure": run["procedure"],
-                              "operating_point": run["operating_point"], "which": " and ".join(x for x in shown if x),
-                              "trace": tr.get("label"),
-                              "limit_drawn": any(spec.get(k) is not None for k in ("tolerance", "speed_limit", "limit")),
-                              "kind": spec["kind"],
-                              "tau": spec.get("tau_window") is not None, "band_scaled": spec.get("tolerance") is not None}
-            if spec.get("speed_limit"):
-                ex = _speed_excess(tr, spec["speed_limit"])
-                if ex and ex.get("duration"):
-                    page["facts"].append(
-                        f"In this worst case the speed exceeds {metric_text(spec['speed_limit'], lead['metric'])} for "
-                        f"{fmt_value(ex['duration'], 's', 3)} (from {fmt_value(ex['start'], 's', 3)} to {fmt_value(ex['end'], 's', 3)}), "
-                        f"peaking at {metric_text(w.get('value'), lead['metric'])}; the gate travels "
-                        f"{metric_text(ex['extra_travel'], 'max_positioning_error')} more than it would at the limit speed.")
-        elif tr is not None:
-            spec = {"id": f"fig-{start + len(specs)}", "kind": "trace", "trace": tr, "marks": [], "run_kind": run["kind"]}
-            specs.append(spec)
-            page["figure"] = {"id": spec["id"], "run": run["id"], "procedure": run["procedure"],
-                              "operating_point": run["operating_point"], "which": w.get("which"), "trace": tr.get("label"),
-                              "limit_drawn": False}
-        if lead["metric"] == "time_constant" and source == "simulation" and lead["status"] == Status.FAIL:
-            page["facts"].append(_linear_contrast(results))
+        _figure(result, lead, entries, reqs, page, specs, start)
+        if lead.metric == "time_constant" and source == "simulation" and lead.status == Status.FAIL:
+            page["facts"].append(_linear_contrast(result))
         page["facts"] = [f for f in page["facts"] if f]
         pages.append(page)
     return pages, specs
 
 
-def _linear_contrast(results: dict) -> str | None:
+def _linear_contrast(result) -> str | None:
     """Why the linear time constant and HYGOV Tg can pass while the simulated steps fail."""
-    lin = [e for e in results["requirements"] if e["metric"] == "time_constant" and e.get("source") == "linear"]
-    gov = ((results.get("linear") or {}).get("governor") or {}).get("parameters") or {}
+    lin = [e for e in result.requirements if e.metric == "time_constant" and e.source == "linear"]
+    linear = result.linear_section
+    tg = linear.governor.parameters.get("Tg") if linear is not None and linear.governor is not None else None
     parts = []
-    if lin and (lin[0].get("worst") or {}).get("value") is not None:
-        parts.append(f"the linearised loop gives {metric_text(lin[0]['worst']['value'], 'time_constant')} ({lin[0]['id']})")
-    if gov.get("Tg") is not None:
-        parts.append(f"the HYGOV fit gives Tg = {fmt_value(gov['Tg'], 's', 3)}")
+    if lin and lin[0].worst is not None and lin[0].worst.value is not None:
+        parts.append(f"the linearised loop gives {metric_text(lin[0].worst.value, 'time_constant')} ({lin[0].id})")
+    if tg is not None:
+        parts.append(f"the HYGOV fit gives Tg = {fmt_value(tg, 's', 3)}")
     if not parts:
         return None
     return ("Why a smaller time constant appears elsewhere: " + " and ".join(parts) + ". Both are small-signal figures "

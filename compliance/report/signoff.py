@@ -11,64 +11,63 @@ from __future__ import annotations
 
 from collections import Counter
 
-from compliance.campaign.coverage import case_coverage, case_coverage_text
-from compliance.campaign.basis import verdict_qualifier
+from compliance.campaign.coverage import CASES_BASIS, case_coverage, case_coverage_text
 from compliance.model.parameters import used_by_model
 from compliance.presentation.values import limit_as_written, metric_text
 from compliance.requirements.verdict import Overall, Status
-from compliance.units.formatting import fmt_margin_pct, fmt_si
+from compliance.results.check_result import CheckResult
+from compliance.results.remedies import RemedySection
+from compliance.results.requirement_set import FileRecord
+from compliance.results.rows import WorstCase
+from compliance.results.summary import CaseCoverage, Qualifier
+from compliance.presentation.numbers import fmt_margin_pct, fmt_si
 
 SOURCE_WORDS = {"paper": "from the paper", "assumed": "assumed", "derived": "derived", "user": "set by the user",
                 "fitted": "fitted to a recording"}
 
 
-def _deciding(results: dict, used: list[dict]) -> list[str]:
+def _deciding(result: CheckResult, used) -> list[str]:
     """The assumptions that decide verdicts: named by the verdicts' bands when present, else the usual suspects."""
     named = []
-    for e in results["requirements"]:
-        for key in ((e.get("band") or {}).get("deciding") or []):
+    for e in result.requirements:
+        for key in (e.band.deciding if e.band is not None else ()):
             if key not in named:
                 named.append(str(key))
-    assumed = [p["key"] for p in used if p.get("source") == "assumed"]
-    out = []
-    if named:
-        out += [k for k in named][:3]
+    assumed = [p.key for p in used if p.source == "assumed"]
+    out = named[:3]
     friction = [k for k in assumed if k.startswith("friction.")]
     if friction and not any(k.startswith("friction.") for k in out):
         out.append("every friction value (" + ", ".join(k.split(".", 1)[1].replace("_", " ") for k in friction) + ")")
-    curve = results["plant"].get("load_curve") or {}
-    ops = results["requirement_set"].get("operating_points") or {}
-    if curve and curve.get("source", "assumed") == "assumed" and any(o.get("load") == "curve" for o in ops.values()):
+    curve = result.plant.load_curve
+    ops = result.requirement_set.operating_points.values()
+    if curve is not None and curve.assumed and any(o.on_curve for o in ops):
         out.append("the gate load curve over the stroke")
-    for k in ("valve.saturation_voltage",):
-        if k in assumed:
-            out.append("the valve's full-opening voltage")
+    if "valve.saturation_voltage" in assumed:
+        out.append("the valve's full-opening voltage")
     return out
 
 
-def basis(results: dict) -> dict:
+def basis(result: CheckResult) -> dict:
     """What every number of the report comes from: the model, the sources of the parameters it uses, validation."""
-    plant = results["plant"]
-    options = plant.get("options") or {}
-    params = [p for p in plant.get("parameters") or [] if isinstance(p, dict)]
-    used = [p for p in params if used_by_model(str(p.get("key")), options)]
-    counts = Counter(str(p.get("source") or "assumed") for p in used)
-    fitted = sum(len(e.get("params") or []) for e in plant.get("effects") or [])
+    plant = result.plant
+    used = [p for p in plant.parameters if used_by_model(p.key, plant.options)]
+    counts = Counter(p.source or "assumed" for p in used)
+    fitted = sum(len(e.params) for e in plant.effects)
     parts = [f"{n} {SOURCE_WORDS.get(s, s)}" for s, n in counts.most_common()]
-    val = results.get("validation")
+    val = result.validation
     if val:
         ok = (val.get("summary") or {}).get("pass")
         validated = (f"validated against a recording: {'PASS' if ok else 'FAIL' if ok is False else 'not decided'} "
                      "(section 6)")
     else:
         validated = "not validated: no recording of this servo was compared with the model"
-    bases = Counter(str(e.get("basis")) for e in results["requirements"] if e.get("basis"))
-    return {"model": plant["name"], "params": ", ".join(parts), "n_params": sum(counts.values()),
-            "n_unused": len(params) - len(used), "assumed": counts.get("assumed", 0),
-            "effects": [e.get("name") for e in plant.get("effects") or []], "fitted": fitted, "validated": validated,
-            "validation_run": bool(val), "deciding": _deciding(results, used),
+    bases = Counter(str(e.basis) for e in result.requirements if e.basis)
+    return {"model": plant.name, "params": ", ".join(parts), "n_params": sum(counts.values()),
+            "n_unused": len(plant.parameters) - len(used), "assumed": counts.get("assumed", 0),
+            "effects": [e.name for e in plant.effects], "fitted": fitted, "validated": validated,
+            "validation_run": bool(val), "deciding": _deciding(result, used),
             "verdict_bases": [f"{n} {k.replace('_', ' ')}" for k, n in bases.most_common()],
-            "provenance": dict(plant.get("provenance") or {})}
+            "provenance": dict(plant.provenance)}
 
 
 def document_block(identity: dict, files: list[dict], document: dict | None = None, *, needs_identity: bool = True) -> dict:
@@ -91,81 +90,74 @@ def document_block(identity: dict, files: list[dict], document: dict | None = No
             "author": identity.get("author"), "test_date": identity.get("test_date")}
 
 
-def document_control(results: dict, document: dict | None = None) -> dict:
+def document_control(result: CheckResult, document: dict | None = None) -> dict:
     """:func:`document_block` of a compliance report: configuration, requirement files, results file, recording.
 
     ``document`` may also carry ``results`` (``{"path", "digest"}`` of the saved results file).
     """
     document = document or {}
-    plant, rs = results["plant"], results["requirement_set"]
-    files = [{"what": "Plant configuration", "path": plant.get("path") or plant["name"], "digest": plant.get("digest")}]
-    for f in rs.get("files") or [{"path": rs.get("path"), "digest": rs.get("digest")}]:
-        files.append({"what": "Requirement file", "path": f.get("path"), "digest": f.get("digest")})
+    plant, rs = result.plant, result.requirement_set
+    files = [{"what": "Plant configuration", "path": plant.path or plant.name, "digest": plant.digest}]
+    for f in rs.files or (FileRecord(path=rs.path, digest=rs.digest),):
+        files.append({"what": "Requirement file", "path": f.path, "digest": f.digest})
     res = document.get("results") or {}
     files.append({"what": "Results file", "path": res.get("path") or "not saved (no --json)", "digest": res.get("digest")})
-    rec = (results.get("validation") or {}).get("recording") or {}
+    rec = (result.validation or {}).get("recording") or {}
     if rec:
         files.append({"what": "Recording", "path": rec.get("path"), "digest": rec.get("digest")})
-    return document_block(plant.get("identity") or {}, files, document)
+    return document_block(plant.identity, files, document)
 
 
 def _remedy_lines(rem) -> dict:
     """Requirement id -> one line on what would fix it, from a ``remedies`` section (docs/results-schema.md)."""
-    if not isinstance(rem, dict):
+    if not rem:
         return {}
-    out = {}
-    fix = rem.get("remedy")
-    if fix:
-        changes = ", ".join(f"{c['path']} from {fmt_si(c['from'], c['unit'])} to {fmt_si(c['to'], c['unit'])}"
-                            for c in fix.get("changes", []))
-        for rid in rem.get("failed", []):
-            out[rid] = f"passes with {changes} (verified by a full campaign: {fix.get('verified', {}).get('status', 'not run')})"
-        return out
-    for rid in rem.get("out_of_reach", []):
-        out[rid] = "out of reach of every adjustable setting searched; needs a hardware or design change"
-    for s in rem.get("sensitivities", []):
-        best = next((b for b in s.get("by_parameter", []) if b.get("delta_margin_pct", 0) > 0), None)
-        if s["requirement"] not in out and best:
-            out[s["requirement"]] = (f"no passing setting found; {best['path']} helps most "
-                                     f"({best['delta_margin_pct']:+.1f} points per {fmt_si(best['step'], best['unit'])})".replace("-", "\u2212"))
+    rem = RemedySection.from_dict(rem, "results.remedies")
+    if rem.remedy is not None:
+        changes = ", ".join(f"{c.path} from {fmt_si(c.start, c.unit)} to {fmt_si(c.end, c.unit)}" for c in rem.remedy.changes)
+        verified = rem.remedy.verified.get("status", "not run")
+        return {rid: f"passes with {changes} (verified by a full campaign: {verified})" for rid in rem.failed}
+    out = {rid: "out of reach of every adjustable setting searched; needs a hardware or design change" for rid in rem.out_of_reach}
+    for s in rem.sensitivities:
+        best = s.most_helpful
+        if s.requirement not in out and best:
+            out[s.requirement] = (f"no passing setting found; {best.path} helps most "
+                                  f"({best.delta_margin_pct:+.1f} points per {fmt_si(best.step, best.unit)})".replace("-", "\u2212"))
     return out
 
 
-def failures(results: dict) -> list[dict]:
+def failures(result: CheckResult) -> list[dict]:
     """One line per failed requirement: the failing number against its limit, where, and the remedy if computed."""
-    remedies = _remedy_lines(results.get("remedies"))
+    remedies = _remedy_lines(result.remedies)
     out = []
-    for e in results["requirements"]:
-        if e["status"] != Status.FAIL:
-            continue
-        w = e.get("worst") or {}
-        out.append({"id": e["id"], "title": e["title"], "severity": e["severity"], "value": metric_text(w.get("value"), e["metric"]),
-                    "limit": limit_as_written(e), "margin_pct": fmt_margin_pct(w.get("margin_pct")),
-                    "where": f"{w.get('procedure')} at {w.get('operating_point')}" if w.get("procedure") else None,
-                    "remedy": remedies.get(e["id"]), "anchor": "req-" + e["id"]})
+    for e in result.failed():
+        w = e.worst or WorstCase()
+        out.append({"id": e.id, "title": e.title, "severity": e.severity, "value": metric_text(w.value, e.metric),
+                    "limit": limit_as_written(e), "margin_pct": fmt_margin_pct(w.margin_pct),
+                    "where": f"{w.procedure} at {w.operating_point}" if w.procedure else None,
+                    "remedy": remedies.get(e.id), "anchor": "req-" + e.id})
     return out
 
 
-def not_evaluated(results: dict) -> dict:
+def not_evaluated(result: CheckResult) -> dict:
     """Judged test cases not evaluated, counted by reason, on the basis of the terminal and JSON summaries
     (:func:`compliance.campaign.coverage.case_coverage`)."""
-    cov = case_coverage(results["requirements"])
+    cov = result.summary.coverage or CaseCoverage(**case_coverage([e.as_dict() for e in result.requirements]))
     reasons = Counter()
-    for e in results["requirements"]:
-        if e.get("limit") is None:
+    for e in result.requirements:
+        if e.limit is None:
             continue
-        for r in e["rows"]:
-            if r.get("status") == Status.NOT_EVALUATED:
-                reasons[(e["id"], str(r.get("reason") or "no value").split(":")[0].split(";")[0].strip())] += 1
+        for r in e.rows:
+            if r.status == Status.NOT_EVALUATED:
+                reasons[(e.id, str(r.reason or "no value").split(":")[0].split(";")[0].strip())] += 1
     items = [{"requirement": rid, "reason": why, "count": n} for (rid, why), n in reasons.most_common()]
-    return {"cases": cov["rows"], "count": cov["not_evaluated"], "evaluated": cov["evaluated"], "basis": cov["basis"],
-            "text": case_coverage_text(cov), "reasons": items,
-            "requirements": (results["summary"].get("counts") or {}).get(Status.NOT_EVALUATED, 0)}
+    return {"cases": cov.rows, "count": cov.not_evaluated, "evaluated": cov.evaluated, "basis": cov.basis or CASES_BASIS,
+            "text": case_coverage_text(cov.as_dict()), "reasons": items, "requirements": result.summary.counts.not_evaluated}
 
 
-def assumptions(results: dict) -> list[str]:
+def assumptions(result: CheckResult) -> list[str]:
     """The model assumptions the verdicts rest on (the readings of the requirements are departures, acceptance.py)."""
-    b = basis(results)
+    b = basis(result)
     out = [f"Every value in this report is computed by simulating the model '{b['model']}'; no hardware was tested.",
            f"{b['assumed']} of the {b['n_params']} parameters the model uses are assumed (physically consistent choices "
            "not given by the paper or the user; appendix A lists them)"
@@ -178,25 +170,24 @@ def assumptions(results: dict) -> list[str]:
     return out
 
 
-def qualified_verdict(results: dict) -> dict:
-    """Page 1's verdict: the word, its qualifier (``campaign.basis.verdict_qualifier``) and why, in the owner's words.
+def qualified_verdict(result: CheckResult) -> dict:
+    """Page 1's verdict: the word, its qualifiers (``campaign.basis.verdict_qualifier``) and why, in the owner's words.
 
     A PASS against assumed limits or on a mostly assumed model is not a plain (green) PASS: its
     class is ``warn`` and the qualifier is printed under the word.
     """
-    status = results["summary"]["status"]
-    summary = results["summary"]
-    qualifier = (summary["qualifier"] if "qualifier" in summary else verdict_qualifier(results)) if status == Overall.PASS else None
-    if not qualifier:
+    status = result.summary.status
+    qualifiers = result.summary.qualifiers if status == Overall.PASS else ()
+    if not qualifiers:
         return {"status": status, "qualifier": None, "css": None, "why": None}
-    b = basis(results)
+    b = basis(result)
     why = []
-    if "assumed targets" in qualifier:
-        ids = [e["id"] for e in results["requirements"] if e.get("limit_assumed") and e["status"] == Status.PASS]
+    if Qualifier.ASSUMED_TARGETS in qualifiers:
+        ids = [e.id for e in result.requirements if e.limit_assumed and e.status == Status.PASS]
         why.append(f"the limits of {', '.join(ids)} are assumed design targets of the requirement file, not figures of a "
                    "standard or of the plant owner")
-    if "assumed model" in qualifier:
+    if Qualifier.ASSUMED_MODEL in qualifiers:
         why.append(f"{b['assumed']} of the {b['n_params']} parameters the model uses are assumed")
-    return {"status": status, "qualifier": qualifier, "css": "warn",
+    return {"status": status, "qualifier": ", ".join(qualifiers), "css": "warn",
             "why": "; ".join(why) + ": the PASS says the model meets these targets, not that the built system meets "
                                     "a specification"}

@@ -3,7 +3,7 @@
 The plant is ``compliance.model.assembly.plant_rhs`` integrated by ``compliance.simulation.rk4.rk4_step``
 (the same physics and integrator as ``govcheck simulate``); the controller
 (:mod:`compliance.model.state_feedback`) runs every ``controller.sample_time`` with a
-zero-order hold. In PID mode the loop reproduces ``compliance.simulation.simulate`` sample for
+zero-order hold. In PID mode the loop reproduces the PID loop (``compliance.simulation.pid_loop``) sample for
 sample (tests), so the two controllers are compared on one footing.
 """
 
@@ -19,9 +19,8 @@ from compliance.effects import EFFECTS
 from compliance.model.config import PlantConfig
 from compliance.model.pid_controller import pid_sample, saturate
 from compliance.errors import InputError, SimulationError
-from compliance.effects.valve_dynamics import P_VD_ON, S_SP
 from compliance.model.vector_slots import N_STATES, P_UCEN, P_ULIM, S_PA, S_PB, S_V, S_X
-from compliance.model.assembly import plant_rhs, valve_lag_input
+from compliance.model.assembly import plant_rhs, settle_valve
 from compliance.model.plant_vector import load_curve_arrays, parameter_vector
 from compliance.model.rest_state import initial_state
 from compliance.simulation.rk4 import OUTPUT_COLUMNS, measured_position, non_physical, output_buffer, output_frame, record_sample
@@ -157,8 +156,7 @@ def tracking_core(P, C, y0, ref, dref, ddref, pos_noise, pos_quantum, pa_noise, 
     x_filt = 0.0
     integral = 0.0
     u_rel = 0.0
-    if P[P_VD_ON] != 0.0:
-        y[S_SP] = valve_lag_input(P, P[P_UCEN])
+    settle_valve(P, y, P[P_UCEN])  # the valve's lag at rest on the centre command
     for k in range(n_samples + 1):
         # --- measurements and estimates at t_k
         xm = measured_position(y[S_X], pos_noise[k], pos_quantum)
@@ -228,7 +226,7 @@ def simulate_axis(cfg: PlantConfig, reference: AxisReference, *, mode: str | Non
         Sampled at ``controller.sample_time``; the run lasts ``len - 1`` samples and starts at
         rest at ``reference.position[0]``.
     mode : {"state_feedback", "pid"}, optional
-        Default ``controller.type``.
+        The seed 001 state feedback (default), or the configuration's PID on the same loop (comparison).
     compensation, feedforward : bool, optional
         Default from the configuration.
     load : float, optional
@@ -258,8 +256,8 @@ def simulate_axis(cfg: PlantConfig, reference: AxisReference, *, mode: str | Non
         Non-physical state.
     """
     where = cfg.path or cfg.name
-    for e, values in cfg.effects.items():  # the declarations say what this loop can run (Effect.plant_b, input_delay)
-        if not EFFECTS[e].plant_b:
+    for e, values in cfg.effects.items():  # the declarations say what this loop can run (Effect.loop_states, input_delay)
+        if EFFECTS[e].loop_states:  # this loop differentiates the raw position: it holds no sampled filter of its own
             raise InputError(f"{where}: effect {e} is not supported by the tracking loop (use govcheck simulate)")
         if EFFECTS[e].input_delay and values.get(EFFECTS[e].input_delay, 0.0) > 0.0:
             raise InputError(f"{where}: a {e} delay is not supported by the tracking loop")
@@ -298,7 +296,7 @@ def simulate_axis(cfg: PlantConfig, reference: AxisReference, *, mode: str | Non
 def simulate_state_feedback(cfg: PlantConfig, scenario: Scenario) -> pd.DataFrame:
     """Closed loop under the seed 001 state-feedback controller (plant B), seed 001 figs. 5-6."""
     if isinstance(scenario.load, str):
-        raise InputError(f"{cfg.name}: a load curve is not supported with controller.type = '{cfg.options['controller.type']}'")
+        raise InputError(f"{cfg.name}: a load curve is not supported by the state-feedback loop (a constant load is)")
     ts = cfg.p("controller.sample_time")
     n = int(round(scenario.duration / ts))
     t = np.arange(n + 1) * ts

@@ -1,7 +1,8 @@
 """``govcheck check --remedies``: the remedies search over a declared space for one configuration.
 
 The space is a sweep file's ``adjust`` table when one is named, else the settings that can be
-changed on site without new hardware, around the configuration's own values (DEFAULT_SPACE):
+changed on site without new hardware, around the configuration's own values (its plant kind's
+``remedy_space``, compliance.plants):
 controller gains and dead-zone compensation, the meter-out flow-control valves, the supply
 pressure regulator; for a PID governor also its set-point rate limiter (``remedies.limiter_space``).
 Then the options of a hardware catalogue (``sweep.sizing.hardware_catalogue``; the shipped one by default).
@@ -13,35 +14,15 @@ physically (``remedies.binding_physics``).
 
 from __future__ import annotations
 
+from compliance.plants import kind_of
 from compliance.sweep.candidates.evaluate import make_context
 from compliance.model.parameters import param_handle
 from compliance.sweep.candidates.spec import Adjustable, Uncertain
 from compliance.sweep.tolerance.yield_mc import nominal_values
 from compliance.sweep.remedies.outcome import RemedyStatus
 
-__all__ = ["DEFAULT_SPACE", "DEFAULT_TOLERANCES", "YIELD_UNITS", "default_space", "remedies_for_check"]
+__all__ = ["DEFAULT_TOLERANCES", "YIELD_UNITS", "default_space", "remedies_for_check"]
 
-# path -> (low factor, high factor, absolute floor of the high end [SI]) around the configured value;
-# factors are commissioning ranges (gains x0.5-x3, throttles x0.6-x1.5, regulator -20 %/+15 %)
-DEFAULT_SPACE = {
-    "pid": {
-        "controller.kp": (0.5, 3.0, 0.0),
-        "controller.ki": (0.0, 10.0, 50.0),
-        "controller.kd": (0.0, 2.0, 10.0),
-        "controller.compensation_width": (0.0, 2.0, 0.8),
-        "controller.compensation_dead_zone_positive": (0.7, 1.3, 0.0),
-        "controller.compensation_dead_zone_negative": (0.7, 1.3, 0.0),
-        "flow_control.opening_conductance": (0.6, 1.5, 0.0),
-        "flow_control.closing_conductance": (0.6, 1.5, 0.0),
-        "air.supply_pressure": (0.8, 1.15, 0.0),
-    },
-    "state_feedback": {
-        "controller.closed_loop_bandwidth": (0.5, 2.0, 0.0),
-        "controller.acceleration_observer_bandwidth": (0.5, 2.0, 0.0),
-        "controller.friction_observer_bandwidth": (0.5, 2.0, 0.0),
-        "air.supply_pressure": (0.8, 1.15, 0.0),
-    },
-}
 # path -> (distribution, spread): relative spreads of a delivered unit around its nominal values
 DEFAULT_TOLERANCES = {
     "friction.static_force": ("uniform", 0.20),
@@ -55,7 +36,7 @@ YIELD_UNITS = 59  # 59 of 59 passing is the fewest that shows >= 95 % yield at 9
 def default_space(cfg) -> tuple[Adjustable, ...]:
     """The on-site settings of ``cfg`` with ranges around their values (zero-valued ones left out)."""
     out = []
-    for path, (f_lo, f_hi, floor) in DEFAULT_SPACE[cfg.options["controller.type"]].items():
+    for path, (f_lo, f_hi, floor) in kind_of(cfg).remedy_space.items():
         pp = param_handle(path, "default remedies space")
         v = float(cfg.params[path])
         lo, hi = max(pp.low, f_lo * v), min(pp.high, max(f_hi * v, floor))
@@ -79,8 +60,8 @@ def _space(cfg, reqset, sweep_file):
     else:
         adjust = default_space(cfg)
     base = nominal_values(cfg, {a.param.path: a.param for a in adjust})
-    limiter = None  # a sweep file's space is as declared; the default space adds the limiter to a PID governor
-    if cfg.options["controller.type"] == "pid" and not cfg.setpoint_rate_limited and not (sweep_file and sweep_file != "default"):
+    limiter = None  # a sweep file's space is as declared; the default space adds the limiter to a loop that has one
+    if kind_of(cfg).setpoint_limiter and not cfg.setpoint_rate_limited and not (sweep_file and sweep_file != "default"):
         lim, start = limiter_space(cfg, reqset)
         adjust = tuple(a for a in adjust if a.param.path not in start)
         limiter = (lim, start)

@@ -14,9 +14,9 @@ from __future__ import annotations
 import time
 
 from compliance.processes import raise_if_stopping
-from compliance.campaign.results_files import write_json
 from compliance.files.atomic import write_json_atomic, write_text_atomic
 from compliance.requirements.verdict import Overall
+from compliance.results.check_result import CheckResult
 from compliance.sweep.candidates.evaluate import make_context
 from compliance.sweep.remedies.smallest_change import find_remedy
 from compliance.sweep.candidates.results import best_index, pareto_front, table, tightest, write_table
@@ -37,13 +37,14 @@ def load_inputs(spec):
     return load_plant(spec.base), load_requirements(spec.requirements)
 
 
-def verify_settings(cfg, reqset, paths, values, *, command_line=None, workers=None):
+def verify_settings(cfg, reqset, paths, values, *, command_line=None, workers=None) -> CheckResult:
     """The full campaign (traces, linear requirements and all) of ``cfg`` with ``values`` applied."""
     from compliance.campaign.run import run_campaign
     from compliance.model.parameters import apply
 
-    return run_campaign(apply(cfg, [paths[p] for p in values], values.values()), reqset, workers=workers, progress=False,
-                        command_line=command_line)
+    # a search judges candidates against the set its caller vetted (a conflict it allowed stays allowed)
+    return CheckResult.of(run_campaign(apply(cfg, [paths[p] for p in values], values.values()), reqset, workers=workers,
+                                       progress=False, command_line=command_line, allow_conflicts=True))
 
 
 MAX_GRID = 100_000  # a grid beyond this is a typo in `steps`, not a plan (use latin_hypercube)
@@ -100,18 +101,16 @@ def run_sweep(spec, out_dir, *, scheduler=None, workers=None, progress=True, cli
     if best is not None:
         values = cands[best]
         res = verify_settings(cfg, reqset, spec.paths, values, command_line=command_line, workers=workers)
-        res["sweep"] = {"name": spec.name, "file": spec.path, "candidate": best, "values": values}
-        if remedies is not None:
-            res["remedies"] = remedies
+        res = res.with_(sweep={"name": spec.name, "file": spec.path, "candidate": best, "values": values}, remedies=remedies)
         best_info = {"candidate": best, "values": values, "status": df.loc[best, "status"],
                      "shortfall": float(df.loc[best, "shortfall"]), "change": float(df.loc[best, "change"]),
-                     "verified_status": res["summary"]["status"],
-                     "failed_mandatory": res["summary"]["failed_mandatory"], "results_file": str(out / "best-results.json")}
+                     "verified_status": res.summary.status, "failed_mandatory": list(res.summary.failed_mandatory),
+                     "results_file": str(out / "best-results.json")}
     raise_if_stopping()
     out.mkdir(parents=True, exist_ok=True)
     files = write_table(df, out)
     if res is not None:
-        write_json(res, out / "best-results.json")
+        res.to_json(out / "best-results.json")
     counts = df["status"].value_counts().to_dict()
     summary = {
         "schema": SUMMARY_SCHEMA, "name": spec.name, "title": spec.title, "sweep_file": spec.path,
@@ -153,9 +152,8 @@ def run_yield_file(spec, out_dir, candidate: dict, label: str, *, scheduler=None
     raise_if_stopping()
     out.mkdir(parents=True, exist_ok=True)
     buf_files = write_table(df, out)
-    res["tolerance_yield"] = y
     y["files"] = {"units": buf_files, "results": str(out / "results.json")}
-    write_json(res, out / "results.json")  # the nominal candidate's campaign with the yield: govcheck report renders it
+    res.with_(tolerance_yield=y).to_json(out / "results.json")  # the nominal candidate's campaign: govcheck report renders it
     write_json_atomic(out / "yield.json", y)
     write_text_atomic(out / "yield.md", yield_markdown(y))
     return y

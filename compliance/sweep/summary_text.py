@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from compliance.units.formatting import fmt_margin_pct, fmt_num, si_prefix, unit_text
+from compliance.presentation.numbers import fmt_margin_pct, fmt_num, si_prefix, unit_text
 
 __all__ = ["remedies_markdown", "summary_markdown", "yield_markdown"]
 

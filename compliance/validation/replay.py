@@ -26,7 +26,8 @@ import pandas as pd
 
 from compliance.errors import InputError
 from compliance.model.config import PlantConfig
-from compliance.simulation import OUTPUT_COLUMNS, Scenario, SensorNoise, simulate
+from compliance.simulation import OUTPUT_COLUMNS, Scenario, SensorNoise
+from compliance.plants import simulate
 from compliance.simulation.profiles import Profile
 from compliance.validation.logger_model import logger_model
 from compliance.validation.recorded_noise import NOISE_FREE_STD, estimate_position_noise, position_quantum, robust_std

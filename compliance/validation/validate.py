@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from compliance import __version__
+from compliance.version import __version__
 from compliance.errors import InputError
 from compliance.files.jsonable import jsonable
 from compliance.model.config import PlantConfig

@@ -3,21 +3,18 @@
 from __future__ import annotations
 
 from compliance.campaign.regression_gate import compare, gate_markdown, gate_table
+from tests.results.build import result, verdict
 
 RATE_LIMITED = "rate limited: valve command reached 6.85 V >= flow saturation 4.00 V before 63.2 %"
 
 
 def entry(rid, status, margin_pct=None, severity="mandatory", reason=None):
-    rows = [{"run": "steps-5@mid", "status": status, "reason": reason}] if reason else []
-    return {"id": rid, "title": rid, "metric": "time_constant", "limit_text": "0.10 s .. 0.25 s", "severity": severity,
-            "status": status, "rows": rows,
-            "worst": {"margin_pct": margin_pct, "value": 0.2, "display": {"value": "0.2 s"}}}
+    return verdict(rid, status, margin_pct, 0.2, metric="time_constant", limit_text="0.10 s .. 0.25 s", severity=severity,
+                   reasons=(reason,) if reason else (), display="0.2 s")
 
 
 def results(*entries):
-    return {"schema": "govcheck-results/1", "requirements": list(entries), "summary": {"status": "fail"},
-            "plant": {"name": "p", "digest": "x", "path": "p.toml"},
-            "requirement_set": {"name": "r", "digest": "d", "path": "r.toml"}}
+    return result(*entries, digest="d", status="fail")
 
 
 def test_mandatory_fail_to_not_evaluated_trips_with_the_reason():

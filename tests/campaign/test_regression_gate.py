@@ -1,6 +1,5 @@
 """The regression gate: comparison rules on synthetic results, then a degraded plant end to end."""
 
-import copy
 import json
 from pathlib import Path
 
@@ -8,6 +7,7 @@ import pytest
 
 from compliance.cli import main
 from compliance.campaign.regression_gate import compare, gate_markdown
+from tests.results.build import result, verdict
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -41,19 +41,16 @@ operating_points = ["mid"]
 
 
 def entry(rid, status, margin_pct, value=1.0):
-    return {"id": rid, "title": rid, "metric": "m", "limit_text": "<= 1", "severity": "mandatory", "status": status,
-            "worst": {"margin_pct": margin_pct, "value": value, "display": {"value": f"{value}"}}}
+    return verdict(rid, status, margin_pct, value)
 
 
 def results(*entries, digest="d1"):
-    return {"schema": "govcheck-results/1", "requirements": list(entries),
-            "plant": {"name": "p", "digest": "x", "path": "p.toml"}, "summary": {"status": "pass"},
-            "requirement_set": {"name": "r", "digest": digest, "path": "r.toml"}}
+    return result(*entries, digest=digest)
 
 
 def test_rules():
     base = results(entry("A", "pass", 40.0), entry("B", "pass", 10.0), entry("C", "fail", -5.0), entry("D", "pass", 30.0))
-    same = compare(base, copy.deepcopy(base), max_margin_loss=5)
+    same = compare(base, base, max_margin_loss=5)
     assert same["status"] == "pass" and same["tripped"] == []
     cand = results(entry("A", "pass", 33.0), entry("B", "fail", -1.0), entry("C", "fail", -50.0),
                    entry("E", "fail", -3.0))

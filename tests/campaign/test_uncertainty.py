@@ -63,7 +63,7 @@ def test_local_band_contains_the_monte_carlo_spread(case):
     mc = copy.deepcopy(local)
     for r in mc["requirements"]:
         r["status"] = r["worst"]["status"] = r["rows"][0]["status"] = "pass" if r["worst"]["value"] >= 3.47 else "fail"
-    info = monte_carlo_bands(cfg, reqset, mc, 16, workers=1)
+    info = monte_carlo_bands(cfg, reqset, mc["requirements"], 16, workers=1)
     assert info["judged"] == 16
     m = mc["requirements"][0]["band"]
     width = band["high"] - band["low"]

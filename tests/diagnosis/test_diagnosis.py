@@ -147,7 +147,7 @@ def test_a_miscalibrated_valve_is_called_parameters_only(cfg):
     assert "No physics is missing" in d.explanation
     assert "valve sonic conductance refitted" in d.explanation and "valve.sonic_conductance" not in d.explanation
     # the fit the text quotes is the validation table's (one NRMSE definition), same replay, same number
-    from compliance.units.formatting import fmt_num
+    from compliance.presentation.numbers import fmt_num
     from compliance.validation.validate import ValidationSettings, validate
 
     table = validate(cfg, frame, meta, ValidationSettings(modes=("closed_loop",)))["modes"]["closed_loop"]["fits"]

@@ -1,4 +1,4 @@
-"""Out-of-sample proof of the seal-friction law (friction_bench/holdout.py) and the declared position_dependent_friction.
+"""Out-of-sample proof of the seal-friction law (friction_bench/holdout.py) and the declared friction_along_stroke.
 
 Synthetic bench runs made from a known law with seeded force noise: a law that is the truth must
 predict a pressure it was not fitted on to the noise, and the position effect must earn its
@@ -80,7 +80,7 @@ def test_power_law_pressure_rise_is_found_and_predicts_every_held_out_pressure()
     tried = _effects(proof)
     assert tried["nonlinear_pressure_friction"]["kept"] and tried["nonlinear_pressure_friction"]["runs_improved"] >= 3
     assert tried["nonlinear_pressure_friction"]["median_held_out_rms_without"] > 3 * tried["nonlinear_pressure_friction"]["median_held_out_rms_with"]
-    assert not any(tried[e]["kept"] for e in ("pressure_force_curvature", "position_dependent_friction", "friction_drift"))
+    assert not any(tried[e]["kept"] for e in ("pressure_force_curvature", "friction_along_stroke", "friction_drift"))
     assert proof["law"] == "pressure_dependent_friction+nonlinear_pressure_friction"
     # within 5 % (10 % on k_p): the Stribeck dip of these short runs is not resolved (v_s ends on its bound) and the
     # viscous term trades with the levels
@@ -125,14 +125,14 @@ def test_friction_drift_shared_by_the_runs_is_kept_and_predicts_each_run():
 
 def test_true_law_predicts_held_out_pressures_to_the_noise_and_position_effect_earns_its_place():
     """Levels falling 1 % per mm along the stroke: the pressure law alone predicts each held-out pressure poorly,
-    with position_dependent_friction it predicts them as well as the runs it saw, within the 3 x force noise a complete
+    with friction_along_stroke it predicts them as well as the runs it saw, within the 3 x force noise a complete
     law leaves (friction_diagnosis.FRICTION_RESIDUAL_LIMIT: the law is evaluated on a differentiated velocity), and
     the effect is kept."""
     runs = _runs(-10.0)
     fits = {"pressure_dependent_friction": fit_law(runs, "pressure_dependent_friction")}
     proof = prove_out_of_sample(runs, fits, "pressure_dependent_friction", True, jobs=1)
     pos = proof["position"]
-    assert pos["earned"] and proof["law"].endswith("position_dependent_friction")
+    assert pos["earned"] and proof["law"].endswith("friction_along_stroke")
     assert pos["runs_improved"] == 4 and pos["median_gain"] > 0.3
     assert fits[proof["law"]].params["position_gradient"] == pytest.approx(-10.0, rel=0.1)
     table = proof["holdout"]
@@ -150,7 +150,7 @@ def test_position_effect_not_kept_when_the_runs_have_none():
     assert not proof["position"]["earned"]
     assert proof["law"] == "pressure_dependent_friction" and len(fits) == 1  # the rejected candidates are not ranked
     assert [t["effect"] for t in proof["effects"]] == ["nonlinear_pressure_friction", "pressure_force_curvature",
-                                                      "position_dependent_friction", "friction_drift"]
+                                                      "friction_along_stroke", "friction_drift"]
     assert not any(t["kept"] for t in proof["effects"])
     assert proof["holdout"]["median_ratio"] < 1.1
     assert max(r["held_out_rms"] for r in proof["holdout"]["runs"]) < FRICTION_RESIDUAL_LIMIT * NOISE
@@ -217,7 +217,7 @@ def test_real_o_ring_fixture_held_out_table(tmp_path):
     assert h["median_ratio"] <= 1.5 and h["within_target"]
     assert h["median_ratio_without_offset"] <= h["median_ratio"]
     tried = {t["effect"]: t for t in seal["bench_effects"]}
-    assert set(tried) == {"nonlinear_pressure_friction", "pressure_force_curvature", "position_dependent_friction", "friction_drift"}
+    assert set(tried) == {"nonlinear_pressure_friction", "pressure_force_curvature", "friction_along_stroke", "friction_drift"}
     curve = tried["pressure_force_curvature"]
     assert curve["kept"] and curve["runs_improved"] >= 3
     bend = -curve["parameters"]["bias_per_pressure_squared"] * 6e5 ** 2 / 4  # N off a straight line at mid-range

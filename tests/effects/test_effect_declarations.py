@@ -54,7 +54,8 @@ def test_declared_states_exist(name):
 def test_effect_off_costs_nothing_in_results():
     """A configuration with an effect at a neutral value gives the same trace as the base model."""
     from compliance.simulation.profiles import steps
-    from compliance.simulation import Scenario, simulate
+    from compliance.simulation import Scenario
+    from compliance.plants import simulate
 
     cfg = load_plant("plant-a")
     sc = Scenario(duration=1.5, initial_position=0.08, reference=steps("5%@0.2s", 0.08, 0.16), load=5000.0)
@@ -75,7 +76,8 @@ def test_every_bound_simulates_stably(name, pname, value):
     """Each parameter at either end of its declared range stays finite at the pinned step: the
     diagnosis fits anywhere inside the bounds, so none of them may make RK4 blow up."""
     from compliance.simulation.profiles import steps
-    from compliance.simulation import Scenario, simulate
+    from compliance.simulation import Scenario
+    from compliance.plants import simulate
 
     cfg = load_plant("plant-a").replace(effects={name: {pname: value}})
     df = simulate(cfg, Scenario(duration=1.5, initial_position=0.08, reference=steps("5%@0.2s,-10%@0.8s", 0.08, 0.16), load=6000.0))

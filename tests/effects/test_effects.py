@@ -21,7 +21,8 @@ from compliance.model.assembly import plant_rhs
 from compliance.model.plant_vector import load_curve_arrays, parameter_vector
 from compliance.model.rest_state import initial_state
 from compliance.simulation.profiles import Profile, steps
-from compliance.simulation import Scenario, simulate
+from compliance.simulation import Scenario
+from compliance.plants import simulate
 
 R, GAMMA, TS = 287.0, 1.4, 293.15
 HOLD_LOAD = 30000.0  # N: more than (8 - 1.013) bar * 0.0237 m^2 = 16.6 kN, the piston stays on x = 0

@@ -4,7 +4,8 @@ import numpy as np
 
 from compliance.model.config import load_plant
 from compliance.simulation.profiles import Profile
-from compliance.simulation import Scenario, simulate
+from compliance.simulation import Scenario
+from compliance.plants import simulate
 
 
 def test_pure_delay_reads_the_delayed_position():

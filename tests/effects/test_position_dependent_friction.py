@@ -20,7 +20,8 @@ from compliance.model.config import load_plant
 from compliance.model.plant_vector import load_curve_arrays, parameter_vector
 from compliance.model.rest_state import initial_state
 from compliance.model.vector_slots import A_FRIC, N_AUX, N_STATES, S_V, S_Z1
-from compliance.simulation import Scenario, simulate
+from compliance.simulation import Scenario
+from compliance.plants import simulate
 from compliance.simulation.profiles import steps
 
 GRADIENT = -10.0  # 1/m, the declared bound: factor 1.6 at x = 20 mm, 0.4 at x = 140 mm of the 160 mm stroke

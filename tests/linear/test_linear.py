@@ -264,3 +264,18 @@ def test_trim_with_a_compliant_linkage_shares_the_load_like_the_rest_state(cfg):
     assert f1 + k * d == pytest.approx(0.5 * load, rel=1e-9)
     y = initial_state(lc, parameter_vector(lc, load=load), 0.02, (op.pressure_a, op.pressure_b))
     assert y[S_X2] - y[S_X] == pytest.approx(d, rel=1e-9)
+
+
+def test_cli_plot_draws_the_reports_figures(tmp_path, monkeypatch, capsys):
+    """--plot is the report's Bode, pole and step figures of the analysis (figures_linear), not a drawing of its own."""
+    import compliance.report.figures_linear as F
+
+    drawn = []
+    for name in ("draw_bode", "draw_poles"):
+        real = getattr(F, name)
+        monkeypatch.setattr(F, name, lambda *a, _real=real, _name=name, **k: drawn.append(_name) or _real(*a, **k))
+    out = tmp_path / "lin.svg"
+    assert main(["linear", "plant-a", "--at", "80 mm", "--plot", str(out), "-q"]) == 0
+    text = out.read_text()
+    assert drawn == ["draw_bode", "draw_poles"]
+    assert "|L| [dB]" in text and "\u03c4 = 0.25 s" in text and "predicted 8 mm step" in text  # the report's labels

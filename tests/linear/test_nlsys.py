@@ -17,7 +17,8 @@ from compliance.linear.nlsys import INPUT, operating_point, to_nlsys, to_statesp
 from compliance.linear.nlsys_loop import closed_loop_nlsys, controller_nlsys, find_rest_point  # noqa: E402
 from compliance.linear.trim import valve_gain  # noqa: E402
 from compliance.model.config import load_plant  # noqa: E402
-from compliance.simulation import Scenario, simulate  # noqa: E402
+from compliance.simulation import Scenario  # noqa: E402
+from compliance.plants import simulate  # noqa: E402
 from compliance.simulation.profiles import Profile  # noqa: E402
 
 X_OP, LOAD = 0.136, 11400.0

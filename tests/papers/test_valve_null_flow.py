@@ -11,7 +11,8 @@ from compliance.model.pid_controller import stall_error
 from compliance.physics.valve_flow import iso6358_mass_flow
 from compliance.effects.valve_null_flow import land_leak_openings
 from compliance.physics.valve_opening import valve_openings
-from compliance.simulation import Scenario, simulate
+from compliance.simulation import Scenario
+from compliance.plants import simulate
 from compliance.simulation.profiles import steps
 
 

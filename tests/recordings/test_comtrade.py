@@ -25,7 +25,7 @@ STEP_AT = 0.3  # [s] the set-point step of ARGV: the trigger of the files writte
 def run():
     """One small plant-A run (1 s, 1 kHz, a 2 % closing step) exactly as ``govcheck simulate ARGV`` makes it."""
     from compliance.model.config import load_plant
-    from compliance.simulation import simulate
+    from compliance.plants import simulate
 
     args = build_parser().parse_args(ARGV + ["-o", "unused.csv"])
     cfg = load_plant("plant-a")

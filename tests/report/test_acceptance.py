@@ -14,7 +14,8 @@ from compliance.report import acceptance as A
 from compliance.report import signoff as S
 from compliance.report.analysis_sections import distinct_points, linear_section
 from compliance.report.fit_bounds import at_bound
-from compliance.units.formatting import fmt_si
+from compliance.results import CheckResult
+from compliance.presentation.numbers import fmt_si
 
 FIXTURE = Path(__file__).resolve().parents[1] / "data" / "results_fixture.json"
 
@@ -23,9 +24,14 @@ def _results() -> dict:
     return json.loads(FIXTURE.read_text(encoding="utf-8"))
 
 
+def _typed(res: dict) -> CheckResult:
+    """The fixture, edited as a dict by a test, read as the report reads it."""
+    return CheckResult.from_dict(res)
+
+
 def test_basis_counts_only_the_parameters_the_selected_model_uses():
     res = _results()
-    b = S.basis(res)
+    b = S.basis(_typed(res))
     keys = {p["key"] for p in res["plant"]["parameters"]}
     unused = {k for k in keys if not S.used_by_model(k, res["plant"]["options"])}
     # 12 parameters of laws plant A does not select: three valve laws (6), plant B's friction (4 + its
@@ -41,14 +47,14 @@ def test_basis_counts_only_the_parameters_the_selected_model_uses():
 def test_deciding_parameters_of_verdict_bands_are_named_first():
     res = _results()
     res["requirements"][0]["band"] = {"low": 0.2, "high": 0.3, "deciding": ["friction.static_force", "load.curve"]}
-    assert S.basis(res)["deciding"][:2] == ["friction.static_force", "load.curve"]
+    assert S.basis(_typed(res))["deciding"][:2] == ["friction.static_force", "load.curve"]
 
 
 def test_linear_points_are_distinct_named_and_judged_against_the_stated_criterion():
-    res = _results()
-    lin = res["linear"]
-    pts = distinct_points(lin.get("analyses") or [], res)
-    keys = [(round(a["operating_point"]["position"], 6), str(a["operating_point"]["load"])) for _, a, _ in pts]
+    res = _typed(_results())
+    lin = res.linear_section
+    pts = distinct_points(lin.all_analyses, res)
+    keys = [(round(a.operating_point.position, 6), str(a.operating_point.load)) for _, a, _ in pts]
     assert len(keys) == len(set(keys))
     ctx, _ = linear_section(lin, 1, res)
     assert ctx["criterion"]["pm"] == 30.0 and ctx["criterion"]["gm"] == 6.0
@@ -61,7 +67,7 @@ def test_linear_points_are_distinct_named_and_judged_against_the_stated_criterio
 
 def test_conditions_define_every_operating_point_with_throttles_in_or_out():
     res = _results()
-    cond = A.conditions(res)
+    cond = A.conditions(_typed(res))
     assert {r["name"] for r in cond["operating_points"]} == set(res["requirement_set"]["operating_points"])
     by = {r["name"]: r for r in cond["operating_points"]}
     for name, op in res["requirement_set"]["operating_points"].items():
@@ -72,17 +78,17 @@ def test_conditions_define_every_operating_point_with_throttles_in_or_out():
 
 def test_every_decision_needing_requirement_gets_a_disposition_row():
     res = _results()
-    rows = A.conclusions(res)
+    rows = A.conclusions(_typed(res))
     need = [e["id"] for e in res["requirements"] if e["status"] in ("fail", "not_evaluated", "open", "uncertain")]
     assert [r["id"] for r in rows] == need
 
 
 def test_document_is_draft_without_identity_or_number():
     res = _results()
-    assert S.document_control(res)["draft"]
+    assert S.document_control(_typed(res))["draft"]
     res["plant"]["identity"] = {"site": "x"}
-    assert S.document_control(res)["draft_reason"].startswith("no document number")
-    d = S.document_control(res, {"number": "QA-1", "revision": "B", "results": {"path": "r.json", "digest": "ab"}})
+    assert S.document_control(_typed(res))["draft_reason"].startswith("no document number")
+    d = S.document_control(_typed(res), {"number": "QA-1", "revision": "B", "results": {"path": "r.json", "digest": "ab"}})
     assert not d["draft"] and d["revision"] == "B"
     files = {f["what"]: f for f in d["files"]}
     assert files["Results file"]["digest"] == "ab" and files["Plant configuration"]["digest"] == res["plant"]["digest"]
@@ -100,59 +106,34 @@ def test_si_prefixes_and_fit_bounds():
 
 
 # --------------------------------------------------------------------------- issue 25: verdicts on assumptions
-def _plant_b_like(res: dict, share_assumed: float) -> dict:
+def _plant_b_like(res: dict, share_assumed: float, limits_assumed: bool = True) -> dict:
     """The fixture turned into a PASS against assumed targets with a given share of assumed parameters."""
+    from compliance.campaign.basis import verdict_qualifier
+
     res["summary"].update(status="pass", failed_mandatory=[], qualifier=None)
-    res["summary"].pop("qualifier")
     for e in res["requirements"]:
-        e["status"], e["severity"], e["limit_assumed"] = "pass", "mandatory", True
+        e["status"], e["severity"], e["limit_assumed"] = "pass", "mandatory", limits_assumed
     used = [p for p in res["plant"]["parameters"] if S.used_by_model(p["key"], res["plant"]["options"])]
     n = round(share_assumed * len(used))
     for i, p in enumerate(used):
         p["source"] = "assumed" if i < n else "paper"
+    res["summary"]["qualifier"] = verdict_qualifier(res)  # decided once, by the campaign, as check() does
     return res
 
 
 def test_a_pass_against_assumed_targets_on_a_mostly_assumed_model_is_not_a_plain_pass():
-    from compliance.campaign.basis import verdict_qualifier
     from compliance.campaign.results_files import summary_lines
+    from compliance.results import Qualifier
 
-    res = _plant_b_like(_results(), 0.8)
-    assert verdict_qualifier(res) == "against assumed targets, on a mostly assumed model"
+    res = _typed(_plant_b_like(_results(), 0.8))
+    assert res.summary.qualifiers == (Qualifier.ASSUMED_TARGETS, Qualifier.ASSUMED_MODEL)
     v = S.qualified_verdict(res)
-    assert v["css"] == "warn" and v["qualifier"] == verdict_qualifier(res)
+    assert v["css"] == "warn" and v["qualifier"] == "against assumed targets, on a mostly assumed model"
     b = S.basis(res)
     assert f"{b['assumed']} of the {b['n_params']} parameters the model uses are assumed" in v["why"]
     assert "not figures of a standard or of the plant owner" in v["why"]
     assert summary_lines(res)[-1] == "VERDICT: PASS (against assumed targets, on a mostly assumed model)"
     # limits from a standard and a model mostly from the paper: a plain PASS
-    res = _plant_b_like(_results(), 0.3)
-    for e in res["requirements"]:
-        e["limit_assumed"] = False
-    assert verdict_qualifier(res) is None and S.qualified_verdict(res)["css"] is None
+    res = _typed(_plant_b_like(_results(), 0.3, limits_assumed=False))
+    assert not res.summary.qualifiers and S.qualified_verdict(res)["css"] is None
     assert summary_lines(res)[-1] == "VERDICT: PASS"
-
-
-def test_an_assumed_limit_makes_the_verdict_basis_assumed():
-    from types import SimpleNamespace
-
-    from compliance.campaign.basis import limit_assumed, row_basis
-
-    req = SimpleNamespace(clause="assumed (plant-B design target)", standard="assumed design targets", metric="path_rms_error",
-                          source="simulation")
-    assert limit_assumed(req) and not limit_assumed(SimpleNamespace(clause="4.2.1", standard="IEC 61362"))
-    op = SimpleNamespace(load=None, flow_control=None)
-    reqset = SimpleNamespace(operating_points={"centre": op}, procedures={})
-    cfg = SimpleNamespace(flow_control_installed=False, effects={}, sources={}, assumptions={})
-    basis, why = row_basis(cfg, reqset, req, {"status": "pass", "value": 1e-4, "operating_point": "centre",
-                                               "procedure": "circle"})
-    assert basis == "assumed" and "assumed design target" in why
-
-
-def test_draft_reason_is_in_the_signers_words():
-    doc = S.document_block({}, [], None)
-    assert doc["draft"]
-    assert doc["draft_reason"] == ("the site, the unit and the equipment are not identified; no document number has been "
-                                   "assigned")
-    assert "[identity]" not in doc["draft_reason"] and "--" not in doc["draft_reason"]
-    assert S.document_block({"site": "x"}, [], None)["draft_reason"] == "no document number has been assigned"

@@ -26,6 +26,7 @@ from compliance.report import render as R
 from compliance.report.figures import decimate
 from compliance.report.render import render_report, render_validation_report
 from compliance.report.requirement_pages import requirement_pages
+from compliance.results import CheckResult
 
 FIXTURE = Path(__file__).resolve().parents[1] / "data" / "results_fixture.json"
 EVIL = "<script>alert(1)</script>"
@@ -81,7 +82,7 @@ def test_html_is_self_contained_with_every_figure_inline(rendered):
     n_traces = sum(len(r["traces"]) for r in res["runs"])
     n_val = sum(len(m["overlays"]) for m in res["validation"]["modes"].values())
     n_lin = 3 + 2  # three maps (time constant, gain and phase margins) + Bode + poles
-    n_pages = len(requirement_pages(res)[1])  # the worst case of each requirement page whose run is in the fixture
+    n_pages = len(requirement_pages(CheckResult.from_dict(res))[1])  # the worst case of each requirement page whose run is in the fixture
     assert n_pages >= 3
     assert doc.tags.count("figure") == n_pages + n_traces + n_val + n_lin
     draft = sum(1 for tag, a in doc.attrs if tag == "svg" and a.get("class") == "draft-svg")  # the DRAFT watermark
@@ -307,7 +308,7 @@ def test_steps_that_cannot_fail_are_marked_with_coverage():
                        "detail": {"size": 0.0016, "x_start": 0.08, "x_final": 0.08074}}]
     row["limit"] = [0.0016]
     pos["rows"] = [row]
-    page = next(p for p in requirement_pages(res)[0] if "IEC61362-POS" in p["ids"])
+    page = next(p for p in requirement_pages(CheckResult.from_dict(res))[0] if "IEC61362-POS" in p["ids"])
     case = page["cases"][0]
     assert case["cannot_fail"]  # tolerance 1.6 mm >= step 1.6 mm: the error cannot exceed it
     assert "moved 46 % of the step" in case["steps"][0]["text"]  # 0.74 of 1.6 mm
@@ -389,13 +390,15 @@ def test_failed_render_leaves_previous_report_intact(tmp_path, monkeypatch):
 
 
 def test_cli_report_rerenders_without_simulating(tmp_path, monkeypatch, capsys):
-    import compliance.simulation.dispatch as sim  # every simulation passes through its two loops
-    import compliance.simulation.state_feedback_loop as sf  # (imported by dispatch when a run needs it)
+    import compliance.plants.kind as sim  # every simulation passes through its two loops
+    import compliance.plants.pid_servo as pid
+    import compliance.simulation.state_feedback_loop as sf  # (imported by the state-feedback drive when a run needs it)
 
     def no_sim(*a, **k):
         raise AssertionError("govcheck report must not simulate")
 
     monkeypatch.setattr(sim, "simulate_pid", no_sim)
+    monkeypatch.setattr(pid, "simulate_pid", no_sim)
     monkeypatch.setattr(sf, "simulate_state_feedback", no_sim)
     res = _results()
     res["runs"] = res["runs"][:1]
@@ -512,11 +515,11 @@ def test_page_one_fix_lines_come_from_the_remedies_section():
     failed = [e["id"] for e in res["requirements"] if e["status"] == "fail"]
     assert failed, "the fixture has failures"
     res["remedies"] = {"failed": failed, "out_of_reach": [failed[0]], "remedy": None, "sensitivities": []}
-    lines = {f["id"]: f["remedy"] for f in failures(res)}
+    lines = {f["id"]: f["remedy"] for f in failures(CheckResult.from_dict(res))}
     assert "hardware" in lines[failed[0]]
     res["remedies"] = {"failed": failed, "remedy": {"changes": [{"path": "controller.kp", "from": 280.0, "to": 400.0, "unit": "V/m"}],
                                                      "verified": {"status": "pass"}}}
-    assert all("from 280 V/m to 400 V/m" in f["remedy"] and "pass" in f["remedy"] for f in failures(res))
+    assert all("from 280 V/m to 400 V/m" in f["remedy"] and "pass" in f["remedy"] for f in failures(CheckResult.from_dict(res)))
 
 
 def test_remedies_are_section_3_4_and_page_one_points_there(tmp_path):

@@ -7,7 +7,8 @@ import pytest
 import numba
 
 from compliance.model.config import load_plant
-from compliance.simulation import OUTPUT_COLUMNS, Scenario, SensorNoise, simulate
+from compliance.plants import simulate
+from compliance.simulation import OUTPUT_COLUMNS, Scenario, SensorNoise
 from compliance.simulation import pid_loop
 from compliance.simulation.pid_loop import simulate_core
 from compliance.simulation.profiles import Profile, sine, steps

@@ -9,7 +9,8 @@ from compliance.errors import InputError
 from compliance.model.config import load_plant
 from compliance.model.pid_controller import limiter_sample, rate_limited_setpoint
 from compliance.model.plant_vector import parameter_vector
-from compliance.simulation import Scenario, simulate
+from compliance.simulation import Scenario
+from compliance.plants import simulate
 from compliance.simulation.profiles import Profile, steps
 
 STROKE = 0.160

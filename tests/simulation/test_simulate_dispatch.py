@@ -7,7 +7,8 @@ import pytest
 from compliance.model.config import load_plant
 from compliance.errors import InputError
 from compliance.simulation.profiles import steps
-from compliance.simulation import Scenario, simulate
+from compliance.simulation import Scenario
+from compliance.plants import simulate
 
 
 def test_plant_b_step_under_state_feedback():

@@ -13,7 +13,8 @@ from compliance.model.assembly import plant_rhs
 from compliance.model.plant_vector import load_curve_arrays, parameter_vector
 from compliance.model.rest_state import initial_state
 from compliance.simulation.profiles import Profile, steps
-from compliance.simulation import Scenario, SensorNoise, simulate
+from compliance.simulation import Scenario, SensorNoise
+from compliance.plants import simulate
 
 STROKE = 0.160
 

@@ -42,7 +42,7 @@ def test_sweep_writes_table_summary_and_best_results(swept):
     passing = df[df["status"] == "pass"]
     assert best["change"] == pytest.approx(passing["change"].min())
     res = read_results(out / "best-results.json")
-    assert res["summary"]["status"] == "pass" and res["sweep"]["candidate"] == best["candidate"]
+    assert res.passed and res.sweep["candidate"] == best["candidate"]
 
 
 def test_summary_text_reads_as_a_document(swept):
@@ -76,12 +76,12 @@ def test_yield_of_best_is_seeded_and_bounded(swept):
     assert a["ci"][0] <= a["fraction"] <= a["ci"][1]
     assert [d["path"] for d in y["drivers"]] and len(y["requirements"]) == 2
     res = read_results(out / "yield-best" / "results.json")
-    assert res["tolerance_yield"]["all_mandatory"] == a
+    assert json.loads(res.json_text())["tolerance_yield"]["all_mandatory"] == a
     units = pd.read_parquet(out / "yield-best" / "results.parquet")
     again = main(["sweep", str(f), "--out", str(out), "--yield", "best", "-q", "-j", "1"])
     assert again == 0
     pd.testing.assert_frame_equal(units, pd.read_parquet(out / "yield-best" / "results.parquet"))
-    _render_partial(res["tolerance_yield"])
+    _render_partial(res.tolerance_yield)
     assert "Tolerance yield" in (out / "yield-best" / "yield.html").read_text()  # the report section of both remedies and yield renders
 
 
@@ -105,7 +105,7 @@ def _render_partial(tolerance_yield):
            "remedy": None, "closest": {"changes": [{"path": "controller.kp", "unit": "V/m", "from": 280.0, "to": 300.0}],
                                        "change": 0.1, "binding": "TC", "binding_margin_pct": -2.0, "failed_mandatory": ["TC"]}}
     env = jinja2.Environment(loader=jinja2.FileSystemLoader(TEMPLATES), autoescape=True, undefined=jinja2.StrictUndefined)
-    from compliance.units.formatting import fmt_margin_pct, fmt_si
+    from compliance.presentation.numbers import fmt_margin_pct, fmt_si
 
     env.filters["si"] = lambda v, u: fmt_si(v, u or "")  # the report's filters: values with units, capped margins
     env.filters["margin"] = lambda v: fmt_margin_pct(v) or "\u2013"

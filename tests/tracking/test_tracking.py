@@ -16,7 +16,8 @@ from compliance.errors import InputError
 from compliance.model.vector_slots import S_PA, S_PB
 from compliance.model.plant_vector import parameter_vector
 from compliance.model.rest_state import initial_state
-from compliance.simulation import Scenario, simulate
+from compliance.simulation import Scenario
+from compliance.plants import simulate
 from compliance.simulation.profiles import sine
 from compliance.procedures import path_tracking as tracking
 from compliance.model import axis_design as design

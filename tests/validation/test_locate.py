@@ -21,7 +21,8 @@ from compliance.simulation.profiles import Profile
 from compliance.recordings.synth import PRACTICE_NOISE, synthesise
 from compliance.validation.regimes import REVERSAL_SPAN, compute_regimes
 from compliance.validation.replay import replay
-from compliance.simulation import Scenario, simulate
+from compliance.simulation import Scenario
+from compliance.plants import simulate
 from compliance.validation.fit_metrics import per_unit_bases
 
 SMOOTHING = LocateSettings().smoothing

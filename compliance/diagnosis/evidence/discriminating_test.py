@@ -19,7 +19,8 @@ import numpy as np
 from compliance.diagnosis.evidence.operating_point import load_at_start
 from compliance.errors import InputError, SimulationError
 from compliance.recordings.synth import practice_profile
-from compliance.simulation import Scenario, simulate
+from compliance.simulation import Scenario
+from compliance.plants import simulate
 from compliance.simulation.profiles import Profile
 
 SUPPLY_FACTOR = 0.7  # another supply pressure: 70 % of the recording's (a regulator setting any bench has)

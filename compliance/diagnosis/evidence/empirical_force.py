@@ -24,11 +24,10 @@ import math
 
 import numpy as np
 
+from compliance.model.assembly import friction_level_at
 from compliance.model.plant_vector import load_curve_arrays, parameter_vector
-
 from compliance.model.rest_state import load_force, pneumatic_forces
 from compliance.diagnosis.evidence.operating_point import load_at_start
-from compliance.effects.pressure_dependent_friction import P_PF_COEF, P_PF_ON, pressure_friction_factor
 from compliance.model.vector_slots import P_BV, P_FC, P_FS, P_MASS, P_NFR, P_PATM, P_VS
 from compliance.physics.friction import stribeck_map
 
@@ -134,7 +133,7 @@ def implied_force(cfg, setup) -> tuple[np.ndarray, dict, np.ndarray]:
     df = np.empty(t.size)
     for k in range(t.size):
         f1, f2 = pneumatic_forces(P, pa[k], pb[k])
-        rise = pressure_friction_factor(P[P_PF_COEF], 0.5 * (pa[k] + pb[k]), patm) if P[P_PF_ON] != 0.0 else 1.0
+        rise = friction_level_at(P, float(x[k]), float(pa[k]), float(pb[k]))  # the effects' friction levels, as plant_rhs
         fs, fc = P[P_FS] * rise, P[P_FC] * rise
         ff = P[P_NFR] * stribeck_map(v[k], fs, fc, P[P_VS], P[P_BV])
         df[k] = P[P_MASS] * acc[k] - (f1 + f2) + load_force(P, x[k], lx, ly) + ff

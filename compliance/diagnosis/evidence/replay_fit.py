@@ -35,10 +35,8 @@ from scipy.signal import savgol_filter
 
 from compliance.model.config import PlantConfig
 from compliance.errors import InputError, SimulationError
-from compliance.effects.heat_transfer import S_TA, S_TB
-from compliance.effects.linkage_compliance import S_V2
-from compliance.effects.sensor_lag import P_SL_ON, P_SL_TAU, P_SL_TD
-from compliance.effects.supply_droop import P_SD_ON, S_PSUP
+from compliance.effects.base import ReplayPoint
+from compliance.effects.structure import reading_lags, reset_for_replay
 from compliance.model.vector_slots import P_KI, P_KP, P_STROKE, S_V
 from compliance.model.plant_vector import load_curve_arrays, parameter_vector
 from compliance.model.rest_state import initial_state, set_rest_internal_states
@@ -321,21 +319,22 @@ def _reset_state(cfg, P, setup: ReplaySetup, k: int, previous: np.ndarray, lx, l
     st = setup.states
     x = float(st["position"][k])
     v = float(st["velocity"][k])
-    if P[P_SL_ON]:
+    lags = reading_lags(P)
+    if lags:
         # the recorded position is the sensor's, which trails the piston by its total lag (exactly for a
         # delay, to first order for the lag): the piston is where the reading arrives that much later
-        later = setup.time[k] + P[P_SL_TAU] + P[P_SL_TD]
+        later = setup.time[k]
+        for lag in lags:
+            later = later + lag
         x = float(np.interp(later, setup.time, st["position"]))
         v = float(np.interp(later, setup.time, st["velocity"]))
     pa = float(st["pressure_a"][k]) if "pressure_a" in st else float(previous[k, _OUT["pressure_a"]])
     pb = float(st["pressure_b"][k]) if "pressure_b" in st else float(previous[k, _OUT["pressure_b"]])
     y = initial_state(cfg, P, min(max(x, 0.0), P[P_STROKE]), (pa, pb))
     y[S_V] = v
-    y[S_V2] = v
-    y[S_TA] = previous[k, _OUT["temperature_a"]]  # gas temperatures are not measured: carried over
-    y[S_TB] = previous[k, _OUT["temperature_b"]]
-    if P[P_SD_ON]:
-        y[S_PSUP] = float(st["supply_pressure"][k]) if "supply_pressure" in st else previous[k, _OUT["supply_pressure"]]
+    # the effects' states at the restart: measured ones from the recording, the others carried over
+    measured = {s: float(st[s][k]) for s in SIGNALS if s in st}
+    reset_for_replay(P, y, ReplayPoint(v, measured, dict(zip(OUTPUT_COLUMNS, previous[k].tolist()))))
     set_rest_internal_states(P, y, lx, ly, v)  # bristles carry the net force, the link its share
     return y
 

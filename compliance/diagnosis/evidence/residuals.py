@@ -123,7 +123,8 @@ def null_recording(cfg: PlantConfig, setup: ReplaySetup, sensor: dict, seed: int
     import pandas as pd
 
     from compliance.simulation.profiles import Profile
-    from compliance.simulation import Scenario, SensorNoise, simulate
+    from compliance.simulation import Scenario, SensorNoise
+    from compliance.plants import simulate
     from compliance.diagnosis.evidence.replay_fit import prepare_replay
 
     rec, res = setup.recorded, setup.resolution

@@ -112,7 +112,7 @@ class SealDiagnosis:
     noise_floor: float
     structure: dict | None = None  # friction_structure: what the law leaves, named (empirical)
     holdout: dict | None = None  # friction_holdout: each pressure predicted by the law fitted on the others
-    position: dict | None = None  # friction_holdout: does position_dependent_friction earn its parameters held out
+    position: dict | None = None  # friction_holdout: does friction_along_stroke earn its parameters held out
     bench_effects: list = field(default_factory=list)  # friction_holdout: every declared bench effect tried held out
 
     def to_dict(self) -> dict:

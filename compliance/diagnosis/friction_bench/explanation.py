@@ -11,7 +11,7 @@ from compliance.diagnosis.friction_bench.position import POSITION_FRICTION
 from compliance.diagnosis.friction_bench.pressure_shape import NONLINEAR_PRESSURE, PRESSURE_FORCE
 from compliance.diagnosis.friction_bench.running_in import FRICTION_DRIFT
 from compliance.diagnosis.friction_bench.laws import core_equivalent
-from compliance.units.formatting import fmt_si
+from compliance.presentation.numbers import fmt_si
 from compliance.diagnosis.verdicts.verdict import DiagnosisVerdict
 
 
@@ -129,7 +129,7 @@ _REFIT_WORDS = {"pressure_exponent": ("pressure exponent n", ""), "bias_per_pres
 
 def _refit_lines(h: dict) -> list[str]:
     """Per pressure-shape parameter, its value refitted without each run and with all runs (console)."""
-    from compliance.units.formatting import fmt_si
+    from compliance.presentation.numbers import fmt_si
 
     out = []
     for key, (label, unit) in _REFIT_WORDS.items():

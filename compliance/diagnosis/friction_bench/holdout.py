@@ -39,7 +39,7 @@ from compliance.diagnosis.friction_bench.fit import LawFit, fit_law, predict, st
 from compliance.diagnosis.friction_bench.position import POSITION_FRICTION
 from compliance.diagnosis.friction_bench.pressure_shape import NONLINEAR_PRESSURE, PRESSURE_FORCE
 from compliance.diagnosis.friction_bench.running_in import FRICTION_DRIFT
-from compliance.units.formatting import fmt_si
+from compliance.presentation.numbers import fmt_si
 from compliance.diagnosis.verdicts.candidate_set import CandidateSet
 
 MIN_RUNS = 3  # fit on at least two pressures, predict a third
@@ -172,7 +172,7 @@ def prove_out_of_sample(runs, fits: dict, law: str, try_effects: bool, *, jobs: 
     """The held-out table of ``law`` and, when ``try_effects``, which declared bench effects earn their place.
 
     The bench effects (``fit.BENCH_EFFECTS``: nonlinear_pressure_friction, pressure_force_curvature,
-    position_dependent_friction, friction_drift, in that order) are tried one after another on the law kept so far;
+    friction_along_stroke, friction_drift, in that order) are tried one after another on the law kept so far;
     one is kept when it earns its parameters on held-out runs (``earns``) *and* lowers the BIC by
     ``selection.SIGNIFICANCE`` over all runs.
 

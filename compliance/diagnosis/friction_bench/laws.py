@@ -56,7 +56,7 @@ def stribeck_level(speed, pressure_gauge, coulomb0, static0, stribeck_velocity, 
 
 
 def position_factor(position, params: dict) -> np.ndarray | float:
-    """Relative friction level along the stroke, 1 + a1 (x - x_r) + a2 (x - x_r)^2 (``position_dependent_friction``).
+    """Relative friction level along the stroke, 1 + a1 (x - x_r) + a2 (x - x_r)^2 (``friction_along_stroke``).
 
     1.0 when the law has no ``position_gradient``; never below ``friction_bench.position.MIN_FACTOR``.
     """
@@ -82,7 +82,7 @@ def friction_force(velocity, pressure_gauge, time, params: dict, *, presliding: 
         ``coulomb`` [N], ``static`` [N], ``stribeck_velocity`` [m/s], ``viscous`` [N*s/m],
         ``pressure_coefficient`` [N/Pa] (0: pressure-independent; with ``nonlinear_pressure_friction``
         ``pressure_exponent`` [-] and ``reference_pressure`` [Pa]), ``bristle_stiffness``
-        sigma0 [N/m] (with ``presliding``); with ``position_dependent_friction``: ``position_gradient``
+        sigma0 [N/m] (with ``presliding``); with ``friction_along_stroke``: ``position_gradient``
         [1/m], ``position_curvature`` [1/m^2], ``reference_position`` [m].
     presliding : bool
         LuGre bristles (True) or the static map.
@@ -114,7 +114,7 @@ def core_equivalent(p: dict) -> str:
     single-acting cylinder has its rod side vented, so p_mean = p_g / 2): k = 2 k_p / F_0 per level.
     """
     from compliance.diagnosis.servo.explanation import effect_words
-    from compliance.units.formatting import fmt_si
+    from compliance.presentation.numbers import fmt_si
 
     rel = [f"{fmt_si(2.0 * p['pressure_coefficient'] / p[level], '1/Pa')} on {name}"
            for level, name in (("coulomb", "F_C"), ("static", "F_S")) if p[level] > 1e-3]

@@ -1,4 +1,4 @@
-"""Declared bench effect: seal friction that changes along the stroke (``position_dependent_friction``).
+"""Declared bench effect: seal friction that changes along the stroke (``friction_along_stroke``).
 
 A seal's friction follows its contact force, which follows its squeeze; a bore whose diameter
 varies along the stroke (a printed or worn bore, a slight taper or ovality) changes the squeeze
@@ -11,7 +11,9 @@ position, expanded to second order about the centre of the travelled range:
 Source: friction of an elastomer seal proportional to its squeeze (Parker O-Ring Handbook
 ORD 5700, 2021, section 5 "Dynamic O-ring sealing", running friction); the second-order
 expansion in position and the reference x_r are our choices (x_r is not fitted: it is the
-median position of the seal's runs, so a1 is the slope at mid-travel).
+median position of the seal's runs, so a1 is the slope at mid-travel). The plant model's effect
+``position_dependent_friction`` is its first-order form about mid-stroke, with its own name, bounds and
+slots; the two are separate declarations.
 """
 
 from __future__ import annotations
@@ -36,7 +38,7 @@ class BenchEffect:
 
 
 POSITION_FRICTION = BenchEffect(
-    name="position_dependent_friction",
+    name="friction_along_stroke",
     meaning="the seal's friction level changes along the stroke (squeeze varying with the bore)",
     params=(
         Param("position_gradient", "1/m", "relative change of both friction levels per metre of travel at mid-travel, a1",

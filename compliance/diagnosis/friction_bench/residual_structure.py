@@ -25,7 +25,7 @@ import math
 import numpy as np
 
 from compliance.diagnosis.evidence.empirical_force import sparse_fit
-from compliance.units.formatting import fmt_si
+from compliance.presentation.numbers import fmt_si
 
 POSITION_BINS = 8  # hat functions along the travelled range
 V_REF = 0.01  # m/s; reference speed of the velocity shapes

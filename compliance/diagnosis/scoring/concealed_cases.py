@@ -30,7 +30,8 @@ from compliance.effects import EFFECTS
 from compliance.errors import SimulationError
 from compliance.diagnosis.evidence.operating_point import load_at_start
 from compliance.recordings.synth import PRACTICE_NOISE, practice_profile, synthesise
-from compliance.simulation import Scenario, simulate
+from compliance.simulation import Scenario
+from compliance.plants import simulate
 
 MAX_POSITION_RMS = 0.5e-3  # m; concealed: the position moves less than this (practice cases: 0.13-0.50 mm)
 MIN_PRESSURE_RMS = 3.0e3  # Pa; visible: ten times the pressure sensor noise (practice cases: 4-13 kPa)

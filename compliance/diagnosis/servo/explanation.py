@@ -7,7 +7,7 @@ from compliance.diagnosis.servo.candidates import FRICTION_LEVEL
 from compliance.diagnosis.servo.friction_form import form_words
 from compliance.diagnosis.servo.instrument_candidates import PREFIX, finding_words
 from compliance.diagnosis.verdicts.candidate_set import is_instrument
-from compliance.units.formatting import fmt_dbic, fmt_num, fmt_si
+from compliance.presentation.numbers import fmt_dbic, fmt_num, fmt_si
 from compliance.diagnosis.verdicts.candidate_set import CandidateSet
 from compliance.diagnosis.verdicts.verdict import DiagnosisVerdict
 

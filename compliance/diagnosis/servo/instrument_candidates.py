@@ -85,7 +85,7 @@ def instrumented(setup, params, values):
 
 def finding_words(fit) -> str:
     """The instrumentation finding of a fit (an instrumentation candidate, or a plant explanation with one on top) in words."""
-    from compliance.units.formatting import fmt_si
+    from compliance.presentation.numbers import fmt_si
 
     pairs = [(fp, v) for fp, v in zip(fit.params, fit.values) if fp.kind == KIND]
     if not pairs:

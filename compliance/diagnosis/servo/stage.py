@@ -20,6 +20,7 @@ from compliance.diagnosis.servo.parallel_fits import run_fits
 from compliance.diagnosis.evidence.replay_fit import ReplaySetup, prepare_replay, replay_config, run_replay
 from compliance.diagnosis.evidence.residuals import build_residual_model, signal_fit, with_fail_level
 from compliance.diagnosis.evidence.locate_misfit import locate_mismatch
+from compliance.plants import kind_of
 
 
 @dataclass
@@ -49,7 +50,9 @@ class Stage:
 
 def check_effects(cfg: PlantConfig, effects) -> list[str]:
     """Stage 0: the effects to try (``None``: every declared effect the plant does not already have); a name
-    that is not declared is an ``InputError``."""
+    that is not declared, or a plant kind whose recordings the replay cannot run (``PlantKind.diagnosis_support``),
+    is an ``InputError``."""
+    kind_of(cfg).check_diagnosable(cfg)
     names = [e for e in EFFECTS if e not in cfg.effects] if effects is None else list(effects)
     for e in names:
         if e not in EFFECTS:

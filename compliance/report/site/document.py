@@ -14,7 +14,7 @@ from compliance.errors import InputError
 from compliance.presentation.values import limit_as_written, metric_text
 from compliance.report import signoff as S
 from compliance.report.render import _check_target, _common, _emit, draw_figures
-from compliance.units.formatting import fmt_date, fmt_si
+from compliance.presentation.numbers import fmt_date, fmt_si
 
 __all__ = ["build_site_report", "render_site_report"]
 

@@ -28,13 +28,13 @@ import math
 
 import numpy as np
 
-from compliance.requirements.verdict import Overall, Severity, Status
+from compliance.requirements.verdict import Severity, Status
 from compliance.sweep.candidates.evaluate import judged
 from compliance.sweep.candidates.results import change
 from compliance.sweep.candidates.ranking import SETTINGS_COST, candidate_passes, failing_mandatory, rank_key
 from compliance.sweep.candidates.runner import run_candidates, shortfall
 from compliance.sweep.candidates.sampling import from_normalised, to_normalised
-from compliance.units.formatting import fmt_margin_pct
+from compliance.presentation.numbers import fmt_margin_pct
 from compliance.sweep.remedies.outcome import RemedyStatus
 
 __all__ = ["STEP", "TARGET", "binding", "closeness", "describe_candidate", "find_remedy", "mandatory_margins", "unreachable"]
@@ -214,11 +214,10 @@ def find_remedy(ctx, adjust, base: dict, *, verify, iterations: int = 4, seeds=(
         if candidate_passes(row):
             results = verify({**cand, **run_kw["fixed"]})
             remedy = describe_candidate(adjust, start, cand, row)
-            remedy["verified"] = {"status": results["summary"]["status"],
-                                  "failed_mandatory": results["summary"]["failed_mandatory"]}
-            if results["summary"]["status"] == Overall.PASS:
+            remedy["verified"] = {"status": results.summary.status, "failed_mandatory": list(results.summary.failed_mandatory)}
+            if results.passed:
                 out.update(status=RemedyStatus.FOUND, remedy=remedy,
-                           note=f"verified by a full campaign of the changed configuration ({len(results['runs'])} runs)")
+                           note=f"verified by a full campaign of the changed configuration ({len(results.runs)} runs)")
                 return out
         if key((cand, row)) < key((cur, cur_row)):
             cur, cur_row = cand, row

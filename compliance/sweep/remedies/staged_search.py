@@ -36,10 +36,10 @@ def _stage(ctx, adjust, base, verify, run_kw, iterations, fixed=None, cost=0.0, 
     rem["hardware_cost"] = cost
     if rem["status"] == RemedyStatus.ALREADY_PASSES and fixed:  # the hardware alone, at these settings, passes: verify it
         results = verify({**fixed, **rem["closest"]["values"]})
-        if results["summary"]["status"] == Overall.PASS:
+        if results.passed:
             remedy = {**rem["closest"], "verified": {"status": Overall.PASS, "failed_mandatory": []}}
             rem.update(status=RemedyStatus.FOUND, remedy=remedy, closest=None,
-                       note=f"verified by a full campaign of the changed configuration ({len(results['runs'])} runs)")
+                       note=f"verified by a full campaign of the changed configuration ({len(results.runs)} runs)")
         else:
             rem["status"] = RemedyStatus.NONE_FOUND
     return rem

@@ -36,15 +36,15 @@ def _swings(cands: list[dict], vals: list[float], ranged) -> dict:
     return out
 
 
-def monte_carlo_bands(cfg, reqset, results: dict, n: int, *, seed: int = 0, workers=None, progress=False) -> dict:
-    """Replace the bands of ``results``' modelled verdicts by a Latin-hypercube Monte Carlo of ``n`` plants.
+def monte_carlo_bands(cfg, reqset, entries: list[dict], n: int, *, seed: int = 0, workers=None, progress=False) -> dict:
+    """Replace the bands of the modelled verdicts by a Latin-hypercube Monte Carlo of ``n`` plants.
 
     Parameters
     ----------
     cfg : PlantConfig
     reqset : RequirementSet
-    results : dict
-        A campaign's results (its ``requirements`` entries are updated in place).
+    entries : list of dict
+        A campaign's requirement entries (``campaign.judge``; updated in place).
     n : int
         Number of candidate plants (>= 2).
     seed : int
@@ -62,7 +62,6 @@ def monte_carlo_bands(cfg, reqset, results: dict, n: int, *, seed: int = 0, work
     ctx = make_context(cfg, reqset, paths)
     rows, _ = run_candidates(ctx, cands, workers=workers, progress=progress, label="uncertainty")
     ok = [(c, r) for c, r in zip(cands, rows) if judged(r)]
-    entries = results["requirements"]
     for e in _targets(entries):
         got = [(c, r["requirements"][e["id"]]["value"]) for c, r in ok
                if r["requirements"].get(e["id"], {}).get("value") is not None]
