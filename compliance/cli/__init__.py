@@ -127,11 +127,22 @@ def _interrupted(command: str | None, exc: KeyboardInterrupt) -> int:
     return 143 if term else 130
 
 
+def _check_source_date_epoch() -> None:
+    """A malformed ``SOURCE_DATE_EPOCH`` is refused before any command module loads (numpy reads it on import too)."""
+    import os
+
+    if os.environ.get("SOURCE_DATE_EPOCH", "").strip():
+        from compliance.files.reproducible import fixed_created
+
+        fixed_created()
+
+
 def _run(args) -> int:
     """Run the parsed command; map every way it can end to an exit code and one line on stderr."""
     from compliance.processes import raise_if_stopping
 
     try:
+        _check_source_date_epoch()
         code = args._run(args)
         sys.stdout.flush()  # inside the try: a reader that went away is met here, not at the interpreter's exit
         raise_if_stopping()  # a signal whose exception Python swallowed (in a fork hook) still ends as interrupted

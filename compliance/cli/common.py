@@ -232,6 +232,9 @@ def check_args_outputs(args, *extra, inputs: dict | None = None) -> None:
     if is_reproducible(getattr(args, "reproducible", False)):
         fixed_created()  # a bad SOURCE_DATE_EPOCH is refused now, not after the work
     outputs = standard_outputs(args, *extra)
+    if getattr(args, "reproducible", False) is True and not outputs:
+        raise InputError("--reproducible: makes the files a run writes byte-identical, and this run writes none; add an "
+                         "output (--json FILE.json, ...) or drop --reproducible")
     found = input_files(args, {o[1].split("/")[-1].lstrip("-").replace("-", "_") for o in outputs})
     check_outputs(*outputs, inputs={**(inputs or {}), **found})
 

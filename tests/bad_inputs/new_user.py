@@ -17,9 +17,9 @@ CASES: list[Case] = []
 CLASSES = ("size", "remedies", "catalogue", "range", "joint", "sidecar", "scheduler", "doc", "conflict")
 
 
-def case(id, argv, fragment, files=None, code=2):
+def case(id, argv, fragment, files=None, code=2, env=None):
     assert id.split("-")[0] in CLASSES + ("older",), id
-    CASES.append(Case(id, files or {}, argv.split() if isinstance(argv, str) else argv, fragment, code))
+    CASES.append(Case(id, files or {}, argv.split() if isinstance(argv, str) else argv, fragment, code, env or {}))
 
 
 # ------------------------------------------------------------------------------------- sizing: the duty and `size`
@@ -255,6 +255,12 @@ for cid, keys in [
     case(cid, "report bad.json --report out/r.html", "where a number (or null) belongs", {"bad.json": damaged(keys)})
 
 # options that shape something the run does not do
+case("older-reproducible-writing-nothing", "validate plant.toml rec.csv --reproducible -q",
+     "--reproducible: makes the files a run writes byte-identical, and this run writes none")
+case("older-sim-bad-epoch", "simulate plant.toml -o out/n.csv", "SOURCE_DATE_EPOCH='last week': expected a whole number",
+     env={"SOURCE_DATE_EPOCH": "last week"})
+case("older-validate-noise-on-plant-only", "validate plant.toml rec.csv --mode plant_only --noise none -q",
+     "--noise none: the position noise of the closed-loop replay")
 case("older-sim-seed-without-noise", "simulate plant.toml -o out/n.csv --seed 3", "--seed 3: seeds the sensor noise")
 case("older-check-appendix-without-report", "check plant.toml -r req.toml --appendix full --json out/r.json -q",
      "--appendix full: shapes the report")
