@@ -99,14 +99,17 @@ def run(args) -> int:
     from compliance.requirements.verdict import Overall
 
     check_args_outputs(args)
+    if args.diagnose and args.no_prediction:
+        raise InputError("--diagnose needs the prediction (it explains where the machine and the model disagree); "
+                         "drop --no-prediction")
+    if args.jobs is not None and args.no_prediction:  # the recordings are judged in this process
+        raise InputError(f"--jobs {args.jobs}: the prediction's replays run in parallel, and --no-prediction runs none; "
+                         "drop --jobs")
     site, config = _site_and_config(args.inputs)
     reqset = load_requirements(args.requirements)
     recordings = read_site(site, args.column_map)  # every file read and checked before any replay
     cfg = _plant(config, recordings)
     checked_requirements(reqset, [cfg.p("cylinder.stroke")], args)  # as every command that loads a requirement set
-    if args.diagnose and args.no_prediction:
-        raise InputError("--diagnose needs the prediction (it explains where the machine and the model disagree); "
-                         "drop --no-prediction")
     results = accept(site, reqset, cfg, recordings=recordings, predict=not args.no_prediction, diagnose=args.diagnose,
                      workers=args.jobs, progress=not args.quiet and sys.stderr.isatty(), command_line=_command_line(args))
     if is_reproducible(args.reproducible):

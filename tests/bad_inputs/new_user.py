@@ -185,6 +185,8 @@ case("scheduler-unreachable-before-work", ["check", "plant.toml", "-r", "req.tom
 # ------------------------------------------------------------------------------------- document control without a document
 case("doc-number-without-report", "check plant.toml -r req.toml --json out/r.json --document-number GC-7 -q",
      "--document-number GC-7: is printed on the report, and no report is asked for")
+case("doc-accept-revision-without-report", "accept site -r req.toml --revision C --json out/s.json -q",
+     "--revision C: is printed on the report")
 case("doc-revision-without-report", "diagnose plant.toml rec.csv --revision B --json out/d.json",
      "--revision B: is printed on the report")
 
@@ -259,6 +261,8 @@ case("older-reproducible-writing-nothing", "validate plant.toml rec.csv --reprod
      "--reproducible: makes the files a run writes byte-identical, and this run writes none")
 case("older-sim-bad-epoch", "simulate plant.toml -o out/n.csv", "SOURCE_DATE_EPOCH='last week': expected a whole number",
      env={"SOURCE_DATE_EPOCH": "last week"})
+case("older-accept-jobs-without-prediction", "accept site -r req.toml --no-prediction -j 2 --json out/s.json -q",
+     "--jobs 2: the prediction's replays run in parallel, and --no-prediction runs none")
 case("older-validate-noise-on-plant-only", "validate plant.toml rec.csv --mode plant_only --noise none -q",
      "--noise none: the position noise of the closed-loop replay")
 case("older-sim-seed-without-noise", "simulate plant.toml -o out/n.csv --seed 3", "--seed 3: seeds the sensor noise")
