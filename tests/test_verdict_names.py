@@ -47,6 +47,8 @@ def _name_positions(tree: ast.AST) -> set[int]:
         elif (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)
               and node.func.attr in KEY_METHODS and node.args):
             out.add(id(node.args[0]))
+        elif isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "key" and node.args:
+            out.add(id(node.args[0]))  # a typed record's JSON key name (compliance.results.record.key)
         elif isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant):
             out.add(id(node.value))  # docstrings and bare strings
     return out
@@ -64,7 +66,7 @@ def bare_verdict_words(source: str) -> list[tuple[int, str]]:
 def test_the_checker_finds_a_bare_status_and_spares_names():
     src = ('def f(e, c):\n    """pass or fail."""\n    x = {"pass": 1}\n    y = c["fail"] + c.get("uncertain", 0)\n'
            '    if e["status"] == "fail":\n        return "incomplete"\n    return ("modelled", Status.PASS)\n'
-           '    words = {Status.PASS: "pass", Basis.MODELLED: "modelled"}\n')
+           '    words = {Status.PASS: "pass", Basis.MODELLED: "modelled"}\n    passed: int = key("pass", default=0)\n')
     assert sorted(bare_verdict_words(src)) == [(5, "fail"), (6, "incomplete"), (7, "modelled")]
 
 

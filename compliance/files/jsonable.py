@@ -8,6 +8,7 @@ a NaN never reaches a file as the non-standard ``NaN`` token and numpy types nev
 from __future__ import annotations
 
 import dataclasses
+import gzip
 import json
 import math
 from pathlib import Path, PurePath
@@ -75,12 +76,15 @@ def read_json(path, what: str) -> dict:
     """Read a JSON object from ``path``; InputError naming the file otherwise."""
     p = Path(path)
     try:
-        data = json.loads(p.read_text(encoding="utf-8"))
+        raw = p.read_bytes()
+        if p.suffix == ".gz":  # a results file stored compressed (a sweep's best candidate, with its traces)
+            raw = gzip.decompress(raw)
+        data = json.loads(raw.decode("utf-8"))
     except FileNotFoundError:
         raise InputError(f"{p}: {what} file not found") from None
     except IsADirectoryError:
         raise InputError(f"{p}: is a folder; expected a {what} JSON file") from None
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+    except (UnicodeDecodeError, json.JSONDecodeError, gzip.BadGzipFile, EOFError) as exc:
         raise InputError(f"{p}: not a JSON {what} file ({exc})") from None
     if not isinstance(data, dict):
         raise InputError(f"{p}: expected a JSON object ({what}), got {type(data).__name__}")

@@ -105,13 +105,13 @@ def _param_rows(params: list) -> list[dict]:
 
     rows = []
     for p in params:
-        if p.get("value") is None:
+        if p["value"] is None:
             continue
         b = FIT_BOUNDS.get(p["name"])
         pinned = bool(b) and at_bound(p["value"], *b)
-        rows.append({"name": p["name"].replace("_", " "), "meaning": p.get("meaning") or "",
-                     "text": fmt_si(p["value"], p.get("unit") or "", p.get("stderr")),
-                     "bound": (f"at its fit bound ({fmt_si(b[0] if abs(p['value'] - b[0]) < abs(p['value'] - b[1]) else b[1], p.get('unit') or '')}): "
+        rows.append({"name": p["name"].replace("_", " "), "meaning": p["meaning"] or "",
+                     "text": fmt_si(p["value"], p["unit"], p["stderr"]),
+                     "bound": (f"at its fit bound ({fmt_si(b[0] if abs(p['value'] - b[0]) < abs(p['value'] - b[1]) else b[1], p['unit'])}): "
                                "the data do not determine it and its standard error means nothing") if pinned else None})
     return rows
 
@@ -122,11 +122,11 @@ def _seal_context(seal, sd: dict, index: int) -> dict:
 
     win = next((e for e in sd["effects"] if e["name"] == sd["winner"]), None) if sd["winner"] else None
     params = _param_rows((win or {}).get("parameters") or [])
-    ranked = [{"name": e["name"].replace("+", " + ").replace("_", " "), "k": e["k"], "chi2": fmt_num(e.get("chi2_per_residual"), 3),
-               "dbic": fmt_dbic(e.get("delta_bic")), "explained": fmt_quantity(e.get("explained_fraction") or 0, "", "%"),
-               "params": "; ".join(f"{p['name'].replace('_', ' ')} {fmt_si(p['value'], p.get('unit') or '')}"
-                                   for p in e["parameters"] if p.get("value") is not None)} for e in sd["effects"]]
-    floor = (sd.get("noise_floor") or {}).get("value")
+    ranked = [{"name": e["name"].replace("+", " + ").replace("_", " "), "k": e["k"], "chi2": fmt_num(e["chi2_per_residual"], 3),
+               "dbic": fmt_dbic(e["delta_bic"]), "explained": fmt_quantity(e["explained_fraction"] or 0, "", "%"),
+               "params": "; ".join(f"{p['name'].replace('_', ' ')} {fmt_si(p['value'], p['unit'])}"
+                                   for p in e["parameters"] if p["value"] is not None)} for e in sd["effects"]]
+    floor = sd["noise_floor"]["value"]
     runs, remarks, after = [], [], []
     for run, b in sd["fit_before"].items():
         a = (sd.get("fit_after") or {}).get(run)
@@ -147,9 +147,9 @@ def _seal_context(seal, sd: dict, index: int) -> dict:
         remarks.append("Parameters at their fit bounds (" + ", ".join(pinned) + "): the runs do not determine them; "
                        "record runs that excite them (slower strokes for a Stribeck velocity) before using their values.")
     return {"seal": sd["seal"], "seal_index": index, "verdict": sd["verdict"], "winner": (sd["winner"] or "").replace("+", " + ").replace("_", " "),
-            "runner_up": (sd.get("runner_up") or "").replace("+", " + ").replace("_", " "),
+            "runner_up": (seal.runner_up or "").replace("+", " + ").replace("_", " "),
             "explanation": sd["explanation"], "params": params, "ranked": ranked, "runs": runs, "remarks": remarks,
-            "figures": seal_figures(seal, f"fig-{index}"), "holdout": _holdout_context(sd.get("holdout"))}
+            "figures": seal_figures(seal, f"fig-{index}"), "holdout": _holdout_context(seal.holdout)}
 
 
 def _holdout_context(h: dict | None) -> dict | None:

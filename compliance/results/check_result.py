@@ -123,10 +123,16 @@ class CheckResult(Record):
         return json_text(self.as_dict(), compact=True)
 
     def to_json(self, path) -> None:
-        """Write the results JSON atomically."""
-        from compliance.files.atomic import write_text_atomic
+        """Write the results JSON atomically; gzip-compressed when ``path`` ends in ``.gz``."""
+        from compliance.files.atomic import write_bytes_atomic, write_text_atomic
 
-        write_text_atomic(path, self.json_text())
+        if str(path).endswith(".gz"):
+            import gzip
+
+            # mtime 0: the same result gives the same bytes
+            write_bytes_atomic(path, gzip.compress(self.json_text().encode("utf-8"), mtime=0))
+        else:
+            write_text_atomic(path, self.json_text())
 
     def made_reproducible(self, command_line: str | None = None) -> "CheckResult":
         """This result as ``--reproducible`` writes it: fixed ``created``, no timings, ``command_line`` replaced."""

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+from compliance.requirements.verdict import Severity
 from compliance.results.record import FrozenDict, Record, derived, key, records, tuple_of
 
 __all__ = ["FileRecord", "OperatingPointRecord", "ProcedureRecord", "RequirementSetRecord", "RequirementSpec"]
@@ -74,7 +75,7 @@ class RequirementSpec(Record):
     limit: tuple[str, ...] | None = None  # as written; None = open
     procedures: tuple[str, ...] = key(default=(), read=tuple_of(str))
     operating_points: tuple[str, ...] = key(default=(), read=tuple_of(str))
-    severity: str = "mandatory"
+    severity: str = Severity.MANDATORY.value
     source: str = "simulation"
     options: FrozenDict = key(factory=FrozenDict)
     note: str | None = None

@@ -2,7 +2,7 @@
 
 ``run_sweep`` writes into one folder: ``results.parquet`` and ``results.csv`` (one row per
 candidate), ``summary.json`` and ``summary.md`` (counts, executor statistics, the Pareto front
-of the two tightest requirements, the best candidate) and ``best-results.json`` (the best
+of the two tightest requirements, the best candidate) and ``best-results.json.gz`` (the best
 candidate's full campaign, schema ``govcheck-results/1``, which ``govcheck report`` renders).
 ``run_yield_file`` does the same for a tolerance-yield run: ``yield.json``, ``yield.md``, the unit
 table (``results.parquet``/``.csv``, one row per unit) and ``results.json`` (the nominal
@@ -105,12 +105,12 @@ def run_sweep(spec, out_dir, *, scheduler=None, workers=None, progress=True, cli
         best_info = {"candidate": best, "values": values, "status": df.loc[best, "status"],
                      "shortfall": float(df.loc[best, "shortfall"]), "change": float(df.loc[best, "change"]),
                      "verified_status": res.summary.status, "failed_mandatory": list(res.summary.failed_mandatory),
-                     "results_file": str(out / "best-results.json")}
+                     "results_file": str(out / "best-results.json.gz")}
     raise_if_stopping()
     out.mkdir(parents=True, exist_ok=True)
     files = write_table(df, out)
     if res is not None:
-        res.to_json(out / "best-results.json")
+        res.to_json(out / "best-results.json.gz")
     counts = df["status"].value_counts().to_dict()
     summary = {
         "schema": SUMMARY_SCHEMA, "name": spec.name, "title": spec.title, "sweep_file": spec.path,

@@ -135,3 +135,22 @@ def test_a_damaged_file_is_named_not_crashed_on(plant_a, tmp_path):
     with pytest.raises(InputError, match="'rows' is missing"):
         CheckResult.from_json(p)
     assert Path(p).exists()
+
+
+def test_a_compressed_results_file_is_the_same_result(plant_a, tmp_path):
+    """``.json.gz`` (a sweep's best candidate, traces and all) holds the same JSON, the same bytes every time,
+    and a truncated one is named, not crashed on."""
+    import gzip
+
+    from compliance.errors import InputError
+
+    typed = CheckResult.of(plant_a)
+    typed.to_json(tmp_path / "r.json.gz")
+    first = (tmp_path / "r.json.gz").read_bytes()
+    assert gzip.decompress(first).decode() == typed.json_text()
+    assert CheckResult.from_json(tmp_path / "r.json.gz") == typed
+    typed.to_json(tmp_path / "r.json.gz")
+    assert (tmp_path / "r.json.gz").read_bytes() == first  # no timestamp in the gzip header
+    (tmp_path / "cut.json.gz").write_bytes(first[: len(first) // 2])
+    with pytest.raises(InputError, match=r"cut\.json\.gz: not a JSON results file"):
+        CheckResult.from_json(tmp_path / "cut.json.gz")

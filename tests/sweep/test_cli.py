@@ -41,7 +41,7 @@ def test_sweep_writes_table_summary_and_best_results(swept):
     # the best passing candidate is the one closest to the base settings (kp 280, kd 20)
     passing = df[df["status"] == "pass"]
     assert best["change"] == pytest.approx(passing["change"].min())
-    res = read_results(out / "best-results.json")
+    res = read_results(out / "best-results.json.gz")
     assert res.passed and res.sweep["candidate"] == best["candidate"]
 
 
