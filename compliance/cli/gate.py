@@ -51,7 +51,7 @@ def register(subparsers):
 
 
 def _is_results(path: str) -> bool:
-    return path.endswith(".json")
+    return path.endswith((".json", ".json.gz"))  # .json.gz: a sweep's best candidate is stored compressed
 
 
 def _requirements_for(args, baseline_results):

@@ -256,6 +256,21 @@ for cid, keys in [
 ]:
     case(cid, "report bad.json --report out/r.html", "where a number (or null) belongs", {"bad.json": damaged(keys)})
 
+
+
+def corrupted_gz(ws):
+    """A compressed results file damaged inside its deflate stream (a bad copy): the header is intact."""
+    import gzip
+
+    data = gzip.compress((W.REPO / "tests" / "data" / "results_fixture.json").read_bytes())
+    (ws / "best.json.gz").write_bytes(data[:12] + bytes(b ^ 0x55 for b in data[12:40]) + data[40:])
+
+
+case("older-report-corrupted-gz", "report best.json.gz --report out/r.html", "best.json.gz: not a JSON results file",
+     {"best.json.gz": corrupted_gz})
+case("older-gate-corrupted-gz", "gate best.json.gz --baseline best.json.gz", "best.json.gz: not a JSON results file",
+     {"best.json.gz": corrupted_gz})
+
 # options that shape something the run does not do
 case("older-reproducible-writing-nothing", "validate plant.toml rec.csv --reproducible -q",
      "--reproducible: makes the files a run writes byte-identical, and this run writes none")

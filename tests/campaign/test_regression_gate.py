@@ -115,6 +115,12 @@ def test_same_plant_passes_the_gate(files, capsys):
     assert capsys.readouterr().out.strip() == "GATE: PASS"
     # two results files compare without running anything
     assert main(["gate", "--baseline", str(d / "base.json"), "--candidate", str(d / "base.json"), "-q"]) == 0
+    # a compressed results file (as a sweep stores its best candidate) is a results file too, not a plant
+    import gzip
+
+    packed = d / "base.json.gz"
+    packed.write_bytes(gzip.compress((d / "base.json").read_bytes()))
+    assert main(["gate", "--baseline", str(packed), "--candidate", str(d / "base.json"), "-q"]) == 0
 
 
 def test_gate_bad_inputs(files, tmp_path, capsys):
