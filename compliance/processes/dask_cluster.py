@@ -54,9 +54,6 @@ def parse_scheduler(text: str | None) -> tuple[str, object]:
         if scheme not in DASK_SCHEMES:
             raise InputError(f"--scheduler {text}: unknown address scheme; expected one of "
                              f"{', '.join(s + '://' for s in DASK_SCHEMES)} (e.g. tcp://host:8786) or local:N")
-        if scheme == "inproc":
-            raise InputError(f"--scheduler {text}: an inproc:// address names a scheduler inside the same Python process, "
-                             "and a govcheck command starts none; give tcp://host:8786 for a running cluster or local:N")
         if scheme in ("tcp", "tls"):
             _check_host_port(text, location)
         return "dask", text
@@ -101,8 +98,16 @@ def dask_client(kind: str, target):
 
 
 def check_reachable(text: str | None) -> None:
-    """``--scheduler`` parsed, and a TCP scheduler address reached (one connect, before any work starts)."""
+    """``--scheduler`` parsed, and a TCP scheduler address reached (one connect, before any work starts).
+
+    An ``inproc://`` address is refused here, at the command line: it names a scheduler inside the
+    same Python process (a library caller's in-process cluster may pass one to ``map_tasks``), and a
+    govcheck command starts none.
+    """
     kind, target = parse_scheduler(text)
+    if kind == "dask" and target.startswith("inproc://"):
+        raise InputError(f"--scheduler {text}: an inproc:// address names a scheduler inside the same Python process, "
+                         "and a govcheck command starts none; give tcp://host:8786 for a running cluster or local:N")
     if kind == "dask":
         _refuse_unreachable(target)
 
