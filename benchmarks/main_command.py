@@ -1,4 +1,5 @@
-"""Time the README's main command in one process, phase by phase: campaign (with the bands), linear analysis, report.
+"""Time the README's main command in one process, phase by phase: campaign (with the bands), model evidence,
+linear analysis (with the stability margins), report.
 
     python benchmarks/main_command.py [--repeat 3] [--appendix summary]
 

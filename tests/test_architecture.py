@@ -19,8 +19,8 @@ PACKAGE = Path(__file__).resolve().parents[1] / "compliance"
 # bottom first: a package may import from itself and from packages before it in this list
 LAYERS = ["version", "errors", "processes", "units", "files", "physics", "effects", "model", "simulation", "plants",
           "metrics", "linear", "tracking", "procedures", "requirements", "presentation", "results", "campaign", "sweep",
-          "recordings", "validation", "characterise", "diagnosis", "acceptance", "report", "papers", "pipeline", "cli",
-          "__main__"]
+          "recordings", "validation", "characterise", "diagnosis", "acceptance", "report", "papers", "model_evidence",
+          "pipeline", "cli", "__main__"]
 
 
 def _modules() -> dict[str, Path]:

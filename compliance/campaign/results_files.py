@@ -14,7 +14,7 @@ from compliance.campaign.coverage import CASES_BASIS, case_coverage_text
 from compliance.files.atomic import write_text_atomic
 from compliance.files.jsonable import json_text, read_json
 from compliance.requirements.verdict import Basis, Severity, Status
-from compliance.presentation.values import limit_as_written
+from compliance.presentation.values import band_pct_text, limit_as_written
 from compliance.results.check_result import CheckResult
 from compliance.results.rows import RowTexts, VerdictRow, WorstCase
 from compliance.results.site_result import SITE_SCHEMA, typed_results
@@ -65,8 +65,9 @@ def _table_row(e) -> tuple:
         margin = d.margin_pct
     elif w.margin is not None:
         margin = d.margin
-    if w.band is not None and w.band.margin_low_pct is not None:
-        margin += f" [{w.band.margin_low_pct:+.0f}..{w.band.margin_high_pct:+.0f} %]"
+    band = band_pct_text(w.band, w.margin_pct)
+    if band:
+        margin += f" {band}"
     where = (w.run or "-") + (f" ({w.which})" if w.which else "")
     cov = e.coverage
     cases = f"{cov.evaluated}/{cov.rows}" if cov is not None and cov.rows and e.limit is not None else "-"
@@ -110,12 +111,37 @@ def summary_lines(result: CheckResult) -> list[str]:
     others = len(result.findings) - len(mandatory)
     if others:
         out.append(f"  requirement set: {others} more finding(s) involving advisory requirements (results JSON, 'findings')")
+    out += evidence_lines(result)
     if s.top_assumptions:
         out.append("  assumptions that matter most: " + "; ".join(f"{a.parameter} ({a.why})" for a in s.top_assumptions))
     out += [f"  {n}" for n in s.notes]
     qualifier = ", ".join(s.qualifiers)
+    pending = [f"{w} {', '.join(ids)}" for w, ids in (("uncertain:", _mandatory(result, Status.UNCERTAIN)),
+                                                       ("not evaluated:", _mandatory(result, Status.NOT_EVALUATED))) if ids]
     out.append(f"VERDICT: {s.status.upper()}" + (f" ({qualifier})" if qualifier else "")
-               + (f" (mandatory failures: {', '.join(s.failed_mandatory)})" if s.failed_mandatory else ""))
+               + (f" (mandatory failures: {', '.join(s.failed_mandatory)})" if s.failed_mandatory else "")
+               + (f" (mandatory {'; '.join(pending)})" if pending else ""))
+    return out
+
+
+def _mandatory(result, status) -> list[str]:
+    return [e.id for e in result.requirements if e.severity == Severity.MANDATORY and e.status == status]
+
+
+def evidence_lines(result) -> list[str]:
+    """The model's evidence and the loop's stability margins under the table (``model_evidence``, ``stability``)."""
+    out = []
+    ev = getattr(result, "model_evidence", None)  # a site's result carries none
+    if ev is not None:
+        out.append(f"  model evidence: {ev.summary}")
+        judged = {e.id: e for e in result.requirements if e.status not in (Status.OPEN, Status.DISABLED)}
+        rest = [f"{c.requirement} ({c.severity}, {_STATUS_WORD.get(judged[c.requirement].status, '')}: "
+                f"{c.consequence.split(':')[0]})" for c in ev.contradicted if c.requirement in judged]
+        if rest:
+            out.append("  verdicts resting on figures the measurements contradict: " + "; ".join(rest))
+    st = getattr(result, "stability", None)
+    if st is not None:
+        out.append(f"  stability of the linearised loop: {st.summary}")
     return out
 
 

@@ -46,7 +46,7 @@ def nominal_point(cfg: PlantConfig) -> tuple[float, float | str | None]:
     L = cfg.p("cylinder.stroke")
     if cfg.load_curve is None:
         return 0.5 * L, None
-    xs, fs = cfg.load_curve
+    xs, fs = cfg.load_curve_forces()
     fn = cfg.p("load.nominal_force")
     i = int(np.argmax(fs >= fn)) if np.any(fs >= fn) else int(np.argmax(fs))
     if i > 0 and fs[i] != fs[i - 1] and fs[i] >= fn:

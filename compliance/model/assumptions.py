@@ -9,18 +9,32 @@ A parameter entry may carry, beside ``value``, ``source`` and ``note``:
   derived (tuned) so that the model gives that figure under that load, so the figure at that load
   is known by construction, not as evidence (``compliance.campaign.basis``).
 
-Both are read here with units, at the edge, and kept on the configuration as plain data.
+Both are read here with units, at the edge, and kept on the configuration as plain data. So is the
+optional ``[model_evidence]`` table, the measurements the model answers to (a check carries its
+agreement with each beside the verdicts, ``compliance.model_evidence``; docs/results-schema.md):
+
+    [model_evidence]
+    paper = "plant-a"        # the plant paper's measured figures (what `govcheck reproduce` compares)
+    recordings = [           # recordings of this servo, replayed as `govcheck validate` does
+      { path = "runs/steps.csv.gz", settings = "val-limits.toml", column_map = "bench.toml", note = "..." },
+    ]
+
+Its paths are relative to the plant file's folder and must exist; the papers govcheck holds a
+table for are checked where the comparison lives.
 """
 
 from __future__ import annotations
 
+from pathlib import Path
+from types import MappingProxyType
 from typing import Any
 
 from compliance.errors import InputError
 from compliance.model.parameters import BASE_BY_KEY
 from compliance.units import parse_quantity
 
-__all__ = ["EFFECT_ENTRY_FIELDS", "ENTRY_FIELDS", "check_effect_entry", "read_assumptions"]
+__all__ = ["EFFECT_ENTRY_FIELDS", "ENTRY_FIELDS", "RECORDING_FIELDS", "check_effect_entry", "parse_model_evidence",
+           "read_assumptions"]
 
 # the fields a parameter entry may hold (the loader refuses any other)
 ENTRY_FIELDS = ("value", "source", "note", "range", "range_note", "derived_for")
@@ -137,3 +151,61 @@ def read_assumptions(data: dict[str, Any], where: str, params: dict, atmosphere:
         der = _derived_for(entry, kw) if "derived_for" in entry else None
         out[key] = {"range": rng, "derived_for": der}
     return out
+
+
+# --------------------------------------------------------------------------- [model_evidence]
+RECORDING_FIELDS = ("path", "settings", "column_map", "note")
+
+
+def _text(v, where: str) -> str:
+    if not isinstance(v, str) or not v.strip():
+        raise InputError(f"{where}: expected a non-empty string")
+    return v.strip()
+
+
+def _resolve(text: str, base: Path | None) -> str:
+    p = Path(text)
+    return str(p if p.is_absolute() or base is None else base / p)
+
+
+def parse_model_evidence(raw, where: str, plant_path: str | None) -> MappingProxyType:
+    """Validate a ``[model_evidence]`` table -> read-only ``{"paper": str or None, "recordings": (dict, ...)}``.
+
+    Recording paths (and their settings and column-map files) are resolved against the plant
+    file's folder and must exist.
+
+    Raises
+    ------
+    InputError
+        An unknown key, a value of the wrong type, or a file that does not exist (named with its key).
+    """
+    if raw is None:
+        return MappingProxyType({"paper": None, "recordings": ()})
+    if not isinstance(raw, dict):
+        raise InputError(f"{where}: [model_evidence] must be a table")
+    unknown = set(raw) - {"paper", "recordings"}
+    if unknown:
+        raise InputError(f"{where}: model_evidence.{sorted(unknown)[0]}: unknown key (expected paper, recordings)")
+    paper = _text(raw["paper"], f"{where}: model_evidence.paper") if "paper" in raw else None
+    recs = raw.get("recordings", [])
+    if not isinstance(recs, list):
+        raise InputError(f"{where}: model_evidence.recordings: expected a list of {{ path = \"...\" }} tables")
+    base = Path(plant_path).parent if plant_path else None
+    out = []
+    for i, r in enumerate(recs):
+        kw = f"{where}: model_evidence.recordings[{i}]"
+        if not isinstance(r, dict) or "path" not in r:
+            raise InputError(f"{kw}: expected {{ path = \"recording.csv\" }} (optional settings, column_map, note)")
+        bad = set(r) - set(RECORDING_FIELDS)
+        if bad:
+            raise InputError(f"{kw}.{sorted(bad)[0]}: unknown key (expected {', '.join(RECORDING_FIELDS)})")
+        entry = {k: _text(r[k], f"{kw}.{k}") for k in RECORDING_FIELDS if k in r}
+        for k in ("path", "settings"):
+            if k in entry:
+                entry[k] = _resolve(entry[k], base)
+                if not Path(entry[k]).is_file():
+                    raise InputError(f"{kw}.{k}: {entry[k]}: file not found")
+        if "column_map" in entry and Path(_resolve(entry["column_map"], base)).is_file():
+            entry["column_map"] = _resolve(entry["column_map"], base)  # else a shipped column map's name
+        out.append(MappingProxyType(entry))
+    return MappingProxyType({"paper": paper, "recordings": tuple(out)})

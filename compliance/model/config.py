@@ -19,13 +19,13 @@ from compliance.effects import EFFECTS
 from compliance.errors import InputError, did_you_mean
 from compliance.files.atomic import write_text_atomic
 from compliance.files.shipped import resolve_shipped
-from compliance.model.assumptions import read_assumptions
+from compliance.model.assumptions import parse_model_evidence, read_assumptions
 from compliance.model.config_fields import SECTIONS, atmosphere_of, effect_values, load_curve_field, section_values
 from compliance.model.parameters import BASE_BY_KEY, BASE_PARAMS, OPTIONS, used_by_model
 from compliance.model.identity import parse_identity
 from compliance.model.toml_file import read_toml
 
-_TOP_KEYS = {"name", "description", "provenance", "effects", "identity"}
+_TOP_KEYS = {"name", "description", "provenance", "effects", "identity", "model_evidence"}
 
 
 
@@ -67,10 +67,18 @@ class PlantConfig:
     provenance: Mapping[str, str] = field(default_factory=dict)
     identity: Mapping[str, Any] = field(default_factory=dict)  # optional [identity]: site, unit, equipment (model/identity.py)
     assumptions: Mapping[str, Any] = field(default_factory=dict)  # key -> range / derived_for (model/assumptions.py)
+    # optional [model_evidence]: the paper and recordings the model answers to (model/assumptions.py)
+    model_evidence: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({"paper": None, "recordings": ()}))
 
     def p(self, key: str) -> float:
         """SI value of a base parameter."""
         return self.params[key]
+
+    def load_curve_forces(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """The load curve the model applies: (position [m], closing force [N]), the drawn forces x ``load.curve_scale``."""
+        if self.load_curve is None:
+            return None
+        return self.load_curve[0], self.load_curve[1] * self.params.get("load.curve_scale", 1.0)
 
     def option(self, key: str) -> str:
         """Value of an option such as ``friction.model``."""
@@ -194,6 +202,7 @@ def plant_from_dict(data: dict[str, Any], where: str = "<configuration>", digest
         provenance=MappingProxyType({str(k): str(v) for k, v in (data.get("provenance") or {}).items()}),
         identity=parse_identity(data.get("identity"), where),
         assumptions=MappingProxyType(read_assumptions(data, where, params, atmosphere_of(data, where))),
+        model_evidence=parse_model_evidence(data.get("model_evidence"), where, None if where.startswith("<") else where),
     )
     _check_physical(cfg, where)
     return cfg
@@ -276,6 +285,7 @@ def plant_to_toml(cfg: PlantConfig) -> str:
         lines.append("position = { values = [" + ", ".join(_fmt(x) for x in xs) + '], unit = "m" }')
         lines.append("force = { values = [" + ", ".join(_fmt(f) for f in fs) + '], unit = "N" }')
         lines.append("")
+    lines += _model_evidence_toml(cfg)
     for ename, vals in cfg.effects.items():
         eff = EFFECTS[ename]
         lines.append(f"[effects.{ename}]")
@@ -286,6 +296,20 @@ def plant_to_toml(cfg: PlantConfig) -> str:
             lines.append(f'{p.name} = "{_fmt(v)} {p.unit}"' if p.unit else f"{p.name} = {_fmt(v)}")
         lines.append("")
     return "\n".join(lines)
+
+
+def _model_evidence_toml(cfg: PlantConfig) -> list[str]:
+    """The ``[model_evidence]`` table of a saved configuration (recording paths as resolved when it was read)."""
+    ev = cfg.model_evidence or {}
+    if not ev.get("paper") and not ev.get("recordings"):
+        return []
+    lines = ["[model_evidence]"]
+    if ev.get("paper"):
+        lines.append(f"paper = {_toml_str(ev['paper'])}")
+    if ev.get("recordings"):
+        rows = ["{ " + ", ".join(f"{k} = {_toml_str(v)}" for k, v in r.items()) + " }" for r in ev["recordings"]]
+        lines.append("recordings = [" + ", ".join(rows) + "]")
+    return lines + [""]
 
 
 def _toml_str(s: str) -> str:

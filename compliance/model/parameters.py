@@ -34,6 +34,9 @@ BASE_PARAMS: tuple[Param, ...] = (
     _P("air.supply_temperature", "K", "supply air temperature", 293.15, 0.0, 500.0, True, slot="t_supply"),
     _P("air.gas_constant", "J/(kg*K)", "specific gas constant R", 287.0, 0.0, 1e4, True, slot="r_gas"),
     _P("air.heat_capacity_ratio", "", "heat capacity ratio gamma", 1.4, 1.0, 2.0, True, slot="gamma"),
+    # a test condition of the full strokes (simulation.scenario.stroke_start_pressures), not of the core
+    _P("air.stroke_start_charge", "", "pressure of the side that held the servo at its end stop when a full stroke "
+       "starts, as a fraction of the supply above atmosphere (1 = at supply)", 1.0, 0.0, 1.0),
     _P("air.reference_density", "kg/m^3", "density at the conductance rating conditions (NTP)", 1.204, 0.0, 10.0, True, slot="rho0"),
     _P("air.reference_temperature", "K", "temperature at the conductance rating conditions (NTP)", 293.15, 0.0, 500.0, True, slot="t0"),
     _P("valve.sonic_conductance", "m^3/(s*Pa)", "ISO 6358 sonic conductance C of each port path", None, 0.0, 1e-4, True, fit_bounds=(5e-9, 8e-8), slot="conductance"),
@@ -63,6 +66,8 @@ BASE_PARAMS: tuple[Param, ...] = (
     _P("end_stop.stiffness", "N/m", "end-stop contact stiffness", 1e8, 0.0, 1e12, True, slot="k_stop"),
     _P("end_stop.damping", "N*s/m", "end-stop contact damping", 5e4, 0.0, 1e10, slot="c_stop"),
     _P("load.nominal_force", "N", "nominal closing load F_Cn", 0.0, -1e7, 1e7),
+    # the load curve's forces as the model applies them: drawn forces x this factor (PlantConfig.load_curve_forces)
+    _P("load.curve_scale", "", "factor on every force of the load curve [load.curve] (1 = as drawn)", 1.0, 0.0, 10.0),
     _P("controller.kp", "V/m", "proportional gain K_P", 0.0, 0.0, 1e7, slot="kp"),
     _P("controller.ki", "V/(m*s)", "integral gain K_I", 0.0, 0.0, 1e7, slot="ki"),
     _P("controller.kd", "V*s/m", "derivative gain K_D", 0.0, 0.0, 1e7, slot="kd"),

@@ -89,4 +89,5 @@ def load_curve_arrays(cfg: PlantConfig) -> tuple[np.ndarray, np.ndarray]:
     """Load-curve arrays for the core (a flat zero curve when none is configured)."""
     if cfg.load_curve is None:
         return np.array([0.0, 1.0]), np.array([0.0, 0.0])
-    return np.ascontiguousarray(cfg.load_curve[0], dtype=float), np.ascontiguousarray(cfg.load_curve[1], dtype=float)
+    xs, fs = cfg.load_curve_forces()
+    return np.ascontiguousarray(xs, dtype=float), np.ascontiguousarray(fs, dtype=float)

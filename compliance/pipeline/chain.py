@@ -12,8 +12,12 @@ report read:
    (``campaign.judge``);
 4. :func:`bands`: each verdict's range over the plant file's declared parameter ranges, by local
    sensitivities or a Monte Carlo (``campaign.uncertainty``, ``sweep.tolerance.uncertainty_mc``);
-5. :func:`linear_analysis`: the linear analysis at every operating point (``linear.operating_points``);
-6. :func:`remedy_search`: what would make it pass (``sweep.check_remedies``).
+5. :func:`evidence`: the model's agreement with the measurements its plant file names, and the
+   verdicts they contradict (``model_evidence``);
+6. :func:`linear_analysis`: the linear analysis at every operating point (``linear.operating_points``);
+7. :func:`stability`: the loop's stability margins against govcheck's criterion at every operating
+   point, reusing the linear analyses when made (``linear.stability``);
+8. :func:`remedy_search`: what would make it pass (``sweep.check_remedies``).
 """
 
 from __future__ import annotations
@@ -23,7 +27,8 @@ from dataclasses import dataclass
 from compliance.errors import InputError
 from compliance.results.check_result import CheckResult
 
-__all__ = ["Check", "bands", "campaign", "check", "judgement", "linear_analysis", "remedy_search", "vet"]
+__all__ = ["Check", "bands", "campaign", "check", "evidence", "judgement", "linear_analysis", "remedy_search", "stability",
+           "vet"]
 
 
 def _plant(plant):
@@ -105,15 +110,32 @@ def bands(cfg, reqset, runs, entries: list[dict], uncertainty="local", *, jobs=N
     return monte_carlo_bands(cfg, reqset, entries, uncertainty, workers=jobs, progress=progress)
 
 
+def evidence(cfg, result: CheckResult):
+    """Step 5: the model's evidence (``results.evidence.ModelEvidence``) on the result's final verdicts."""
+    from compliance.model_evidence import model_evidence
+
+    return model_evidence(cfg, result)
+
+
 def linear_analysis(cfg, reqset, *, jobs: int | None = None) -> dict:
-    """Step 5: the linear analysis at every operating point, the map, the cross-check and HYGOV."""
+    """Step 6: the linear analysis at every operating point, the map, the cross-check and HYGOV."""
     from compliance.linear.operating_points import linear_for_campaign
 
     return linear_for_campaign(cfg, reqset, workers=jobs)
 
 
+def stability(cfg, reqset, linear: dict | None = None, *, jobs: int | None = None):
+    """Step 7: the loop's margins at every operating point against govcheck's criterion
+    (``results.evidence.StabilitySection``); ``linear``'s analyses are reused when given."""
+    from compliance.linear.stability import stability_margins
+    from compliance.results.evidence import StabilitySection
+
+    section = stability_margins(cfg, reqset, analyses=(linear or {}).get("analyses"), workers=jobs)
+    return StabilitySection.from_dict(section, "results.stability")
+
+
 def remedy_search(cfg, reqset, space="default", *, jobs=None, scheduler=None, progress=False, **options) -> dict:
-    """Step 6: what would make it pass over ``space`` ("default" on-site settings, or a sweep file)."""
+    """Step 8: what would make it pass over ``space`` ("default" on-site settings, or a sweep file)."""
     from compliance.sweep.check_remedies import remedies_for_check
 
     options.setdefault("scheduler", scheduler)
@@ -144,6 +166,9 @@ class Check:
         check_remedies(remedies)
         cfg, reqset = _plant(plant), _requirements(requirements)
         check_uncertainty(uncertainty, cfg)
+        from compliance.model_evidence import check_sources
+
+        check_sources(cfg)  # a [model_evidence] source govcheck cannot compare
         space = None if not remedies else "default" if remedies is True else remedies
         return cls(cfg, reqset, vet(cfg, reqset, allow_conflicts), bool(linear), space, uncertainty)
 
@@ -158,9 +183,11 @@ class Check:
         section = bands(cfg, reqset, runs, entries, self.uncertainty, jobs=jobs, progress=progress)
         result = CheckResult.of(assemble(cfg, reqset, runs, entries, notes, self.vetting, section, command_line))
         _stage(on_stage, "campaign")
-        if self.linear:
-            result = result.with_(linear=linear_analysis(cfg, reqset, jobs=jobs))
-            _stage(on_stage, "linear analysis")
+        result = result.with_(model_evidence=evidence(cfg, result))
+        _stage(on_stage, "model evidence")
+        lin = linear_analysis(cfg, reqset, jobs=jobs) if self.linear else None
+        result = result.with_(linear=lin, stability=stability(cfg, reqset, lin, jobs=jobs))
+        _stage(on_stage, "linear analysis" if self.linear else "stability")
         if self.remedies:
             options = {"scheduler": scheduler, **(remedy_options or {})}  # the search's own scheduler, if given, wins
             rem = remedy_search(cfg, reqset, self.remedies, jobs=jobs, progress=progress, **options)
@@ -198,7 +225,8 @@ def check(plant, requirements, *, linear: bool = False, remedies=None, uncertain
     remedy_options : dict, optional
         Further keywords of the remedies search (``catalogue``, ``yield_units``, ``store``, ``iterations``, ...).
     on_stage : callable, optional
-        ``on_stage(name)`` as each stage ends ("campaign", "linear analysis", "remedies").
+        ``on_stage(name)`` as each stage ends ("campaign" with the bands, "model evidence", "linear analysis"
+        with the stability margins or, without it, "stability", "remedies").
 
     Returns
     -------

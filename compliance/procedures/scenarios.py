@@ -8,6 +8,8 @@ closed-loop run adds (peak speeds, valve saturation). No physics here: the plant
 
 from __future__ import annotations
 
+from collections import OrderedDict
+
 import numpy as np
 
 from compliance import metrics as M
@@ -100,11 +102,34 @@ def full_command_stroke(cfg, op, direction, command, duration, flow_control, sta
 
     u_open, u_close = full_command(cfg, command)
     x0, u = (0.0, u_open) if direction == "opening" else (stroke(cfg), u_close)
+    load = scenario_load(cfg, op)
+    key = (_plant_key(cfg), load, direction, u, duration, flow_control, start)
+    if key in _STROKES:  # the steps procedures at one operating point ask for the same strokes
+        _STROKES.move_to_end(key)
+        return _STROKES[key]
     if cfg.setpoint_rate_limited:  # the governor's rate limiter is the limiting device: stroke through the governor
-        return simulate_run(cfg, duration, x0, reference=Profile.constant(stroke(cfg) - x0), load=scenario_load(cfg, op),
-                            flow_control=flow_control, pressures=stroke_start_pressures(cfg, direction, start))
-    return simulate_run(cfg, duration, x0, command=Profile.constant(u), load=scenario_load(cfg, op), flow_control=flow_control,
-                        pressures=stroke_start_pressures(cfg, direction, start))
+        df = simulate_run(cfg, duration, x0, reference=Profile.constant(stroke(cfg) - x0), load=load,
+                          flow_control=flow_control, pressures=stroke_start_pressures(cfg, direction, start))
+    else:
+        df = simulate_run(cfg, duration, x0, command=Profile.constant(u), load=load, flow_control=flow_control,
+                          pressures=stroke_start_pressures(cfg, direction, start))
+    _STROKES[key] = df
+    if len(_STROKES) > _STROKES_KEPT:
+        _STROKES.popitem(last=False)
+    return df
+
+
+# full-command strokes already simulated in this process (the callers only read them): every steps procedure
+# at an operating point checks the same full-command speeds, and a perturbed plant repeats them per step size
+_STROKES: OrderedDict = OrderedDict()
+_STROKES_KEPT = 24
+
+
+def _plant_key(cfg) -> tuple:
+    """Everything of a configuration a simulation reads, hashable (a configuration is frozen but holds mappings)."""
+    curve = None if cfg.load_curve is None else (cfg.load_curve[0].tobytes(), cfg.load_curve[1].tobytes())
+    return (tuple(cfg.params.items()), tuple(cfg.options.items()), curve,
+            tuple((k, tuple(v.items())) for k, v in cfg.effects.items()))
 
 
 def swing(cfg, proc, op) -> tuple[float, float]:

@@ -10,10 +10,11 @@ those sections from the check's result alone (no simulation here); the template 
 
 from __future__ import annotations
 
+from compliance.linear.stability import MARGIN_CRITERION as _MARGIN_CRITERION
 from compliance.metrics import METRICS
 from compliance.metrics.catalogue import STEP_OPTION_DEFAULTS
 from compliance.presentation.quantities import fmt_quantity
-from compliance.presentation.values import limit_as_written, metric_text
+from compliance.presentation.values import limit_as_written, verdict_texts
 from compliance.requirements.verdict import Status
 from compliance.results.check_result import CheckResult
 from compliance.presentation.numbers import fmt_value, unit_text
@@ -41,10 +42,8 @@ SMALL_HYDRO = ("IEC 62006:2010, Hydraulic machines \u2013 Acceptance tests of sm
                "acceptance-test code for units of this size; its governor and load-rejection tests need the installed "
                "unit and are not covered here.")
 
-# Stability criterion of the linear section: our own choice, from common control practice (phase margin
-# 30-60 deg and gain margin 6-12 dB are the usual lower ends); no governor standard gives one for a
-# servo-positioner loop.
-MARGIN_CRITERION = {"phase_margin_deg": 30.0, "gain_margin_db": 6.0}
+# Stability criterion of the linear section and page 1: our own choice (compliance.linear.stability)
+MARGIN_CRITERION = _MARGIN_CRITERION
 
 
 def standards_cited(result: CheckResult) -> list[str]:
@@ -217,7 +216,7 @@ def conclusions(result: CheckResult) -> list[dict]:
         if e.status not in (Status.FAIL, Status.UNCERTAIN, Status.NOT_EVALUATED, Status.OPEN):
             continue
         w = e.worst
-        value = metric_text(w.value, e.metric) if w is not None else "\u2013"
+        value = verdict_texts(e)["value"]
         if e.status == Status.OPEN:
             finding = f"no limit set; value found {value}"
         elif e.status == Status.NOT_EVALUATED:
@@ -234,3 +233,43 @@ def parties(identity) -> list[dict]:
             {"role": "Supplier of the servo-positioner", "name": identity.get("supplier")},
             {"role": "Prepared by (test engineer)", "name": identity.get("author")},
             {"role": "Witness", "name": identity.get("witness")}]
+
+
+# --------------------------------------------------------------------------- 6. model validation
+def _figure_cells(f) -> dict:
+    """One measured figure of a paper beside the model's (a ``ComparedFigure``), with its agreement in words."""
+    if f.agreement is None:
+        word, css = "no measured figure", "neutral"
+    elif f.by_construction:
+        word, css = "by construction", "neutral"
+    elif not f.independent:
+        word, css = f"{f.agreement} (fitted to it)", "neutral"
+    else:
+        word, css = f.agreement, Status.PASS if f.agreement == "agrees" else Status.FAIL  # the row colour of its word
+    return {"test": f.test, "metric": f.metric, "modelled": f.display.modelled, "measured": f.display.measured,
+            "agreement": word, "css": css}
+
+
+def _replays(modes) -> str:
+    """A recording's replays in words: every window within its limits, or how many are not."""
+    return "; ".join(f"{m.replace('_', ' ')}: " + ("every window within its limits" if d["pass"] else
+                                                   f"{len(d['failed_windows'])} of {d['windows']} windows outside their limits")
+                     for m, d in modes.items())
+
+
+def evidence_sections(result: CheckResult) -> tuple[list[dict], list]:
+    """Section 6's tables: each source of the model evidence with its figures, and the judged verdicts that rest on
+    contradicted figures (``ContradictedVerdict`` records)."""
+    ev = result.model_evidence
+    if ev is None:
+        return [], []
+    out = []
+    for s in ev.sources:
+        if s.kind == "paper":
+            out.append({"kind": "paper", "title": "Measured figures of the plant paper", "command": s.command,
+                        "independence": (s.independence or "").capitalize(), "rows": [_figure_cells(f) for f in s.figures]})
+        else:
+            out.append({"kind": "recording", "title": f"Recording {s.path}", "command": s.command,
+                        "independence": "A recording of the servo, replayed with the model", "summary": _replays(s.modes)})
+    judged = {e.id for e in result.requirements if e.status not in (Status.OPEN, Status.DISABLED)}
+    return out, [c for c in ev.contradicted if c.requirement in judged]

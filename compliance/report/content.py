@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import hashlib
 
-from compliance.presentation.values import limit_as_written, metric_text, row_texts
+from compliance.presentation.values import band_pct_text, limit_as_written, metric_text, row_texts, verdict_texts
 from compliance.report.requirement_pages import TOLERANCE_METRICS, reader_text
 from compliance.requirements.verdict import Basis, Overall, Status
 from compliance.results.check_result import CheckResult
@@ -74,7 +74,7 @@ def summary_rows(result: CheckResult) -> list[dict]:
     run_ids = {r.id for r in result.runs}
     for e in result.requirements:
         w = e.worst
-        d = row_texts(w.as_dict(), e.metric) if w is not None else _NO_TEXTS
+        d = verdict_texts(e) if w is not None else _NO_TEXTS
         reason = "; ".join(e.not_evaluated_reasons()) or "not evaluated" if e.status == Status.NOT_EVALUATED else None
         where = (w.run or f"{w.procedure}@{w.operating_point}") if w is not None else None
         out.append({
@@ -88,6 +88,7 @@ def summary_rows(result: CheckResult) -> list[dict]:
             "basis": BASIS_WORDS.get(e.basis, str(e.basis).replace("_", " ")) if e.basis else None,
             "basis_key": e.basis, "basis_reason": w and w.basis_reason,
             "band": band_text(e.band, e.metric), "band_pct": e.band, "coverage": e.coverage,
+            "band_margins": band_pct_text(e.band, w.margin_pct if w is not None else None, unicode=True),
         })
     return out
 

@@ -172,6 +172,17 @@ def body_pages(path) -> dict:
     return {"body": body, "appendix": len(texts) - body, "total": len(texts)}
 
 
+def sign_off_fits(path) -> bool:
+    """Whether a compliance report's sign-off page (page 1, ending with the signature blocks) fits one page."""
+    import pdfplumber
+
+    with pdfplumber.open(str(path)) as pdf:
+        if len(pdf.pages) < 2:
+            return True
+        first, second = (pdf.pages[i].extract_text() or "" for i in (0, 1))
+    return "Accepted for the plant owner" in first and "Accepted for the plant owner" not in second
+
+
 def _overprints(chars: list) -> list[str]:
     """Pairs of characters on different text lines or far apart in one line that overlap."""
     grid: dict = {}

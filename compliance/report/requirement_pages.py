@@ -12,9 +12,9 @@ from __future__ import annotations
 import re
 
 from compliance.metrics import METRICS
-from compliance.presentation.values import limit_as_written, metric_text
+from compliance.presentation.values import limit_as_written, metric_text, row_texts, verdict_texts
 from compliance.requirements.verdict import Status
-from compliance.presentation.numbers import fmt_margin_pct, fmt_value
+from compliance.presentation.numbers import fmt_value
 
 TOLERANCE_METRICS = ("max_positioning_error", "tracking_max_error", "steady_state_error")
 SPEED_METRICS = ("max_speed", "max_opening_speed", "max_closing_speed")
@@ -71,9 +71,10 @@ def _row_cells(e, r) -> dict:
         steps.append({"text": txt, "excluded": not s.eligible or s.value is None})
         cannot.append(facts.get("cannot_fail"))
     cannot_fail = bool(cannot) and all(c is True for c in cannot)
-    margin = None if r.margin is None else metric_text(r.margin, metric)
-    return {"req": e.id, "procedure": r.procedure, "ops": [r.operating_point], "value": metric_text(r.value, metric),
-            "which": r.which, "margin": margin, "margin_pct": fmt_margin_pct(r.margin_pct),
+    texts = row_texts(r, metric)
+    margin = None if r.margin is None else texts["margin"]
+    return {"req": e.id, "procedure": r.procedure, "ops": [r.operating_point], "value": texts["value"],
+            "which": r.which, "margin": margin, "margin_pct": texts["margin_pct"],
             "status": r.status, "reason": str(r.reason).split(":")[0] if r.reason else None,
             "raw": r.value, "raw_margin": r.margin, "metric": metric, "steps": steps, "cannot_fail": cannot_fail,
             "run": r.run}
@@ -102,9 +103,10 @@ def _grouped(rows: list[dict]) -> list[dict]:
                            "excluded": True}] + g["steps"]
             continue
         worst = min(ms, key=lambda c: c["raw_margin"] if c["raw_margin"] is not None else float("inf"))
-        vals = [c["raw"] for c in ms if isinstance(c["raw"], (int, float))]
-        if vals and min(vals) != max(vals):
-            lo, hi = metric_text(min(vals), g["metric"]), metric_text(max(vals), g["metric"])
+        vals = [c for c in ms if isinstance(c["raw"], (int, float))]
+        if vals and min(c["raw"] for c in vals) != max(c["raw"] for c in vals):
+            # each end as its own row prints it (the one formatter's digits: a failing value never reads as its limit)
+            lo, hi = min(vals, key=lambda c: c["raw"])["value"], max(vals, key=lambda c: c["raw"])["value"]
             g["value"] = lo if lo == hi else f"{lo.rsplit(' ', 1)[0]}\u2013{hi}"
         g.update(margin=worst["margin"], margin_pct=worst["margin_pct"], which=worst["which"], run=worst["run"])
         per_point = " \u00b7 ".join(f"{c['ops'][0]} {c['value']}" for c in ms)
@@ -203,13 +205,12 @@ _RANK = {Status.FAIL: 0, Status.NOT_EVALUATED: 1, Status.OPEN: 2, Status.PASS: 3
 def _page_requirement(e) -> dict:
     """A requirement on its page: what it rests on, its worst value against its limit, its grouped cases."""
     cases = _grouped([_row_cells(e, r) for r in e.rows])
-    w = e.worst
+    texts = verdict_texts(e)
     info = METRICS.get(e.metric)
     return {"id": e.id, "title": e.title, "status": e.status, "severity": e.severity, "metric": e.metric,
             "meaning": info.meaning if info else "", "standard": e.standard, "clause": reader_text(e.clause),
             "note": reader_text(e.note), "limit": limit_as_written(e),
-            "value": metric_text(w.value, e.metric) if w is not None else "\u2013",
-            "margin_pct": fmt_margin_pct(w.margin_pct if w is not None else None), "cases": cases,
+            "value": texts["value"], "margin_pct": texts["margin_pct"], "cases": cases,
             "cannot_fail": sum(1 for c in cases if c["cannot_fail"]),
             "not_evaluated": sum(len(c["ops"]) for c in cases if c["status"] == Status.NOT_EVALUATED)}
 

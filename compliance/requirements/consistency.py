@@ -105,7 +105,8 @@ def _time_vs_speed(reqset, stroke, t_req, v_req) -> list[dict]:
             out.append(_finding(CONFLICT, t_req, v_req, p, who + f" cannot both pass: the window ends at {hi:.3g} s" + why))
         elif lo is not None and lo < t_min:
             admit = f"{t_min:.3g} s .. {hi:.3g} s" if hi is not None else f">= {t_min:.3g} s"
-            out.append(_finding(NARROWING, t_req, v_req, p, who + f" together admit only {admit}" + why))
+            out.append(_finding(NARROWING, t_req, v_req, p, who + f" together admit only {admit}" + why,
+                                t_min=t_min, t_max=hi, v_max=v))
     return out
 
 

@@ -6,11 +6,14 @@
 ``govcheck-results/1``) is written by ``as_dict``/``to_json`` and read by ``from_json``, the edge. A site's
 measured verdicts (``govcheck accept``, ``govcheck-site/1``) read into a ``SiteResult`` with the same verdicts;
 the linear, validation and remedies sections a result carries read into records of their own
-(``results.linear``, ``results.validation``, ``results.remedies``).
+(``results.linear``, ``results.validation``, ``results.remedies``); the model's evidence and the
+loop's stability margins are records of the result (``results.evidence``).
 """
 
 from compliance.results.check_result import RESULTS_SCHEMA, CheckResult, Coverage
 from compliance.results.entries import EntryCoverage, RequirementVerdict
+from compliance.results.evidence import (ComparedFigure, ContradictedVerdict, EvidenceSource, ModelEvidence, StabilityPoint,
+                                         StabilitySection)
 from compliance.results.keys import RequestKey
 from compliance.results.plant import EffectRecord, LoadCurve, ParameterRecord, PlantRecord
 from compliance.results.requirement_set import (OperatingPointRecord, ProcedureRecord, RequirementSetRecord,
@@ -20,9 +23,9 @@ from compliance.results.runs import Finding, Mark, RunRecord, Timing, Trace, Unj
 from compliance.results.site_result import SITE_SCHEMA, SiteResult, typed_results
 from compliance.results.summary import Counts, Qualifier, Summary
 
-__all__ = ["RESULTS_SCHEMA", "SITE_SCHEMA", "Band", "CheckResult", "Counts", "Coverage", "EffectRecord", "EntryCoverage",
-           "Finding", "LoadCurve", "Mark", "OperatingPointRecord", "ParameterRecord", "PlantRecord", "ProcedureRecord",
-           "Qualifier",
+__all__ = ["RESULTS_SCHEMA", "SITE_SCHEMA", "Band", "CheckResult", "ComparedFigure", "ContradictedVerdict", "Counts",
+           "Coverage", "EffectRecord", "EntryCoverage", "EvidenceSource", "Finding", "LoadCurve", "Mark",
+           "ModelEvidence", "OperatingPointRecord", "ParameterRecord", "PlantRecord", "ProcedureRecord", "Qualifier",
            "RequestKey", "RequirementSetRecord", "RequirementSpec", "RequirementVerdict", "RowTexts", "RunRecord",
-           "SampleRecord", "SiteResult", "Summary", "Timing", "Trace", "Unjudged", "VerdictRow", "WorstCase",
-           "typed_results"]
+           "SampleRecord", "SiteResult", "StabilityPoint", "StabilitySection", "Summary", "Timing", "Trace",
+           "Unjudged", "VerdictRow", "WorstCase", "typed_results"]

@@ -15,6 +15,7 @@ from pathlib import Path
 from compliance.errors import InputError
 from compliance.requirements.verdict import Overall, Status
 from compliance.results.entries import RequirementVerdict
+from compliance.results.evidence import ModelEvidence, StabilitySection
 from compliance.results.numbers import check_numbers
 from compliance.results.plant import PlantRecord
 from compliance.results.record import FrozenDict, Record, freeze, key, need, records
@@ -52,6 +53,10 @@ class CheckResult(Record):
         One verdict per requirement, in file order, each with its rows (SI values and limits).
     runs : tuple of RunRecord
         Every simulation run with its values, traces and marks.
+    model_evidence : ModelEvidence or None
+        The model's agreement with the measurements its plant file names, and the verdicts they contradict.
+    stability : StabilitySection or None
+        The linearised loop's margins at every operating point against govcheck's criterion.
     linear, remedies, uncertainty, ... : FrozenDict or None
         Sections kept as their steps wrote them.
     """
@@ -65,6 +70,8 @@ class CheckResult(Record):
     summary: Summary = key(read=Summary.from_dict)
     coverage: Coverage = key(factory=Coverage, read=Coverage.from_dict)
     findings: tuple[Finding, ...] = key(default=(), read=records(Finding))
+    model_evidence: ModelEvidence | None = key(omit_none=True, default=None, read=ModelEvidence.from_dict)
+    stability: StabilitySection | None = key(omit_none=True, default=None, read=StabilitySection.from_dict)
     uncertainty: FrozenDict | None = key(default=None, read=_section)
     requirements: tuple[RequirementVerdict, ...] = key(read=records(RequirementVerdict))
     runs: tuple[RunRecord, ...] = key(default=(), read=records(RunRecord))

@@ -103,6 +103,11 @@ class Finding(Record):
         """The SI figures of the finding's arithmetic."""
         return self.extra
 
+    def figure(self, name: str) -> float | None:
+        """One SI figure of the arithmetic (``t_min``, ``t_max``, ``v_max``, ``step``, ``tau_max``, ``mean_speed``),
+        None when this kind of finding has none."""
+        return self.extra.get(name)
+
 
 @dataclass(frozen=True, kw_only=True)
 class Timing(Record):

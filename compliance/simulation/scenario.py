@@ -89,11 +89,13 @@ def stroke_start_pressures(cfg, direction: str, start: str = "end_stop"):
     """Initial chamber pressures (p_A, p_B) [Pa] of a full stroke, or None for the rest state.
 
     ``"end_stop"``: the servo sits at the end it starts from, held there by the side that drove it
-    (at supply); the side about to drive is exhausted to atmosphere (A drives opening, B closing).
+    (at ``air.stroke_start_charge`` of the supply above atmosphere; 1 = at supply, as the previous
+    stroke left it); the side about to drive is exhausted to atmosphere (A drives opening, B closing).
     ``"rest"``: None (the simulator's rest state balancing the load, mean (p_s + p_atm)/2).
     """
     if start == "rest":
         return None
     ps, patm = cfg.p("air.supply_pressure"), cfg.p("air.atmospheric_pressure")
     exhausted = 1.001 * patm  # just above atmosphere: an exhausted chamber still holds its residual air
-    return (exhausted, ps) if direction == "opening" else (ps, exhausted)
+    held = max(exhausted, patm + cfg.p("air.stroke_start_charge") * (ps - patm))  # 1: at supply, as the stroke left it
+    return (exhausted, held) if direction == "opening" else (held, exhausted)

@@ -189,7 +189,7 @@ def compute_regimes(recording: pd.DataFrame, cfg: PlantConfig, load: float | str
     n_fr = 2.0 if cfg.options["cylinder.arrangement"] == "tandem" else 1.0  # friction parameters are per cylinder
     f_static = n_fr * cfg.p("friction.static_force")
     if load == "curve" and cfg.load_curve is not None:
-        f_load = np.interp(x, cfg.load_curve[0], cfg.load_curve[1])
+        f_load = np.interp(x, *cfg.load_curve_forces())
     elif isinstance(load, (int, float)) and math.isfinite(load):
         f_load = np.full(t.shape, float(load))
     else:

@@ -6,7 +6,7 @@
 
 Each example is made by the documented govcheck command (printed before it runs). Afterwards
 every HTML and PDF example is checked for text outside its figure or page and for overprinting
-(compliance.report.layout_check; the plant-A body at most 25 pages), for names of the code base, "seed" and references to missing
+(compliance.report.layout_check; the plant-A body at most 25 pages, the sign-off on page 1), for names of the code base, "seed" and references to missing
 sections (compliance.report.text_check), and every file an example points at must exist.
 Exit 0 when all is made and clean, 1 when a check fails, 2 when a command fails.
 """
@@ -68,7 +68,7 @@ def _pointers_missing() -> list[str]:
 def check() -> list[str]:
     """Layout and text problems of every example, and missing pointers."""
     sys.path.insert(0, str(ROOT))
-    from compliance.report.layout_check import BODY_PAGES_MAX, body_pages, html_problems, pdf_problems
+    from compliance.report.layout_check import BODY_PAGES_MAX, body_pages, html_problems, pdf_problems, sign_off_fits
     from compliance.report.text_check import html_text, repository_names, text_problems
 
     names = repository_names(ROOT)
@@ -88,6 +88,9 @@ def check() -> list[str]:
     plant_a = ROOT / OUT / "plant-a-shpp-400kw.pdf"
     if plant_a.exists() and body_pages(plant_a)["body"] > BODY_PAGES_MAX:
         problems.append(f"{plant_a.name}: the body has {body_pages(plant_a)['body']} pages, more than {BODY_PAGES_MAX}")
+    for pdf in (ROOT / OUT / "plant-a-shpp-400kw.pdf", ROOT / OUT / "plant-b-tracking-robot.pdf"):
+        if pdf.exists() and not sign_off_fits(pdf):
+            problems.append(f"{pdf.name}: the sign-off page runs onto page 2")
     return problems + _pointers_missing()
 
 

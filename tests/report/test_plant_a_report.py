@@ -65,3 +65,35 @@ def test_plant_a_page_one_counts_cases_as_the_json_and_prints_clean(plant_a):
     assert f"{cov['evaluated']} of {cov['rows']} judged test cases evaluated, {cov['not_evaluated']} NOT EVALUATED" in p1
     assert cov["rows"] == cov["evaluated"] + cov["not_evaluated"] and cov["basis"].split(";")[0][:30] in p1
     assert pdf_problems(pdf) == []
+
+
+@pytest.mark.slow
+def test_plant_a_results_carry_the_model_evidence_and_page_one_says_it(plant_a):
+    pdf, pages, res = plant_a
+    ev = res["model_evidence"]
+    assert ev["status"] == "contradicted" and ev["compared"] == 16 and ev["contradict"] >= 10
+    p1 = " ".join(pages[0].split())
+    assert "Model validation: CONTRADICTED" in p1 and "Verdicts resting on figures the measurements contradict" in p1
+    not_met = [e["id"] for e in res["requirements"] if e["severity"] == "mandatory"
+               and e["status"] in ("fail", "uncertain", "not_evaluated")]
+    assert not_met and all(rid in p1 for rid in not_met)
+    # with --linear the margins are the linear analyses' own, one per distinct operating point
+    pm = [p["phase_margin_deg"] for p in res["stability"]["points"] if p["phase_margin_deg"] is not None]
+    assert pm and f"phase margin {min(pm):.0f}–{max(pm):.0f}°" in p1 and "Requirement set:" in p1
+    assert "Accepted for the plant owner" in p1 and "Contents" in pages[1]  # page 1 fits one page
+
+
+@pytest.mark.slow
+def test_plant_a_every_row_has_a_band_and_no_failure_prints_as_its_limit(plant_a):
+    _, _, res = plant_a
+    rows = [(e, r) for e in res["requirements"] if e["source"] == "simulation" for r in e["rows"]
+            if r.get("value") is not None]
+    assert len(rows) > 80 and all(r.get("band") for _, r in rows)
+    for e, r in rows:
+        b = r["band"]
+        assert b["low"] <= r["value"] <= b["high"], (e["id"], r["run"])
+        if r.get("margin_pct") is not None and b["margin_low_pct"] is not None:
+            assert b["margin_low_pct"] <= r["margin_pct"] <= b["margin_high_pct"], (e["id"], r["run"])
+        if r["status"] == "fail":
+            shown, limit = r["display"]["value"], r["display"]["limit"]
+            assert shown not in limit.split(" .. "), (e["id"], r["run"], shown, limit)

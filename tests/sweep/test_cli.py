@@ -61,7 +61,7 @@ def test_summary_text_reads_as_a_document(swept):
     for p in s["parameters"]:  # each parameter's value printed with its unit
         assert f"| {p['path']} |" in md
     assert "V/m" in md  # controller.kp in V/m, typeset
-    named = re.findall(r"[\w.-]+\.(?:json|csv|parquet|md|html)(?:\.gz)?\b", md)  # best-results.json.gz
+    named = re.findall(r"[\w.-]+\.(?:json(?:\.gz)?|csv|parquet|md|html)\b", md)
     assert named and all((out / n).exists() for n in named), named
     heads = [line.lstrip("# ") for line in md.splitlines() if line.startswith("#")]
     assert text_problems(md, heads, repo_names=repository_names(Path(__file__).resolve().parents[2])) == []

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from compliance.campaign.uncertainty import _targets, apply_band, ranged_parameters, top_assumptions
+from compliance.campaign.uncertainty import apply_band, modelled_verdicts, ranged_parameters, top_assumptions
 from compliance.sweep.candidates.evaluate import judged, make_context
 from compliance.model.parameters import param_handle
 from compliance.sweep.candidates.runner import run_candidates
@@ -62,7 +62,7 @@ def monte_carlo_bands(cfg, reqset, entries: list[dict], n: int, *, seed: int = 0
     ctx = make_context(cfg, reqset, paths)
     rows, _ = run_candidates(ctx, cands, workers=workers, progress=progress, label="uncertainty")
     ok = [(c, r) for c, r in zip(cands, rows) if judged(r)]
-    for e in _targets(entries):
+    for e in modelled_verdicts(entries):
         got = [(c, r["requirements"][e["id"]]["value"]) for c, r in ok
                if r["requirements"].get(e["id"], {}).get("value") is not None]
         if len(got) < 2:
