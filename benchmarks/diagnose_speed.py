@@ -21,6 +21,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import resource
 import subprocess
 import sys
 import tempfile
@@ -59,19 +60,24 @@ def _recordings(tmp: Path, practice: Path | None) -> list[Path]:
     return out
 
 
-def _diagnose(code: Path, rec: Path, out: Path, jobs: int) -> tuple[float, dict]:
-    """Wall time of one cold ``diagnose`` process running the package in ``code``, and its JSON."""
+def _diagnose(code: Path, rec: Path, out: Path, jobs: int) -> tuple[float, dict, float]:
+    """Wall time of one cold ``diagnose`` process running the package in ``code``, its JSON, and the CPU time of
+    the process and its workers [s] (on a shared machine the wall time follows the others' load; the CPU time
+    much less)."""
     if out.exists():
         out.unlink()
     env = dict(ENV, PYTHONPATH=str(code))
     env.pop("NUMBA_CACHE_DIR", None)  # each side its own cache, keyed by its own compiled sources
     cmd = [sys.executable, "-m", "compliance", "diagnose", str(rec), "--json", str(out), "--jobs", str(jobs), "--quiet"]
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     p = subprocess.run(cmd, cwd=code, capture_output=True, text=True, check=False, env=env)
     wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if p.returncode != 0:
         raise SystemExit(f"diagnose failed ({p.returncode}) in {code} on {rec}: {p.stderr[-2000:]}")
-    return wall, json.loads(out.read_text())
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return wall, json.loads(out.read_text()), cpu
 
 
 def _duration(rec: Path) -> float:
@@ -114,26 +120,30 @@ def main() -> None:
             for rec in recs:
                 row = {"name": rec.name, "seconds": _duration(rec)}
                 for name, code in sides.items():
-                    wall, data = _diagnose(code, rec, tmp / f"{name}.json", args.jobs)
-                    row[name] = (wall, data["timing"]["simulations"], data["verdict"], data["winner"])
+                    wall, data, cpu = _diagnose(code, rec, tmp / f"{name}.json", args.jobs)
+                    row[name] = (wall, data["timing"]["simulations"], data["verdict"], data["winner"], cpu)
                 rows.append(row)
         finally:
             if "previous" in sides:
                 subprocess.run(["git", "worktree", "remove", "--force", str(sides["previous"])], cwd=ROOT, check=False)
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     print(f"govcheck diagnose, full library, --jobs {args.jobs} (load average at the end {load:.1f}):")
-    print(f"{'recording':52s} {'length [s]':>10s} {'wall [s]':>9s} {'per 30 s':>9s} {'simulations':>12s} "
-          f"{'previous [s]':>13s} {'ratio':>6s}  verdict")
+    print(f"{'recording':52s} {'length [s]':>10s} {'wall [s]':>9s} {'per 30 s':>9s} {'CPU [s]':>8s} {'simulations':>12s} "
+          f"{'previous [s]':>13s} {'CPU [s]':>8s} {'sims':>5s} {'ratio':>6s}  verdict")
     for r in rows:
-        wall, sims, verdict, winner = r["this"]
+        wall, sims, verdict, winner, cpu = r["this"]
         prev = r.get("previous")
-        extra = f"{prev[0]:13.1f} {prev[0] / wall:6.2f}" if prev else f"{'-':>13s} {'-':>6s}"
-        print(f"{r['name']:52s} {r['seconds']:10.1f} {wall:9.1f} {_per30(wall, r):9.1f} {sims:12d} {extra}  "
-              f"{verdict} {winner or ''}")
+        extra = f"{prev[0]:13.1f} {prev[4]:8.1f} {prev[1]:5d} {prev[0] / wall:6.2f}" if prev else f"{'-':>13s} {'-':>8s} {'-':>5s} {'-':>6s}"
+        same = "" if not prev or (prev[2], prev[3]) == (verdict, winner) else f"  (previous: {prev[2]} {prev[3] or ''})"
+        print(f"{r['name']:52s} {r['seconds']:10.1f} {wall:9.1f} {_per30(wall, r):9.1f} {cpu:8.1f} {sims:12d} {extra}  "
+              f"{verdict} {winner or ''}{same}")
     worst = max(_per30(r["this"][0], r) for r in rows)
     if "previous" in rows[0]:
         total = sum(r["previous"][0] for r in rows) / sum(r["this"][0] for r in rows)
-        print(f"speed ratio against {args.against} (previous wall / this wall, same run): {total:.2f}")
+        cpu = sum(r["previous"][4] for r in rows) / sum(r["this"][4] for r in rows)
+        sims = sum(r["previous"][1] for r in rows) / sum(r["this"][1] for r in rows)
+        print(f"speed ratio against {args.against} (previous wall / this wall, same run): {total:.2f}; "
+              f"CPU time ratio {cpu:.2f}; simulations ratio {sims:.2f}")
     print(f"worst {worst:.1f} s per 30 s of recording against the {BUDGET:.0f} s budget: "
           f"{'within' if worst <= BUDGET else 'OVER'}")
 

@@ -8,7 +8,14 @@ is diagnosed alone and both jointly, as cold processes
 verdict, the two rival explanations' chi2/N (friction level recalibrated, ``base``, against
 ``pressure_dependent_friction``), wall time, CPU time of the process and its workers, and the load.
 
+A site case (``--site DIR``): every recording of a site-acceptance folder (the commissioning tests of one
+servo: step series, open-loop full strokes, holds whose positioner goes to manual with the valve at null,
+a dead-band staircase, a sinusoid; docs/acceptance.md) diagnosed jointly as one cold process, with its
+wall time against the 2 min budget (15 recordings on 2 cores), CPU time, simulations, verdict and the
+leading candidates; with the folder's truth when an ``ANSWERS.json`` beside it names the site's effects.
+
 Run: .venv/bin/python benchmarks/joint_diagnosis.py [--jobs 2] [--profile practice|steps] [--effects a,b]
+     .venv/bin/python benchmarks/joint_diagnosis.py --site /work/shared/practice-acceptance/site-p2 [--jobs 2]
 (default: the 30 s practice profile and the full effect library). Not part of the test suite.
 """
 
@@ -28,6 +35,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 K_TRUE = 1.5e-6  # 1/Pa
 SUPPLY_FACTOR = 0.7
+SITE_BUDGET = 120.0  # s for a 15-recording site on 2 cores (issue 35)
 
 
 def _recordings(tmp: Path, profile: str) -> list[Path]:
@@ -63,12 +71,39 @@ def _run(paths: list[Path], out: Path, jobs: int, effects: str | None) -> dict:
             "simulations": d["timing"]["simulations"]}
 
 
+def _site(site: Path, jobs: int, effects: str | None) -> int:
+    """The site case: every recording of ``site`` diagnosed jointly (one cold process)."""
+    recs = sorted(site.glob("*.csv.gz")) + sorted(site.glob("*.csv"))
+    if not recs:
+        raise SystemExit(f"--site {site}: no recordings (*.csv, *.csv.gz)")
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "site.json"
+        print(f"load before: {os.getloadavg()[0]:.1f}; site {site.name}: {len(recs)} recordings; jobs {jobs}")
+        r = _run(recs, out, jobs, effects)
+        d = json.loads(out.read_text())
+    truth = None
+    answers = site.parent / "ANSWERS.json"
+    if answers.is_file():
+        truth = (json.loads(answers.read_text()).get("sites") or {}).get(site.name, {}).get("effects")
+    print(f"verdict: {r['verdict']} ({r['winner'] or '-'})" + (f"; truth: {', '.join(truth) or 'none'}" if truth is not None else ""))
+    print(f"{'candidate':40s} {'k':>2s} {'chi2/N':>9s} {'dBIC':>10s}  parameters")
+    for e in d["effects"][:6]:
+        params = ", ".join(f"{p['name'].split('.')[-1]}={p['value']:.3g}" for p in e["parameters"])
+        print(f"{e['name']:40s} {e['k']:2d} {e['chi2_per_residual']:9.3f} {e['delta_bic']:10.1f}  {params}")
+    print(f"wall {r['wall']:.1f} s (budget {SITE_BUDGET:.0f} s: {'within' if r['wall'] <= SITE_BUDGET else 'OVER'}), "
+          f"CPU {r['cpu']:.1f} s, {r['simulations']} simulations; load after: {os.getloadavg()[0]:.1f}")
+    return 0
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--profile", choices=("practice", "steps"), default="practice")
     ap.add_argument("--effects", default=None, help="candidate effects (default: the full library)")
+    ap.add_argument("--site", type=Path, default=None, help="a site-acceptance folder: every recording in it, jointly")
     args = ap.parse_args()
+    if args.site is not None:
+        return _site(args.site, args.jobs, args.effects)
     with tempfile.TemporaryDirectory() as tmp:
         r1, r2 = _recordings(Path(tmp), args.profile)
         print(f"load before: {os.getloadavg()[0]:.1f}; profile {args.profile}; jobs {args.jobs}")

@@ -46,7 +46,7 @@ def register(sub):
         ],
         usage="govcheck diagnose [options] [CONFIG] RECORDING [RECORDING ...]",
     )
-    add_recording_inputs(p, "the recording file(s); several closed-loop recordings of one plant are diagnosed jointly")
+    add_recording_inputs(p, "the recording file(s); several recordings of one plant are diagnosed jointly")
     p.add_argument("--effects", help="comma-separated candidate effects (default: every declared effect)")
     p.add_argument("--no-recalibration", action="store_true", help="do not consider recalibrating base parameters")
     add_jobs(p)
@@ -270,7 +270,7 @@ def _same_plant(a: str, b: str) -> bool:
 
 
 def _run_joint(args, plant_arg, effects) -> int:
-    """Several closed-loop recordings of one plant: one diagnosis with shared physics (diagnosis.servo.joint_recordings)."""
+    """Several recordings of one plant: one diagnosis with shared physics (diagnosis.servo.joint_recordings)."""
     from compliance.cli.progress import progress
     from compliance.diagnosis.servo.joint_recordings import diagnose_joint, format_joint
     from compliance.model.config import load_plant
@@ -284,8 +284,6 @@ def _run_joint(args, plant_arg, effects) -> int:
     cfg = load_plant(plant_arg or named)
     for path, (frame, meta) in zip(args.recordings, recs):
         check_sidecar_conditions(cfg, frame, meta, path)
-        if "reference" not in frame.columns:
-            raise InputError(f"{path}: no 'reference' column; a joint diagnosis needs closed-loop recordings")
     with progress(1, "diagnose", quiet=args.quiet, unit="stage", first=f"{len(recs)} recordings, shared physics") as bar:
         diag = diagnose_joint(cfg, recs, effects=effects, jobs=args.jobs, scheduler=args.scheduler,
                               recalibrate=not args.no_recalibration)

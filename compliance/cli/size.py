@@ -16,11 +16,13 @@ def register(subparsers):
         description=(
             "From the duty (stroke, supply pressure, closing force over the stroke, opening/closing times; a "
             "govcheck-duty/1 TOML file) and the requirement file, propose ISO 15552 cylinders (count, bore, rod), "
-            "a valve rating (ISO 6358 nominal flow), meter-out throttles refined by simulation to the stroke times, "
-            "PID gains and dead-zone compensation from the rules of docs/sizing.md; what sizing does not decide "
-            "comes from the duty's template configuration. The proposal is then checked like `govcheck check` "
-            "and, with --remedies, handed to the remedies search. Exit 0 when the proposal passes every mandatory "
-            "requirement, 1 when not, 2 on invalid input."
+            "a valve rating (ISO 6358 nominal flow) and the governor settings (set-point rate limiter for the stroke "
+            "times, flow-control valves wide open as its backstop, PID gains tuned on the file's own time-constant "
+            "test) by the rules of docs/sizing.md; what sizing does not decide comes from the duty's template "
+            "configuration. The proposal is checked like `govcheck check`, corrected and, when what fails grows "
+            "with the load's share of the cylinders' force, sized again on the next pair of cylinders up; the "
+            "requirement it cannot meet is named with the arithmetic. With --remedies it is handed to the remedies "
+            "search. Exit 0 when the proposal passes every mandatory requirement, 1 when not, 2 on invalid input."
         ),
         examples=[
             "govcheck size requirements/shpp-400kw.toml --duty models/duties/plant-a.toml --out sized.toml",
@@ -45,19 +47,33 @@ def register(subparsers):
     return p
 
 
-def _sizing_text(rec: dict, tune: dict) -> str:
-    c, v, k = rec["cylinders"], rec["valve"], rec["controller"]
-    lines = [f"cylinders: {c['count']} x ISO 15552 {c['bore']*1e3:.0f} mm bore / {c['rod']*1e3:.0f} mm rod ({c['arrangement']}); "
-             f"side area {c['area']*1e4:.1f} cm^2 >= {c['area_needed']*1e4:.1f} cm^2 needed; load ratio {c['load_ratio']:.2f}",
-             f"valve: {v['rating']:.0f} NL/min ({v['rating_needed']:.0f} NL/min needed for {rec['stroke_speed']*1e3:.1f} mm/s "
-             f"at 3x the filling flow); C = {v['conductance']*1e8:.2f} dm^3/(s*bar)"]
-    for d, t in tune.items():
-        lines.append(f"{d} throttle: " + (f"C = {t['conductance']*1e8:.3f} dm^3/(s*bar) -> {t['achieved']:.2f} s "
-                                          f"(target {t['target']:.2f} s at {t['operating_point']})" if isinstance(t, dict) else t))
-    lines.append(f"PID: K_P = {k['controller.kp']:.0f} V/m (tau {rec['tau_target']:.3f} s, speed gain "
-                 f"{k['_speed_gain']*1e3:.1f} mm/s per V), K_I = {k['controller.ki']:.3g} V/(m*s), K_D = {k['controller.kd']:.2f} "
-                 f"V*s/m (omega_n {k['_omega']:.0f} rad/s); compensation {k['controller.compensation_dead_zone_positive']:.2f}/"
-                 f"{k['controller.compensation_dead_zone_negative']:.2f} V, width {k['controller.compensation_width']:.2f} V")
+def _sizing_text(rec: dict, rounds: list) -> str:
+    c, v = rec["cylinders"], rec["valve"]
+    lines = []
+    for r in rounds[:-1]:
+        lines.append(f"tried {r['count']} x {r['bore']*1e3:.0f} mm bore (load share {r['load_ratio']:.2f}, {r['valve_rating']:.0f} "
+                     f"NL/min): {r['status']}, failing {', '.join(r['failed_mandatory']) or '-'}"
+                     + (f"; {r['cannot']}" if r.get("cannot") else "") + " -> the next pair up")
+    lines += [f"cylinders: {c['count']} x ISO 15552 {c['bore']*1e3:.0f} mm bore / {c['rod']*1e3:.0f} mm rod ({c['arrangement']}); "
+              f"side area {c['area']*1e4:.1f} cm^2 >= {c['area_needed']*1e4:.1f} cm^2 needed; load ratio {c['load_ratio']:.2f}",
+              f"valve: {v['rating']:.0f} NL/min ({v['rating_needed']:.0f} NL/min needed for {rec['stroke_speed']*1e3:.1f} mm/s "
+              f"at 3x the filling flow); C = {v['conductance']*1e8:.2f} dm^3/(s*bar)"]
+    d = rec.get("design") or {}
+    for k, why in (d.get("limiter") or {}).items():
+        lines.append(f"{k}: {why}")
+    for t in d.get("tau") or []:
+        rng = ", ".join(f"{k} {v[0]:.3f}-{v[1]:.3f} s" for k, v in (("up", t["up"]), ("down", t["down"])) if v)
+        lines.append(f"time constant at K_P {t['kp']:.0f} V/m, K_D {t['kd']:.1f} V*s/m, closing slope {t['slope_negative']:.2f}: {rng}")
+    for r in d.get("rounds") or []:
+        lines.append(f"check failed {', '.join(r['failing'])}: " + ("; ".join(r["corrections"]) or "no correction applies"))
+    st = d.get("stability") or []
+    if st:
+        pm = min((s["phase_margin_deg"] for s in st if s["phase_margin_deg"] is not None), default=None)
+        gm = min((s["gain_margin_db"] for s in st if s["gain_margin_db"] is not None), default=None)
+        lines.append(f"linearised loop: least phase margin {pm:.0f} deg, least gain margin {gm:.1f} dB over {len(st)} points "
+                     "(criterion 30 deg, 6 dB)" if pm is not None and gm is not None else "linearised loop: no margins")
+    if d.get("cannot"):
+        lines.append(f"cannot meet: {d['cannot']}")
     return "\n".join(lines) + "\n"
 
 
@@ -86,7 +102,7 @@ def _sized_configuration(cfg, out: str | None):
 
 
 def run(args) -> int:
-    """Size, check, optionally search remedies, then write; exit code from the proposal's verdict.
+    """Size, set the governor, check (stepping the cylinders up when needed), optionally search remedies, then write.
 
     Every input and output is checked first; the proposal (--out) is written only when the run has
     finished, so an interrupted or failed run leaves nothing behind.
@@ -97,8 +113,7 @@ def run(args) -> int:
     from compliance.files.shipped import resolve_shipped
     from compliance.model.config import load_plant
     from compliance.sweep.sizing.duty_file import load_duty
-    from compliance.sweep.sizing.size_servo import size_servo, time_constant_target
-    from compliance.sweep.sizing.throttle_tuning import tune_throttles
+    from compliance.sweep.sizing.size_servo import size_and_check, size_servo, time_constant_target
 
     _refuse_unused(args)
     check_remedies_options(args)
@@ -108,23 +123,35 @@ def run(args) -> int:
                        inputs={str(template_path): f"the template of {args.duty}", args.duty: "--duty"})
     template = load_plant(duty.template)
     reqset = checked_requirements(args.requirements, [duty.stroke], args)  # before any simulation
-    cfg, rec = size_servo(duty, template, time_constant_target(reqset))
-    cfg, tune = tune_throttles(cfg, reqset, {"opening": duty.opening_time, "closing": duty.closing_time})
-    cfg, text = _sized_configuration(cfg, args.out)
-    if not args.quiet:
-        sys.stdout.write(_sizing_text(rec, tune))
     if args.no_check:
+        from compliance.sweep.sizing.governor_design import design_governor
+
+        cfg, rec = size_servo(duty, template, time_constant_target(reqset))
+        cfg, rec["design"] = design_governor(cfg, reqset, tune=False)
+        if not args.quiet:
+            sys.stdout.write(_sizing_text(rec, [{}]))
         if args.out:
-            write_text_atomic(args.out, text)
+            write_text_atomic(args.out, _sized_configuration(cfg, args.out)[1])
         return 0
     from compliance.campaign.results_files import summary_table
-    from compliance.pipeline.chain import Check
+    from compliance.pipeline.chain import Check, remedy_search
+    from compliance.results.check_result import CheckResult
 
-    prepared = Check.of(cfg, reqset, uncertainty=None, remedies="default" if args.remedies else None,
-                        allow_conflicts=args.allow_conflicts)
-    results = prepared.run(jobs=args.jobs, progress=not args.quiet,
-                           remedy_options=remedies_kwargs(args) if args.remedies else None)
-    results = results.with_(sizing={"duty": duty.path, "record": rec, "throttles": tune})
+    cfg, rec, results, rounds = size_and_check(duty, template, reqset, workers=args.jobs, progress=not args.quiet)
+    if not args.quiet:
+        sys.stdout.write(_sizing_text(rec, rounds))
+    cfg, text = _sized_configuration(cfg, args.out)  # what is judged is what --out will hold, written at the end
+    from compliance.campaign.uncertainty import ranged_parameters
+
+    if ranged_parameters(cfg):  # judged as `govcheck check` will judge the written file: with the bands of its declared ranges
+        prepared = Check.of(cfg, reqset, uncertainty="local", allow_conflicts=args.allow_conflicts)
+        results = prepared.run(jobs=args.jobs, progress=not args.quiet)
+    else:
+        results = CheckResult.of(results)
+    results = results.with_(sizing={"duty": duty.path, "record": rec, "rounds": rounds})
+    if args.remedies:
+        results = results.with_(remedies=remedy_search(cfg, reqset, "default", jobs=args.jobs, progress=not args.quiet,
+                                                       **remedies_kwargs(args)))
     table = summary_table(results)
     sys.stdout.write(table.rstrip().splitlines()[-1] + "\n" if args.quiet else table)
     if args.remedies and not args.quiet:

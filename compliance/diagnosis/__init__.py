@@ -6,7 +6,7 @@ Public API:
   replay, locate, fit every candidate, select by BIC, explain; ``to_dict()`` is the JSON of
   docs/diagnosis-schema.md) and ``save_fitted(diagnosis, path)``;
 - ``diagnose_friction(runs, bore=None)`` -> ``FrictionDiagnosis`` (seal-friction bench runs);
-- ``diagnose_joint(cfg, recordings)`` -> ``JointDiagnosis`` (several closed-loop recordings of one
+- ``diagnose_joint(cfg, recordings)`` -> ``JointDiagnosis`` (several recordings of one
   plant: shared physics, each recording's own conditions and floors);
 - ``run_benchmark(cfg, ...)`` and ``run_practice(directory, cfg)`` (the proof on generated
   concealed-effect cases and on recordings with answers).

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from numba import njit
 
-from compliance.effects.base import Effect, Rest, State
+from compliance.effects.base import Effect, ReplayPoint, Rest, State
 from compliance.effects.param import Param
 from compliance.physics.valve_flow import iso6358_mass_flow
 
@@ -20,6 +20,14 @@ def rest(P, y, at: Rest) -> None:
     """Hook ``rest``: no flow at rest, so each hose at its chamber's pressure."""
     y[S_PLA] = at.pressure_a
     y[S_PLB] = at.pressure_b
+
+
+def replay_reset(P, y, point: ReplayPoint) -> None:
+    """Hook ``replay_reset``: each hose at its chamber's pressure where the replay restarts (recorded, else carried
+    over; not the rest state's, which clamps to the supply a chamber a meter-out throttle holds above it)."""
+    if P[P_LD_ON]:
+        y[S_PLA] = point.measured.get("pressure_a", point.simulated["pressure_a"])
+        y[S_PLB] = point.measured.get("pressure_b", point.simulated["pressure_b"])
 
 
 EFFECT = Effect(
@@ -39,6 +47,7 @@ EFFECT = Effect(
     fit_grid={"volume": (1e-4, 5e-4, 2e-3), "conductance": (1e-8, 3e-8, 1e-7)},
     draw={"volume": (1e-4, 6e-4, True), "conductance": (5e-9, 3e-8, True)},
     rest=rest,
+    replay_reset=replay_reset,
 )
 
 

@@ -53,8 +53,8 @@ class StateFeedbackDrive(PlantKind):
                 f"the PID only; a {self.title} is designed on its own linear model of the axis (docs/plant-b.md)")
 
     def diagnosis_support(self, cfg: PlantConfig) -> str | None:
-        return (f"the diagnosis replays recordings with the PID loop; a {self.title} has no replay "
-                "(its observers' states are not recorded)")
+        return (f"validate and diagnose replay a closed-loop recording with the PID loop; a {self.title} has no "
+                "closed-loop replay (its observers' states are not recorded)")
 
 
 STATE_FEEDBACK_DRIVE = StateFeedbackDrive()

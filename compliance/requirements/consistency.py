@@ -123,6 +123,7 @@ def _tau_vs_rate_limit(reqset, stroke, tau_req, v_req) -> list[dict]:
     if not any(reqset.procedures[p].kind == "full_stroke" for p in v_req.procedures):
         return []
     valves_out = _circuit(reqset, tau_req.operating_points) == {False} and False not in _circuit(reqset, v_req.operating_points)
+    limiter_out = {reqset.operating_points[o].setpoint_limiter for o in tau_req.operating_points} == {False}
     out = []
     for p in sorted(set(tau_req.procedures) - set(v_req.procedures)):
         proc = reqset.procedures[p]
@@ -135,14 +136,17 @@ def _tau_vs_rate_limit(reqset, stroke, tau_req, v_req) -> list[dict]:
         circuit = ("the file measures tau with the flow-control valves out and the strokes with them in, so the valves "
                    "may set the stroke rate" if valves_out else
                    "tau and the strokes are judged on the same circuit, so the device that limits the stroke rate must not act on these steps")
+        limiter = (f"The file injects these steps downstream of the set-point rate limiter, so a limiter at or below "
+                   f"{v * 1e3:.1f} mm/s may set the stroke rate too (as commissioned it would ramp them: tau >= 0.632 x "
+                   f"{h * 1e3:.2f} mm / {v * 1e3:.1f} mm/s = {_TAU_FRACTION * h / v:.3f} s > {tau_max:.3g} s)" if limiter_out else
+                   f"A set-point rate limiter at or below {v * 1e3:.1f} mm/s acts on every step and gives tau >= 0.632 x "
+                   f"{h * 1e3:.2f} mm / {v * 1e3:.1f} mm/s = {_TAU_FRACTION * h / v:.3f} s > {tau_max:.3g} s")
         out.append(_finding(RATE_SPLIT, tau_req, v_req, p, step=h, tau_max=tau_max, v_max=v, mean_speed=mean,
                             ramp_tau_min=_TAU_FRACTION * h / v, text=(
             f"{tau_req.id} (time constant <= {tau_max:.3g} s on {p}, steps of {h * 1e3:.2f} mm) and {v_req.id} "
             f"({v_req.metric} <= {v * 1e3:.1f} mm/s on full strokes): reaching 63.2 % of the step within {tau_max:.3g} s needs "
             f"a mean speed of 0.632 x {h * 1e3:.2f} mm / {tau_max:.3g} s = {mean * 1e3:.1f} mm/s > {v * 1e3:.1f} mm/s, so the "
-            f"servo must move faster on these steps than the strokes may: {circuit}. A set-point rate limiter at or below "
-            f"{v * 1e3:.1f} mm/s acts on every step and gives tau >= 0.632 x {h * 1e3:.2f} mm / {v * 1e3:.1f} mm/s = "
-            f"{_TAU_FRACTION * h / v:.3f} s > {tau_max:.3g} s")))
+            f"servo must move faster on these steps than the strokes may: {circuit}. {limiter}")))
     return out
 
 

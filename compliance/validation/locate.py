@@ -203,6 +203,7 @@ def locate(
     settings: LocateSettings = LocateSettings(),
     exclude=(),
     resolutions: dict | None = None,
+    command_input_from: float | None = None,
 ) -> tuple[list[Window], dict[str, float], dict[str, np.ndarray]]:
     """Located windows of every compared signal, sorted by start time.
 
@@ -219,6 +220,9 @@ def locate(
         Signals not compared.
     resolutions : dict, optional
         Signal -> quantisation step (SI) of its channel, a lower bound of its floor.
+    command_input_from : float, optional
+        Time [s] from which the recorded valve command was the replay's input (a hold test's positioner
+        in manual): the command's floor is estimated on the samples before it, where the controller wrote it.
 
     Returns
     -------
@@ -233,7 +237,10 @@ def locate(
     levels: dict[str, np.ndarray] = {}
     for sig, r in res.items():
         base = bases.get(sig, 0.0)
-        floor = noise_floor(recording[sig].to_numpy(dtype=float), rest, settings.min_floor_pu * base, (resolutions or {}).get(sig, 0.0))
+        values, at_rest = recording[sig].to_numpy(dtype=float), rest
+        if sig == "valve_command" and command_input_from is not None and np.count_nonzero(t < command_input_from) > 1:
+            values, at_rest = values[t < command_input_from], None if rest is None else rest[t < command_input_from]
+        floor = noise_floor(values, at_rest, settings.min_floor_pu * base, (resolutions or {}).get(sig, 0.0))
         if not floor > 0:
             floor = max(float(np.max(np.abs(r))) * 1e-9, 1e-300)
         floors[sig] = floor

@@ -1,162 +1,254 @@
-"""Replay a recorded test with the model: same set-point (closed loop) or same valve command (plant only).
+"""The one replay of a recorded test through the model, for ``govcheck validate`` and ``govcheck diagnose``.
 
-Two ways to put the model beside a recording (IEC 61400-27-2 calls them the *full-system*
-and the *play-back* simulation approaches):
+A replay is prepared once from the recording (``prepare_replay``: its conditions, start state,
+noise and segments) and run on any plant configuration (``run_replay``, on the compiled core).
+Validation runs it once per mode and puts it beside the recording (``replay``); the diagnosis
+runs it hundreds of times on candidate configurations. Both see the same test:
 
-- ``closed_loop``: the model's controller follows the recorded reference. Gains from the
-  sidecar (``controller.kp/ki/kd/sample_time``) override the configuration's. By default the
-  position noise the recording carries (its high-pass part) is fed to the simulated sensor, so
-  the controller sees the same noise-driven crossings of the valve dead band as the real
-  one (see ``estimate_position_noise``); without it a dead-band loop drifts apart from the
-  recording for reasons that are not plant physics.
-- ``plant_only``: the recorded valve command drives the plant. The controller cannot hide a
-  plant error here: the position integrates every flow error.
+- **conditions**: the sidecar's controller gains, supply pressure, load, flow-control valves and
+  loop switch, each with one fallback (``replay_conditions``);
+- **modes** (IEC 61400-27-2 calls them the *full-system* and the *play-back* simulation):
+  ``closed_loop``, the model's controller follows the recorded set-point wherever the recording's
+  controller acted, and the recorded valve command drives the plant where it did not (after a
+  hold test's switch to manual, ``test.valve_null_from``; a recording without a set-point is
+  driven by its command throughout); ``plant_only``, the recorded valve command drives the plant
+  throughout, so the controller cannot hide a plant error: the position integrates every flow error;
+- **noise**: in closed loop the controller acts on the *measured* position, so the recorded valve
+  command carries the sensor noise through K_P and the filtered derivative K_D, and each noise-driven
+  crossing of the valve dead band lets a little air through. The recording's own position noise
+  (``recorded_noise.replay_noise``) is added to the model's measured position, so the replayed
+  controller sees the noise the real one saw (on the practice no-effect recording the command
+  residual falls from ~0.15 V to ~0.015 V);
+- **start**: at rest at the recorded position smoothed at the first sample and the chamber pressures' medians
+  over the first 50 ms;
+- **segments** (``replay_segments``): the diagnosis re-synchronises with the recorded state at each
+  set-point change and every 2 s (multiple shooting); measured states are reset, unmeasured ones
+  carried over or set by physics (``replay_reset``), and the controller's integral state is carried
+  by shifting the segment's set-point by K_I*I/K_P. Validation replays in one piece; either way a
+  segment starts where the loop switches mode.
 
-Everything is simulated on the controller grid ``t0 + k*T_s`` and interpolated back onto the
-recording's own time stamps, so the returned frame lines up row by row with the recording.
+Everything is simulated on the controller grid ``t0 + k*T_s`` (a recording logged at another rate
+is put on it by ``resampling.on_controller_clock``); the simulated channels go through the
+recording's declared instruments (``logger_model``) before any comparison.
 """
 
 from __future__ import annotations
 
-import math
-from dataclasses import replace
-
 import numpy as np
 import pandas as pd
 
-from compliance.errors import InputError
+from compliance.errors import InputError, SimulationError
 from compliance.model.config import PlantConfig
-from compliance.simulation import OUTPUT_COLUMNS, Scenario, SensorNoise
-from compliance.plants import simulate
-from compliance.simulation.profiles import Profile
+from compliance.plants import kind_of
+from compliance.model.plant_vector import load_curve_arrays, parameter_vector
+from compliance.model.vector_slots import P_KI, P_KP
+from compliance.simulation.pid_loop import simulate_core
+from compliance.simulation.rk4 import OUTPUT_COLUMNS, output_buffer
 from compliance.validation.logger_model import logger_model
-from compliance.validation.recorded_noise import NOISE_FREE_STD, estimate_position_noise, position_quantum, robust_std
-from compliance.validation.resampling import (
-    controller_grid,
-    is_uniform,
-    on_controller_clock,
-    resample_uniform,
-    zoh_interval_average,
-)
-
-__all__ = [  # the clock and noise helpers live beside this module and stay importable from it
-    "MODES", "NOISE_CHOICES", "INITIAL_WINDOW", "NOISE_FREE_STD", "controller_grid", "estimate_position_noise",
-    "initial_conditions", "is_uniform", "load_from_metadata", "on_controller_clock", "position_quantum", "replay",
-    "replay_config", "resample_uniform", "robust_std", "zoh_interval_average",
-]
+from compliance.validation.recorded_noise import NOISE_FREE_STD, replay_noise, robust_std
+from compliance.validation.replay_conditions import (command_from_of, flow_control_of, initial_conditions, load_at_start, load_of,
+                                                     replay_config, where_of)
+from compliance.validation.replay_reset import OUT, reset_state, start_state
+from compliance.validation.replay_setup import ReplaySetup, clip_to_full_scale, full_scale, recorded_states, replay_conditions, resolutions
+from compliance.validation.replay_segments import MAX_SEGMENT, plan_segments
+from compliance.validation.resampling import logged_indices, on_controller_clock
 
 MODES = ("closed_loop", "plant_only")
 NOISE_CHOICES = ("auto", "recorded", "none")
-INITIAL_WINDOW = 0.05  # s; initial position = median of the first 50 ms (our choice: a few noise samples, before any motion)
-_CONTROLLER_KEYS = {"kp": "controller.kp", "ki": "controller.ki", "kd": "controller.kd", "sample_time": "controller.sample_time"}
+SIGNALS = ("position", "pressure_a", "pressure_b", "valve_command", "supply_pressure")
+MIN_SAMPLES = 10
 
 
-# ----------------------------------------------------------------------------------- conditions
-def _where(metadata: dict | None) -> str:
-    return str((metadata or {}).get("source_path") or "recording")
+def _check_inputs(frame: pd.DataFrame, mode: str, noise: str, src: str) -> None:
+    """A known mode and noise choice, the columns the mode needs, enough strictly increasing time stamps."""
+    if mode not in MODES:
+        raise InputError(f"mode '{mode}' is not one of {', '.join(MODES)}")
+    if noise not in NOISE_CHOICES:
+        raise InputError(f"noise '{noise}' is not one of {', '.join(NOISE_CHOICES)}")
+    need = ("time", "position", "reference" if mode == "closed_loop" else "valve_command")
+    missing = [c for c in need if c not in frame.columns]
+    if missing:
+        raise InputError(
+            f"{src}: {mode.replace('_', '-')} replay needs column(s) {', '.join(repr(m) for m in missing)}; "
+            f"the recording has {', '.join(map(str, frame.columns))}"
+        )
+    t = frame["time"].to_numpy(dtype=float)
+    if t.size < MIN_SAMPLES:
+        raise InputError(f"{src}: only {t.size} samples; a replay needs at least {MIN_SAMPLES}")
+    if np.any(np.diff(t) <= 0):
+        raise InputError(f"{src}: column 'time' must be strictly increasing")
 
 
-def _sidecar_number(metadata: dict, section: str, key: str, where: str, positive: bool = False) -> float | None:
-    table = metadata.get(section)
-    if table is None:
-        return None
-    if not isinstance(table, dict):
-        raise InputError(f"{where}: sidecar [{section}] must be a table")
-    if key not in table:
-        return None
-    value = table[key]
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise InputError(f"{where}: sidecar {section}.{key} = {value!r}; expected a number in SI units")
-    if positive and value <= 0:
-        raise InputError(f"{where}: sidecar {section}.{key} = {value!r}; expected a positive number")
-    return float(value)
-
-
-def replay_config(cfg: PlantConfig, metadata: dict | None) -> tuple[PlantConfig, dict]:
-    """Configuration the recorded test ran with: sidecar controller gains and supply pressure.
+def prepare_replay(cfg: PlantConfig, frame: pd.DataFrame, meta: dict | None, *, mode: str | None = None, noise: str = "auto",
+                   segmented: bool = True, max_segment: float = MAX_SEGMENT) -> ReplaySetup:
+    """Prepare the replay of a recording (conditions, start, noise, segments) for ``run_replay``.
 
     Parameters
     ----------
     cfg : PlantConfig
-    metadata : dict or None
-        Sidecar metadata from ``read_recording`` (SI floats).
+    frame : pandas.DataFrame
+        Canonical recording: ``time`` [s], ``position`` [m], ``valve_command`` [V], ``reference`` [m]
+        for a closed-loop test, pressures [Pa abs] when measured; at any rate.
+    meta : dict
+        Recording metadata (``read_recording``).
+    mode : {"closed_loop", "plant_only"}, optional
+        Default: closed loop when the recording has a set-point, else plant only (module doc).
+    noise : {"auto", "recorded", "none"}
+        Feed the recording's estimated position noise to the replayed controller: ``auto`` when the
+        recording carries noise (robust std above ``NOISE_FREE_STD``), ``recorded`` always.
+    segmented : bool
+        Re-synchronise with the recorded state at set-point changes and every ``max_segment``.
+    max_segment : float
+        [s].
 
-    Returns
-    -------
-    (PlantConfig, dict)
-        The configuration with overrides, and the overrides (dotted key -> SI value).
+    Raises
+    ------
+    InputError
+        Unknown mode, missing columns, a time base the controller clock cannot follow, a start
+        outside the stroke, bad sidecar values.
     """
-    metadata = metadata or {}
-    where = _where(metadata)
-    overrides: dict[str, float] = {}
-    for key, dotted in _CONTROLLER_KEYS.items():
-        v = _sidecar_number(metadata, "controller", key, where, positive=(key == "sample_time"))
-        if v is not None:
-            overrides[dotted] = v
-    ps = _sidecar_number(metadata, "conditions", "supply_pressure", where, positive=True)
-    if ps is not None:
-        overrides["air.supply_pressure"] = ps
-    if "controller.sample_time" in overrides:
-        # keep the configured RK4 step if it divides the recorded sample time, else the largest that does
-        ts = overrides["controller.sample_time"]
-        h = cfg.p("simulation.step")
-        if abs(ts / h - round(ts / h)) > 1e-6 or h > ts:
-            overrides["simulation.step"] = ts / max(1, math.ceil(ts / h))
-    if not overrides:
-        return cfg, overrides
-    try:
-        return cfg.replace(params=overrides), overrides
-    except InputError as exc:
-        raise InputError(f"{where}: the sidecar's values do not fit the plant: {exc}") from None
+    meta = meta or {}
+    src = where_of(meta) if meta.get("source_path") else "<recording>"
+    mode = mode or ("closed_loop" if "reference" in frame.columns else "plant_only")
+    _check_inputs(frame, mode, noise, src)
+    if mode == "closed_loop":
+        kind_of(cfg).check_diagnosable(cfg)  # the replay's closed loop is the PID servo's (simulate_core)
+    run_cfg, overrides = replay_config(cfg, meta, frame)
+    notes: list[str] = []
+    ts = run_cfg.p("controller.sample_time")
+    frame, logged = _on_clock(frame, ts, src, notes)
+    t = frame["time"].to_numpy(dtype=float)
+    closed = mode == "closed_loop"
+    switch = command_from_of(meta) if closed else None
+    command_from = _command_from(frame, closed, switch, ts, src, notes)
+    rec = {s: frame[s].to_numpy(dtype=float) for s in SIGNALS if s in frame.columns}
+    init = initial_conditions(frame, run_cfg, src)
+    x0, pressures = init["initial_position"], init["initial_pressures"]
+    load, load_source = load_of(cfg, meta, pressures)
+    if load_source != "sidecar conditions.load_force":
+        notes.append(load_source)
+    fc = flow_control_of(meta)
+    reference = frame["reference"].to_numpy(dtype=float) if "reference" in frame.columns else np.full(t.size, x0)
+    command = rec["valve_command"] if "valve_command" in rec else np.full(t.size, run_cfg.p("valve.centre_voltage"))
+    if "reference" not in frame.columns:
+        notes.append("no reference column: replayed open loop from the recorded valve command")
+    resolution = resolutions(rec, logged, meta)
+    logger = logger_model(meta)
+    share = logger.noise_share("position", ts) if logger is not None else 1.0
+    injected = np.zeros(t.size)
+    if command_from > 0 and noise != "none":
+        injected = _injected(rec["position"], logged, ts, resolution["position"], share, noise == "recorded")
+        injected[command_from:] = 0.0  # the controller is not in the loop there
+    tt = t - t[0]
+    states = recorded_states(rec, reference if closed else None, ts)
+    resets = plan_segments(tt, reference, command, states["velocity"], command_from, segmented, max_segment)
+    start = min(max(float(states["position"][0]), 0.0), run_cfg.p("cylinder.stroke"))
+    conditions = replay_conditions(run_cfg, meta, init, start, load, load_source, overrides, fc, switch)
+    return ReplaySetup(
+        time=tt, reference=np.ascontiguousarray(reference), command=np.ascontiguousarray(command),
+        closed_loop=closed, load=load, initial_position=float(x0), initial_pressures=pressures,
+        noise=np.ascontiguousarray(injected), recorded=rec, resets=resets, states=states, overrides=overrides,
+        notes=notes, source=src, logged=logged, logger=logger, resolution=resolution, command_from=command_from,
+        flow_control=fc, conditions=conditions, noise_replay=bool(np.any(injected)), full_scale=full_scale(rec, logged),
+    )
 
 
-def load_from_metadata(metadata: dict | None) -> float | str | None:
-    """Closing load of the test from ``conditions.load_force`` [N] (> 0 closes), ``"curve"`` or None."""
-    metadata = metadata or {}
-    cond = metadata.get("conditions")
-    if not isinstance(cond, dict) or "load_force" not in cond:
-        return None
-    value = cond["load_force"]
-    if value == "curve":
-        return "curve"
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise InputError(f"{_where(metadata)}: sidecar conditions.load_force = {value!r}; expected a force in N (> 0 closes) or \"curve\"")
-    return float(value)
+def _on_clock(frame: pd.DataFrame, ts: float, src: str, notes: list) -> tuple[pd.DataFrame, np.ndarray | None]:
+    """The recording on the controller's clock, and the controller periods that carry a logged sample (None: all)."""
+    t_rec = frame["time"].to_numpy(dtype=float)
+    frame, note = on_controller_clock(frame, ts, src)  # one sample per controller period
+    if not note:
+        return frame, None
+    notes.append(note)
+    logged = logged_indices(t_rec, ts)
+    return frame, logged[logged < len(frame)]
 
 
-def initial_conditions(recording: pd.DataFrame, cfg: PlantConfig, where: str = "recording") -> dict:
-    """Initial position and pressures from the recording's first ``INITIAL_WINDOW`` seconds.
+def _command_from(frame: pd.DataFrame, closed: bool, switch: float | None, ts: float, src: str, notes: list) -> int:
+    """First sample the recorded valve command drives (``ReplaySetup.command_from``)."""
+    n = len(frame)
+    if not closed:
+        return 0
+    if switch is None:
+        return n
+    notes.append(f"the recorded valve command drives the plant from {switch:g} s (sidecar test.valve_null_from: the positioner in manual)")
+    if "valve_command" not in frame.columns:
+        raise InputError(f"{src}: the recorded valve command drives the plant from {switch:g} s, but there is no column 'valve_command'")
+    return min(max(int(round(switch / ts)), 0), n)
 
-    Returns
-    -------
-    dict
-        ``initial_position`` [m] (median of the first 50 ms), ``initial_pressures`` ((p_A, p_B)
-        [Pa abs] medians, or None when either side is not measured).
+
+def _injected(position: np.ndarray, logged, ts: float, quantum: float, share: float, always: bool) -> np.ndarray:
+    """The recording's position noise for the replayed controller, or zeros when it carries none (and not ``always``)."""
+    est = replay_noise(position, logged, ts, quantum, share)
+    if always or robust_std(est if logged is None else est[logged]) >= NOISE_FREE_STD:
+        return est
+    return np.zeros(position.size)
+
+
+def run_replay(cfg: PlantConfig, setup: ReplaySetup, *, noise: np.ndarray | None = None, stop=None) -> dict[str, np.ndarray] | None:
+    """Simulate the replay; returns output column -> array on the recording's controller grid.
+
+    ``cfg`` must already carry the recording's overrides (``ReplaySetup.config``).
+
+    Parameters
+    ----------
+    noise : ndarray, optional
+        Position noise to inject instead of the recording's [m].
+    stop : callable, optional
+        ``stop(out, k)`` after each segment (``out``: the (n + 1, N_OUT) outputs, filled up to sample
+        ``k``): True ends the replay there and ``run_replay`` returns None (a residual that has
+        already decided; ``diagnosis.evidence.residuals.Bound``). Not called when the logger filters
+        or delays a channel (a sample's logged value then depends on later ones).
+
+    Raises
+    ------
+    SimulationError
+        The state became non-physical (the fit treats it as a very poor fit).
     """
-    t = recording["time"].to_numpy(dtype=float)
-    first = t <= t[0] + INITIAL_WINDOW
-    x0 = float(np.median(recording["position"].to_numpy(dtype=float)[first]))
-    stroke = cfg.p("cylinder.stroke")
-    if not (-1e-3 * stroke <= x0 <= stroke * (1 + 1e-3)):
-        raise InputError(
-            f"{where}: column 'position' starts at {x0*1e3:.2f} mm, outside the stroke 0..{stroke*1e3:.0f} mm of "
-            f"'{cfg.name}' (is the position in metres, measured from the closed end?)"
-        )
-    x0 = min(max(x0, 0.0), stroke)
-    pressures = None
-    if "pressure_a" in recording and "pressure_b" in recording:
-        pa = float(np.median(recording["pressure_a"].to_numpy(dtype=float)[first]))
-        pb = float(np.median(recording["pressure_b"].to_numpy(dtype=float)[first]))
-        for name, p in (("pressure_a", pa), ("pressure_b", pb)):
-            if not p > 0:
-                raise InputError(f"{where}: column '{name}' starts at {p:.0f} Pa; expected an absolute pressure > 0 (gauge data need a column map with kind = \"gauge\")")
-        pressures = (pa, pb)
-    return {"initial_position": x0, "initial_pressures": pressures}
+    P = parameter_vector(cfg, load=load_at_start(cfg, setup.load, setup.initial_position), flow_control=setup.flow_control)
+    ts = cfg.p("controller.sample_time")
+    n_sub = int(round(ts / cfg.p("simulation.step")))
+    lx, ly = load_curve_arrays(cfg)
+    n = setup.n_samples
+    out = output_buffer(n + 1)  # by column, as the loop writes it: each signal contiguous
+    nz = setup.noise if noise is None else np.ascontiguousarray(noise, dtype=float)
+    quiet = np.zeros(n + 1)
+    bounds = list(setup.resets) + [n]
+    kp, ki = P[P_KP], P[P_KI]
+    if stop is not None and setup.logger is not None and setup.logger.active:
+        stop = None
+    for i in range(len(setup.resets)):
+        k0, k1 = int(bounds[i]), int(bounds[i + 1])
+        if k1 <= k0:
+            continue
+        closed = setup.closed_loop and k0 < setup.command_from
+        ref = setup.reference[k0:k1 + 1]
+        if i == 0:
+            y0 = start_state(cfg, P, setup)
+        else:
+            y0 = reset_state(cfg, P, setup, k0, out, lx, ly)
+            if closed and kp > 0.0 and ki != 0.0:
+                ref = ref + ki * setup.states["integral"][k0] / kp  # carries the integral state (module doc)
+        seg = output_buffer(k1 - k0 + 1)  # the layout the loop is compiled for
+        pos_noise = nz[k0:k1 + 1] if closed else quiet[k0:k1 + 1]
+        # writable copies: a read-only input (pandas' to_numpy) would compile the loop once more for it
+        status = simulate_core(P, y0, np.array(ref), np.array(setup.command[k0:k1 + 1]), closed, np.array(pos_noise), 0.0,
+                               lx, ly, k1 - k0, n_sub, seg)
+        if status >= 0:
+            raise SimulationError(f"replay of {setup.source} became non-physical at t = {(k0 + status)*ts:.3f} s")
+        out[k0:k1 + 1] = seg
+        if stop is not None and k1 < n and stop(out, k1):
+            return None
+    sim = {c: out[:, OUT[c]] for c in OUTPUT_COLUMNS[1:]}
+    sim = setup.logger.apply(sim, ts) if setup.logger is not None else sim  # as the logger recorded it ...
+    for s, levels in setup.full_scale.items():  # ... and as a transducer at its full scale read it
+        sim[s] = clip_to_full_scale(sim[s], levels)
+    return sim
 
 
-# ----------------------------------------------------------------------------------- simulation
-def replay(cfg: PlantConfig, recording: pd.DataFrame, metadata: dict | None = None, mode: str = "closed_loop", *, noise: str = "auto") -> pd.DataFrame:
-    """Simulate the recorded test with the model, aligned to the recording's time stamps.
+def replay(cfg: PlantConfig, recording: pd.DataFrame, metadata: dict | None = None, mode: str = "closed_loop", *,
+           noise: str = "auto") -> pd.DataFrame:
+    """Simulate the recorded test in one piece, aligned to the recording's own time stamps (validation's view).
 
     Parameters
     ----------
@@ -167,24 +259,18 @@ def replay(cfg: PlantConfig, recording: pd.DataFrame, metadata: dict | None = No
         [V], optional ``pressure_a`` / ``pressure_b`` / ``supply_pressure`` [Pa abs]); uniform
         or not, at any rate.
     metadata : dict, optional
-        Sidecar metadata (``read_recording``): ``controller.kp/ki/kd/sample_time`` override the
-        configuration; ``conditions.load_force`` [N] (> 0 closes) and
-        ``conditions.supply_pressure`` [Pa abs] set the test conditions.
+        Sidecar metadata (``read_recording``; ``replay_conditions`` reads it).
     mode : {"closed_loop", "plant_only"}
-        Follow the recorded reference with the model's controller, or drive the plant with the
-        recorded valve command.
+        Module doc.
     noise : {"auto", "recorded", "none"}
-        Closed loop only: feed the recording's own position noise (``estimate_position_noise``)
-        to the simulated sensor. ``auto`` does so when the recording is sampled on the
-        controller's clock (otherwise the noise sequence cannot be placed sample by sample) and
-        carries noise (robust std above ``NOISE_FREE_STD``).
+        Closed loop: feed the recording's own position noise to the simulated sensor (``prepare_replay``).
 
     Returns
     -------
     pandas.DataFrame
         The simulation's columns (``compliance.simulation.rk4.OUTPUT_COLUMNS``) at the recording's
         time stamps (``time`` equals the recording's). ``attrs`` holds ``mode``,
-        ``noise_replay``, ``conditions`` and ``overrides``.
+        ``noise_replay``, ``conditions``, ``overrides`` and ``notes``.
 
     Raises
     ------
@@ -193,95 +279,14 @@ def replay(cfg: PlantConfig, recording: pd.DataFrame, metadata: dict | None = No
     SimulationError
         The model became non-physical.
     """
-    where = _where(metadata)
-    _check_replay_inputs(recording, mode, noise, where)
+    setup = prepare_replay(cfg, recording, metadata, mode=mode, noise=noise, segmented=False)
+    sim = run_replay(setup.config(cfg), setup)
     t_rec = recording["time"].to_numpy(dtype=float)
-    run_cfg, overrides = replay_config(cfg, metadata)
-    init = initial_conditions(recording, run_cfg, where)
-    load = load_from_metadata(metadata)
-    ts = run_cfg.p("controller.sample_time")
     tr = t_rec - t_rec[0]
-    grid = controller_grid(t_rec, ts)
-    duration = float(grid[-1]) if grid.size > 1 else ts
-    scenario_kw = dict(duration=duration, initial_position=init["initial_position"], load=load, initial_pressures=init["initial_pressures"])
-    noise_used = False
-    if mode == "closed_loop":
-        scenario = Scenario(reference=Profile(tr, recording["reference"].to_numpy(dtype=float)), **scenario_kw)
-        sim, noise_used = _closed_loop_run(run_cfg, scenario, recording, noise, where)
-    else:
-        edges = np.concatenate((grid, [grid[-1] + ts]))
-        u = zoh_interval_average(tr, recording["valve_command"].to_numpy(dtype=float), edges)
-        sim = simulate(run_cfg, Scenario(command=Profile(grid, u), **scenario_kw))
-    t_sim = sim["time"].to_numpy(dtype=float)
-    instruments = logger_model(metadata)
-    cols = {c: sim[c].to_numpy(dtype=float) for c in OUTPUT_COLUMNS[1:]}
-    if instruments is not None:  # the simulated channels as the recording's logger records them
-        cols = instruments.apply(cols, float(np.median(np.diff(t_sim))))
-    out = {"time": t_rec}
-    for col in OUTPUT_COLUMNS[1:]:
-        out[col] = np.interp(tr, t_sim, cols[col])
-    frame = pd.DataFrame(out)
-    frame.attrs.update(mode=mode, noise_replay=noise_used, overrides=dict(overrides),
-                       conditions=_replay_conditions(run_cfg, init, load, overrides))
+    frame = pd.DataFrame({"time": t_rec} | {c: np.interp(tr, setup.time, sim[c]) for c in OUTPUT_COLUMNS[1:]})
+    frame.attrs.update(mode=mode, noise_replay=setup.noise_replay, overrides=dict(setup.overrides),
+                       conditions=setup.conditions, notes=list(setup.notes))
     return frame
 
 
-def _check_replay_inputs(recording: pd.DataFrame, mode: str, noise: str, where: str) -> None:
-    """A known mode and noise choice, the columns the mode needs, a strictly increasing time."""
-    if mode not in MODES:
-        raise InputError(f"mode '{mode}' is not one of {', '.join(MODES)}")
-    if noise not in NOISE_CHOICES:
-        raise InputError(f"noise '{noise}' is not one of {', '.join(NOISE_CHOICES)}")
-    need = ("time", "position", "reference" if mode == "closed_loop" else "valve_command")
-    missing = [c for c in need if c not in recording.columns]
-    if missing:
-        raise InputError(
-            f"{where}: {mode.replace('_', '-')} replay needs column(s) {', '.join(repr(m) for m in missing)}; "
-            f"the recording has {', '.join(map(str, recording.columns))}"
-        )
-    t_rec = recording["time"].to_numpy(dtype=float)
-    if t_rec.size < 2 or np.any(np.diff(t_rec) <= 0):
-        raise InputError(f"{where}: column 'time' must be strictly increasing with at least 2 samples")
-
-
-def _closed_loop_run(run_cfg: PlantConfig, scenario: Scenario, recording: pd.DataFrame, noise: str, where: str):
-    """Simulate the closed loop, with the recording's own position noise when asked and possible.
-
-    Returns
-    -------
-    (pandas.DataFrame, bool)
-        The simulation and whether the recorded noise was replayed.
-    """
-    ts = run_cfg.p("controller.sample_time")
-    on_clock = is_uniform(recording["time"].to_numpy(dtype=float), ts)
-    use_noise = noise == "recorded" or (noise == "auto" and on_clock)
-    if use_noise and not on_clock:
-        raise InputError(
-            f"{where}: noise='recorded' needs a recording sampled on the controller clock "
-            f"({ts*1e3:g} ms); this one is not (use noise='none')"
-        )
-    x = recording["position"].to_numpy(dtype=float)
-    est = estimate_position_noise(x, ts) if use_noise else None
-    if est is not None and noise == "auto" and robust_std(est) < NOISE_FREE_STD:
-        est = None  # a noise-free recording (e.g. from the model itself): nothing to replay
-    if est is None:
-        return simulate(run_cfg, scenario), False
-    return simulate(run_cfg, replace(scenario, position_noise=est, noise=SensorNoise(position_quantum=position_quantum(x)))), True
-
-
-def _replay_conditions(run_cfg: PlantConfig, init: dict, load, overrides: dict) -> dict:
-    """The test conditions the replay assumed, each with where it came from."""
-    return {
-        "initial_position": init["initial_position"],
-        "initial_position_source": f"median of the recorded position over the first {INITIAL_WINDOW*1e3:.0f} ms",
-        "initial_pressures": init["initial_pressures"],
-        "initial_pressures_source": (
-            f"medians of the recorded pressures over the first {INITIAL_WINDOW*1e3:.0f} ms"
-            if init["initial_pressures"] else "at rest balancing the load, mean (p_s + p_atm)/2 (pressures not recorded)"
-        ),
-        "load_force": load,
-        "load_source": "sidecar conditions.load_force" if load is not None else "none given: no load",
-        "supply_pressure": run_cfg.p("air.supply_pressure"),
-        "supply_pressure_source": "sidecar conditions.supply_pressure" if "air.supply_pressure" in overrides else "configuration",
-        "controller": {k: run_cfg.p(d) for k, d in _CONTROLLER_KEYS.items()},
-    }
+__all__ = ["MODES", "NOISE_CHOICES", "SIGNALS", "ReplaySetup", "prepare_replay", "replay", "run_replay"]

@@ -87,13 +87,32 @@ def _held_reference(t: np.ndarray, v: np.ndarray, grid: np.ndarray, held: np.nda
     return out
 
 
+def _held_command(t: np.ndarray, v: np.ndarray, grid: np.ndarray, held: np.ndarray, ts: float) -> np.ndarray:
+    """The command the controller held over each period from a log of its zero-order-hold staircase.
+
+    Where no logged sample falls inside a period (a log on the controller's clock, or slower, or
+    a missing sample), the last logged value at or before the period's start, exactly; where one
+    does (a jittered clock, a faster log), the staircase's average over the period
+    (``zoh_interval_average``), which conserves the command's time integral.
+    """
+    out = v[held]
+    tol = CLOCK_TOLERANCE * ts
+    edges = np.append(grid, grid[-1] + ts)
+    inside = np.searchsorted(t, edges[1:] - tol, side="left") - np.searchsorted(t, edges[:-1] + tol, side="right")
+    mixed = inside > 0
+    if np.any(mixed):
+        out[mixed] = zoh_interval_average(t, v, edges)[mixed]
+    return out
+
+
 def on_controller_clock(frame: pd.DataFrame, ts: float, where: str) -> tuple[pd.DataFrame, str | None]:
     """The recording on the controller's clock t_0 + k*ts (a replay needs one sample per period).
 
     Measured signals (position, pressures) are interpolated linearly at the controller's
     instants; the valve command, which the controller holds over its period, takes the last
-    logged value at or before each instant, and so does a set-point step (a ramp keeps
-    ramping: ``_held_reference``). A recording already on the clock is returned unchanged.
+    logged value at or before each instant, or its average over the period where a logged sample
+    falls inside one (``_held_command``), and a set-point step holds (a ramp keeps ramping:
+    ``_held_reference``). A recording already on the clock is returned unchanged.
     Which controller instants carry a logged sample: ``logged_indices``.
 
     Parameters
@@ -135,6 +154,8 @@ def on_controller_clock(frame: pd.DataFrame, ts: float, where: str) -> tuple[pd.
         v = frame[col].to_numpy(dtype=float)
         if col == "reference":
             out[col] = _held_reference(t, v, grid, held)
+        elif col == "valve_command":
+            out[col] = _held_command(t, v, grid, held, ts)
         else:
             out[col] = v[held] if col in HELD_COLUMNS else np.interp(grid, t, v)
     note = (f"resampled onto the {ts*1e3:g} ms controller clock: {t.size} samples at {dt.min()*1e3:.3g}..{dt.max()*1e3:.3g} ms "

@@ -19,7 +19,8 @@ from compliance.model.config import PlantConfig
 from compliance.validation.fit_metrics import SIGNAL_UNITS, derive_windows, per_unit_bases, signal_fit, window_metrics
 from compliance.validation.locate import locate, merge_across_signals
 from compliance.validation.regimes import REGIME_NAMES, compute_regimes
-from compliance.validation.replay import load_from_metadata, replay, replay_config
+from compliance.validation.replay import replay
+from compliance.validation.replay_conditions import replay_config
 from compliance.validation.resampling import is_uniform
 from compliance.validation.settings import MAX_OVERLAY_POINTS, ValidationSettings, apply_overrides, load_settings
 from compliance.validation.settings import read_settings_table, settings_from_dict
@@ -90,9 +91,19 @@ def validate(cfg: PlantConfig, recording: pd.DataFrame, metadata: dict | None = 
     t = recording["time"].to_numpy(dtype=float)
     if t.size < 10:
         raise InputError(f"{where}: {t.size} samples; validation needs at least 10")
-    metadata, warnings = _sidecar_conditions(cfg, recording, metadata)
-    run_cfg, overrides = replay_config(cfg, metadata)
-    load = load_from_metadata(metadata)
+    warnings = _sidecar_warnings(cfg, metadata)
+    run_cfg, overrides = replay_config(cfg, metadata, recording)
+    sims: dict[str, pd.DataFrame] = {}
+    for mode in settings.modes:
+        need = "reference" if mode == "closed_loop" else "valve_command"
+        if need not in recording and len(settings.modes) > 1:
+            warnings.append(f"{mode} replay skipped: the recording has no '{need}' column")
+            continue
+        sims[mode] = replay(cfg, recording, metadata, mode, noise=settings.noise)
+    conditions = next(iter(sims.values())).attrs["conditions"] if sims else None
+    if conditions is not None:
+        warnings += _assumed(conditions, next(iter(sims.values())).attrs["notes"])
+    load = conditions["load_force"] if conditions else None
     supply = run_cfg.p("air.supply_pressure")
     regimes = compute_regimes(recording, run_cfg, load, supply)
     bases_info = per_unit_bases(run_cfg, supply)
@@ -103,14 +114,7 @@ def validate(cfg: PlantConfig, recording: pd.DataFrame, metadata: dict | None = 
     modes_out: dict[str, dict] = {}
     traces: dict[str, tuple[dict, dict]] = {}
     floors_out: dict[str, float] = {}
-    conditions = None
-    for mode in settings.modes:
-        need = "reference" if mode == "closed_loop" else "valve_command"
-        if need not in recording and len(settings.modes) > 1:
-            warnings.append(f"{mode} replay skipped: the recording has no '{need}' column")
-            continue
-        sim = replay(cfg, recording, metadata, mode, noise=settings.noise)
-        conditions = sim.attrs["conditions"]
+    for mode, sim in sims.items():
         modes_out[mode], traces[mode], floors = _compare_mode(recording, sim, mode, regimes, bases, windows, settings)
         floors_out.update(floors)
     if not modes_out:
@@ -145,20 +149,24 @@ def validate(cfg: PlantConfig, recording: pd.DataFrame, metadata: dict | None = 
     return result
 
 
-def _sidecar_conditions(cfg: PlantConfig, recording: pd.DataFrame, metadata: dict) -> tuple[dict, list[str]]:
-    """Fill the supply pressure the sidecar lacks (the recorded median) and warn of what is assumed."""
+def _sidecar_warnings(cfg: PlantConfig, metadata: dict) -> list[str]:
+    """What the sidecar leaves to assumption (the replay's own fallbacks are in its conditions)."""
     warnings: list[str] = []
-    # supply pressure: sidecar, else the recorded one, else the configuration's
-    cond = dict(metadata.get("conditions") or {}) if isinstance(metadata.get("conditions"), dict) else {}
-    if "supply_pressure" not in cond and "supply_pressure" in recording:
-        cond["supply_pressure"] = float(np.median(recording["supply_pressure"].to_numpy(dtype=float)))
-        warnings.append(f"no conditions.supply_pressure in the sidecar: using the recorded median {cond['supply_pressure']/1e5:.3f} bar abs")
-        metadata["conditions"] = cond
     if metadata.get("plant") and metadata["plant"] != cfg.name:
         warnings.append(f"the sidecar says the recording was taken on '{metadata['plant']}', the model is '{cfg.name}'")
-    if "load_force" not in cond:
-        warnings.append("no conditions.load_force in the sidecar: the replay assumes no load")
-    return metadata, warnings
+    return warnings
+
+
+def _assumed(conditions: dict, notes: list) -> list[str]:
+    """Warnings for the conditions the replay took from elsewhere than the sidecar."""
+    out = []
+    if not conditions["supply_pressure_source"].startswith("sidecar"):
+        source = conditions["supply_pressure_source"].split(" (")[0]
+        out.append(f"no conditions.supply_pressure in the sidecar: {conditions['supply_pressure']/1e5:.3f} bar abs, the {source}")
+    if not conditions["load_source"].startswith("sidecar"):
+        out.append(conditions["load_source"])
+    out += [n for n in notes if "drives the plant" in n]
+    return out
 
 
 def _compare_mode(recording: pd.DataFrame, sim: pd.DataFrame, mode: str, regimes, bases: dict, windows, settings):
@@ -171,7 +179,9 @@ def _compare_mode(recording: pd.DataFrame, sim: pd.DataFrame, mode: str, regimes
     """
     t = recording["time"].to_numpy(dtype=float)
     exclude = ("valve_command",) if mode == "plant_only" else ()
-    located, floors, levels = locate(recording, sim, regimes, bases, settings.locate, exclude=exclude)
+    switch = sim.attrs["conditions"].get("command_from")
+    located, floors, levels = locate(recording, sim, regimes, bases, settings.locate, exclude=exclude,
+                                     command_input_from=None if switch is None or mode != "closed_loop" else t[0] + switch)
     events = merge_across_signals(located, regimes, settings.locate.merge_gap)
     signals = [s for s in floors]  # compared signals, in SIGNALS order
     fits = {s: {**signal_fit(recording[s].to_numpy(dtype=float), sim[s].to_numpy(dtype=float)), "unit": SIGNAL_UNITS[s]} for s in signals}

@@ -19,7 +19,8 @@ from compliance.model.config import load_plant
 from compliance.diagnosis.servo.candidates import effect_params
 from compliance.model.parameters import ParamHandle
 from compliance.diagnosis.servo.diagnose import diagnose, save_fitted
-from compliance.diagnosis.evidence.replay_fit import prepare_replay, replay_config, run_replay, segment_starts
+from compliance.validation.replay import prepare_replay, run_replay
+from compliance.validation.replay_segments import segment_starts
 from compliance.errors import InputError
 from compliance.recordings.synth import PRACTICE_NOISE, synthesise, write_recording
 
@@ -51,7 +52,7 @@ def test_replay_of_the_model_reproduces_its_own_noise_free_recording(cfg):
     frame, meta = _recording(cfg)
     setup = prepare_replay(cfg, frame, meta)
     assert len(setup.resets) > 3
-    sim = run_replay(replay_config(cfg, setup), setup)
+    sim = run_replay(setup.config(cfg), setup)
     # differences come from the smoothed states read at the resets (S-G on exact data) and the
     # smoother's bias injected as "noise" during fast moves; a replay error below the practice
     # sensor noise (20 um, 300 Pa) cannot move a diagnosis, so that is the bound
@@ -87,7 +88,7 @@ def test_lumped_total_lag_propagates_the_full_covariance():
 def test_newey_west_information_counts_correlated_residuals_as_fewer():
     """White residuals: S = J^T J var(r). AR(1) residuals with rho = 0.8: S approaches the long-run
     variance (1 + rho)/(1 - rho) = 9 times larger, less the Bartlett truncation 2 rho/((L+1)(1-rho)^2)."""
-    from compliance.diagnosis.servo.fit import hac_information
+    from compliance.diagnosis.estimation.standard_errors import hac_information
     from compliance.diagnosis.evidence.residuals import ResidualModel
 
     m, lag, rho = 40000, 50, 0.8
@@ -321,7 +322,7 @@ def test_resets_in_motion_start_a_lagged_sensor_where_the_motion_left_it(cfg):
         frame, meta = synthesise(plant, x0=0.04, load=2000.0, kd=20.0, noise=None, seed=3, duration=6.0,
                                  reference=ramp(0.04, 0.14, 0.5, 0.02))
         setup = prepare_replay(plant, frame, meta)
-        sim = run_replay(replay_config(plant, setup), setup)
+        sim = run_replay(setup.config(plant), setup)
         err = sim["position"] - frame.position.to_numpy()
         t = setup.time
         return [float(np.sqrt(np.mean(err[k:k + 50] ** 2))) for k in setup.resets if 1.0 < t[k] < 4.0]

@@ -8,6 +8,8 @@ a position-dependent load and a -1 % pressure_b gain (docs/diagnosis.md, practic
 
 from __future__ import annotations
 
+import math
+
 import pytest
 
 from compliance.diagnosis.servo import fit as fit_module
@@ -99,9 +101,9 @@ def test_the_screen_level_asks_two_percent_of_the_nominal_excess():
 def test_a_parameter_set_is_replayed_once(monkeypatch):
     calls = []
 
-    def fake(model, cfg, setup):
+    def fake(model, cfg, setup, limit=math.inf):
         calls.append(cfg)
-        return [len(calls)], None
+        return [len(calls)], None, False
 
     monkeypatch.setattr(fit_module, "evaluate", fake)
     ctx = FitContext(load_plant("plant-a"), None, None)

@@ -16,8 +16,8 @@ from compliance.diagnosis.servo.candidates import effect_params
 from compliance.model.parameters import apply
 from compliance.diagnosis.servo.fit import FitResult, chi2_parts
 from compliance.diagnosis.servo.friction_form import OPTION, form_after_effects, friction_form_check, form_words
-from compliance.diagnosis.evidence.replay_fit import run_replay
-from compliance.diagnosis.evidence.operating_point import load_at_start
+from compliance.validation.replay import run_replay
+from compliance.validation.replay_conditions import load_at_start
 from compliance.diagnosis.servo.selection import MIN_GAIN, SIGNIFICANCE
 from compliance.recordings.synth import PRACTICE_NOISE, synthesise
 

@@ -8,7 +8,7 @@ import pytest
 from compliance.diagnosis.servo.diagnose import diagnose
 from compliance.diagnosis.servo.instrument_candidates import instrument_candidates, instrumented
 from compliance.diagnosis.scoring.practice_score import practice_correct
-from compliance.diagnosis.evidence.replay_fit import prepare_replay
+from compliance.validation.replay import prepare_replay
 from compliance.model.config import load_plant
 from compliance.recordings.synth import PRACTICE_NOISE, synthesise
 

@@ -20,7 +20,7 @@ from compliance.diagnosis.servo.candidates import effect_params
 from compliance.diagnosis.servo.stage import prepare_recording
 from compliance.diagnosis.servo.effect_sets import ADD_GAIN, BURST_WINDOW, NO_WORSE, adds_enough, screen_addition
 from compliance.diagnosis.servo.fit import FitContext, FitResult, chi2_parts, scan_points
-from compliance.diagnosis.evidence.operating_point import load_at_start
+from compliance.validation.replay_conditions import load_at_start
 from compliance.diagnosis.servo.selection import RESIDUAL_LIMIT, Score, ambiguity_set, honest
 from compliance.recordings.synth import PRACTICE_NOISE, synthesise
 

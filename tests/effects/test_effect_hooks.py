@@ -90,6 +90,18 @@ def test_a_replay_restart_reads_the_measured_and_carries_the_rest(plant_a):
     assert y[_index("supply_pressure")] == 7.6e5  # not recorded: carried over
 
 
+def test_a_replay_restart_puts_the_hoses_at_the_chamber_pressures_it_reads(plant_a):
+    """A meter-out throttle can hold chamber A above the supply: the hose takes the reading, not the rest clamp."""
+    cfg = plant_a.replace(effects={"line_dynamics": {}})
+    P = parameter_vector(cfg)
+    y = initial_state(cfg, P, 0.05)
+    above = cfg.p("air.supply_pressure") + 0.5e5
+    reset_for_replay(P, y, ReplayPoint(0.0, {"pressure_a": above}, {"pressure_a": 3.0e5, "pressure_b": 4.2e5,
+                                                                    "temperature_a": 293.0, "temperature_b": 293.0}))
+    assert y[_index("line_pressure_a")] == above  # measured
+    assert y[_index("line_pressure_b")] == 4.2e5  # not recorded (or at the transducer's full scale): carried over
+
+
 def test_the_reading_lags_are_the_sensor_lag_while_it_is_on(plant_a):
     assert reading_lags(parameter_vector(plant_a)) == ()
     on = plant_a.replace(effects={"sensor_lag": {"time_constant": 0.004, "delay": 0.002}})

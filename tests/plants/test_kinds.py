@@ -77,9 +77,19 @@ def test_only_the_servo_has_a_linear_model_and_a_replay(plants):
         controller_nlsys(b)
     from compliance.diagnosis.servo.stage import check_effects
 
-    with pytest.raises(InputError, match="the diagnosis replays recordings with the PID loop"):
+    with pytest.raises(InputError, match="replay a closed-loop recording with the PID loop"):
         check_effects(b, None)
     assert check_effects(a, ["valve_offset"]) == ["valve_offset"]
+    # validate's replay is the same engine: a closed-loop recording of the drive is refused, not replayed by the PID
+    import numpy as np
+    import pandas as pd
+
+    from compliance.validation.replay import prepare_replay
+
+    t = np.arange(400) * 1e-3
+    frame = pd.DataFrame({"time": t, "position": np.full(t.size, 0.1), "reference": np.full(t.size, 0.1)})
+    with pytest.raises(InputError, match="replay a closed-loop recording with the PID loop"):
+        prepare_replay(b, frame, {})
 
 
 def test_remedies_change_the_kind_s_own_settings(plants):

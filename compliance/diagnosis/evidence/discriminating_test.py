@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from compliance.diagnosis.evidence.operating_point import load_at_start
+from compliance.validation.replay_conditions import load_at_start
 from compliance.errors import InputError, SimulationError
 from compliance.recordings.synth import practice_profile
 from compliance.simulation import Scenario

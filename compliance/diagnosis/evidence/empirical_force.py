@@ -27,7 +27,7 @@ import numpy as np
 from compliance.model.assembly import friction_level_at
 from compliance.model.plant_vector import load_curve_arrays, parameter_vector
 from compliance.model.rest_state import load_force, pneumatic_forces
-from compliance.diagnosis.evidence.operating_point import load_at_start
+from compliance.validation.replay_conditions import load_at_start
 from compliance.model.vector_slots import P_BV, P_FC, P_FS, P_MASS, P_NFR, P_PATM, P_VS
 from compliance.physics.friction import stribeck_map
 

@@ -41,7 +41,7 @@ def locate_mismatch(cfg: PlantConfig, setup, signals, nominal: dict):
     ----------
     cfg : PlantConfig
         Replay configuration.
-    setup : replay_fit.ReplaySetup
+    setup : validation.replay.ReplaySetup
     signals : sequence of str
         Compared signals.
     nominal : dict

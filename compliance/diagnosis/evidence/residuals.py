@@ -19,9 +19,11 @@ import numpy as np
 from compliance.model.config import PlantConfig
 from compliance.errors import InputError, SimulationError
 from compliance.validation.recorded_noise import QUANTISED_SHARE, sensor_noise_std
-from compliance.diagnosis.evidence.operating_point import load_at_start
-from compliance.diagnosis.evidence.replay_fit import ReplaySetup, run_replay
+from compliance.validation.replay_conditions import load_at_start
+from compliance.validation.replay import ReplaySetup, prepare_replay, run_replay
+from compliance.validation.replay_setup import clip_to_full_scale
 from compliance.validation.fit_metrics import nrmse
+from compliance.simulation.rk4 import OUTPUT_COLUMNS
 
 # lowest floors we accept (instrument resolution a logger rarely beats): keeps one signal from
 # dominating when its noise estimate comes out implausibly small
@@ -122,10 +124,7 @@ def null_recording(cfg: PlantConfig, setup: ReplaySetup, sensor: dict, seed: int
     """The same test recorded by the nominal model with sensors like the recording's, prepared for replay."""
     import pandas as pd
 
-    from compliance.simulation.profiles import Profile
-    from compliance.simulation import Scenario, SensorNoise
-    from compliance.plants import simulate
-    from compliance.diagnosis.evidence.replay_fit import prepare_replay
+    from compliance.simulation import SensorNoise
 
     rec, res = setup.recorded, setup.resolution
     qx, qp = res.get("position", 0.0), max(res.get("pressure_a", 0.0), res.get("pressure_b", 0.0))
@@ -137,32 +136,66 @@ def null_recording(cfg: PlantConfig, setup: ReplaySetup, sensor: dict, seed: int
                         pressure_quantum=qp)
     t = setup.time
     ts = float(np.median(np.diff(t)))
-    pre = int(round(NULL_PRE_ROLL / ts))
-    # the null bench settles first (a hold before the test), like a real recording does
-    tt = np.concatenate([t[:pre] , t + pre * ts]) if pre else t
-    if setup.closed_loop:
-        ref = np.concatenate([np.full(pre, setup.reference[0]), setup.reference])
-        sc = Scenario(duration=float(tt[-1]), initial_position=setup.initial_position, reference=Profile(tt, ref),
-                      load=load_at_start(cfg, setup.load, setup.initial_position), noise=noise, seed=seed)
-    else:
-        cmd = np.concatenate([np.full(pre, setup.command[0]), setup.command])
-        sc = Scenario(duration=float(tt[-1]), initial_position=setup.initial_position, command=Profile(tt, cmd),
-                      load=load_at_start(cfg, setup.load, setup.initial_position), noise=noise, seed=seed)
-    syn = simulate(cfg, sc).iloc[pre:].reset_index(drop=True)
-    n = min(len(syn), t.size)
-    frame = pd.DataFrame({"time": t[:n], "position": syn["position"].to_numpy()[:n], "valve_command": syn["valve_command"].to_numpy()[:n]})
+    pre = min(int(round(NULL_PRE_ROLL / ts)), t.size)  # a recording shorter than the pre-roll settles for as long as it lasts
+    load = load_at_start(cfg, setup.load, setup.initial_position)
+    syn = _null_run(cfg, setup, pre, load, noise, seed)
+    n = min(len(syn["position"]), t.size)
+    frame = pd.DataFrame({"time": t[:n], "position": syn["position"][:n], "valve_command": syn["valve_command"][:n]})
     if setup.closed_loop:
         frame["reference"] = setup.reference[:n]
     for s_ in ("pressure_a", "pressure_b", "supply_pressure"):
         if s_ in rec:
-            frame[s_] = syn[s_].to_numpy()[:n]
+            frame[s_] = syn[s_][:n] if s_ not in setup.full_scale else clip_to_full_scale(syn[s_][:n], setup.full_scale[s_])
     if setup.logger is not None:  # through the recording's instruments (filter, delays, calibration) ...
         logged = setup.logger.apply({c: frame[c].to_numpy() for c in frame.columns}, ts)
         frame = pd.DataFrame({c: logged[c] for c in frame.columns})
     if setup.logged is not None:  # ... at the instants it logged
         frame = frame.iloc[setup.logged[setup.logged < n]].reset_index(drop=True)
-    meta = {"conditions": {"load_force": setup.load}, "source_path": "<null replay>"}
+    test = {} if setup.flow_control is None else {"flow_control": "set" if setup.flow_control else "open"}
+    if setup.closed_loop and setup.command_from < t.size:
+        test["valve_null_from"] = float(t[setup.command_from])
+    meta = {"conditions": {"load_force": setup.load}, "source_path": "<null replay>"} | ({"test": test} if test else {})
     return dataclasses.replace(prepare_replay(cfg, frame, meta), logger=setup.logger)
+
+
+def _null_run(cfg: PlantConfig, setup: ReplaySetup, pre: int, load, noise, seed: int) -> dict:
+    """The nominal model run through the recorded test with sensors like the recording's (signal -> array from t = 0).
+
+    The bench settles first (``pre`` samples of hold before the test, like a real recording). A
+    test whose valve command drives the plant from ``command_from`` (a hold test's switch to manual)
+    is recorded in two runs: the closed loop up to the switch, then the command from the state the
+    loop left the servo in (at rest: its position and pressures).
+    """
+    from compliance.plants import simulate
+    from compliance.simulation import Scenario
+    from compliance.simulation.profiles import Profile
+
+    t = setup.time
+    ts = float(np.median(np.diff(t)))
+    switch = setup.command_from if setup.closed_loop else 0
+    tt = np.concatenate([t[:pre], t + pre * ts]) if pre else t
+    common = dict(load=load, noise=noise, seed=seed, flow_control=setup.flow_control)
+    if switch == 0:
+        cmd = np.concatenate([np.full(pre, setup.command[0]), setup.command])
+        sc = Scenario(duration=float(tt[-1]), initial_position=setup.initial_position, command=Profile(tt, cmd), **common)
+        syn = simulate(cfg, sc).iloc[pre:]
+        return {c: syn[c].to_numpy() for c in syn.columns}
+    last = min(switch, t.size - 1)
+    ref = np.concatenate([np.full(pre, setup.reference[0]), setup.reference[:last + 1]])
+    sc = Scenario(duration=float(tt[pre + last]), initial_position=setup.initial_position, reference=Profile(tt[:pre + last + 1], ref),
+                  **common)
+    first = simulate(cfg, sc).iloc[pre:]
+    out = {c: first[c].to_numpy() for c in first.columns}
+    if switch >= t.size:
+        return out
+    held = (float(first["pressure_a"].iloc[-1]), float(first["pressure_b"].iloc[-1]))
+    x_held = min(max(float(first["position_true"].iloc[-1]), 0.0), cfg.p("cylinder.stroke"))
+    rest = setup.command[switch:]
+    tr = t[switch:] - t[switch]
+    sc2 = Scenario(duration=float(tr[-1]), initial_position=x_held, command=Profile(tr, rest), initial_pressures=held,
+                   **dict(common, seed=seed + 1))
+    second = simulate(cfg, sc2)
+    return {c: np.concatenate([out[c][:switch], second[c].to_numpy()]) for c in out}
 
 
 def _beyond_quantisation(std: float, q: float) -> float:
@@ -269,13 +302,64 @@ def build_residual_model(cfg: PlantConfig, setup: ReplaySetup, *, stride: int = 
                          recorded={s: setup.recorded[s] for s in signals}, local=local or None)
 
 
-def evaluate(model: ResidualModel, cfg: PlantConfig, setup: ReplaySetup) -> tuple[np.ndarray, dict | None]:
-    """Run one replay and return (normalised residual vector, replay or None when it diverged)."""
+CHECK_SHARE = 0.05  # a stopping replay checks its residual after each segment that adds this share of the fitted samples
+STOP_MARGIN = 1.0 + 1e-9  # a partial sum of squares summed in another order than the full one: stop only clearly above
+
+
+class Bound:
+    """Stops a replay once its chi-square over the samples replayed so far exceeds ``limit`` (``run_replay``'s ``stop``).
+
+    The replay is re-synchronised in segments, so after each segment the residuals of every fitted
+    sample before its end are final; their sum of squares only grows with the rest. A candidate
+    whose value can no longer matter to the search asking for it (``servo.simplex``, the grid scans
+    of ``servo.fit``) is known to be worse once that partial sum exceeds the limit, and the rest of
+    the recording is not replayed. ``vec`` holds the residuals so far (zeros beyond): its sum of
+    squares is the partial chi-square, a lower bound of the full one.
+    """
+
+    def __init__(self, model: ResidualModel, limit: float, full_scale: dict | None = None):
+        self.model, self.limit = model, limit
+        self.full_scale = full_scale or {}
+        self.vec = np.zeros(model.size)
+        self.chi2 = 0.0
+        self.done = 0  # fitted samples accounted for (positions in model.index)
+        self.every = max(1, int(CHECK_SHARE * model.index.size))
+        self.columns = [OUTPUT_COLUMNS.index(s) for s in model.signals]
+
+    def __call__(self, out: np.ndarray, k: int) -> bool:
+        """True when the residuals of the samples before ``k`` (final once a segment ends at ``k``) exceed the limit."""
+        m = self.model
+        j = int(np.searchsorted(m.index, k, side="left"))
+        if j - self.done < self.every:
+            return False
+        idx = m.index[self.done:j]
+        size = m.index.size
+        for i, (s, col) in enumerate(zip(m.signals, self.columns)):
+            scale = m.scale(s)
+            if not np.isscalar(scale):
+                scale = scale[self.done:j]
+            sim = out[idx, col] if s not in self.full_scale else clip_to_full_scale(out[idx, col], self.full_scale[s])
+            r = (m.recorded[s][idx] - sim) / scale
+            self.vec[i * size + self.done:i * size + j] = r
+            self.chi2 += float(np.dot(r, r))
+        self.done = j
+        return self.chi2 > self.limit * STOP_MARGIN
+
+
+def evaluate(model: ResidualModel, cfg: PlantConfig, setup: ReplaySetup, limit: float = math.inf) -> tuple[np.ndarray, dict | None, bool]:
+    """Run one replay; (normalised residual vector, replay or None when it diverged or stopped, stopped).
+
+    With a finite ``limit`` the replay stops at the first segment where its chi-square exceeds it
+    (``Bound``); the vector then holds the residuals so far, zeros beyond.
+    """
+    bound = Bound(model, limit, setup.full_scale) if math.isfinite(limit) else None
     try:
-        sim = run_replay(cfg, setup)
+        sim = run_replay(cfg, setup, stop=bound)
     except SimulationError:
-        return model.vector(None), None
-    return model.vector(sim), sim
+        return model.vector(None), None, False
+    if sim is None:
+        return bound.vec, None, True
+    return model.vector(sim), sim, False
 
 
 def signal_fit(model: ResidualModel, sim: dict | None, mask: np.ndarray | None = None) -> dict:

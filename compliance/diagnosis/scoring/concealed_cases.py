@@ -28,7 +28,7 @@ import numpy as np
 from compliance.model.config import PlantConfig
 from compliance.effects import EFFECTS
 from compliance.errors import SimulationError
-from compliance.diagnosis.evidence.operating_point import load_at_start
+from compliance.validation.replay_conditions import load_at_start
 from compliance.recordings.synth import PRACTICE_NOISE, practice_profile, synthesise
 from compliance.simulation import Scenario
 from compliance.plants import simulate
@@ -142,7 +142,7 @@ def _record(cfg_truth: PlantConfig, op: dict, seed: int, description: str):
 
     ref = practice_profile(op["x0"], cfg_truth.p("cylinder.stroke"))
     shifted = Profile(ref.times + PRE_ROLL, ref.values)
-    # the stated load is the load at the start position (evidence/operating_point.py), as a bench states it
+    # the stated load is the load at the start position (validation/replay_conditions.py), as a bench states it
     frame, meta = synthesise(cfg_truth, "practice", x0=op["x0"], load=load_at_start(cfg_truth, op["load"], op["x0"]),
                              kd=op["kd"], noise=PRACTICE_NOISE, seed=seed, description=description,
                              duration=30.0 + PRE_ROLL, reference=shifted)
@@ -159,17 +159,17 @@ def _record(cfg_truth: PlantConfig, op: dict, seed: int, description: str):
 def replay_visibility(cfg: PlantConfig, frame, meta, truth: PlantConfig | None = None) -> dict:
     """What the recording shows the nominal model: normalised RMS of its re-synchronised replay per
     signal, and (with ``truth``) the chi-square ratio truth / nominal (how much the true model explains)."""
-    from compliance.diagnosis.evidence.replay_fit import prepare_replay, replay_config, run_replay
+    from compliance.validation.replay import prepare_replay, run_replay
     from compliance.diagnosis.evidence.residuals import build_residual_model, signal_fit
 
     setup = prepare_replay(cfg, frame, meta)
-    rc = replay_config(cfg, setup)
+    rc = setup.config(cfg)
     model = build_residual_model(rc, setup)
     nom = run_replay(rc, setup)
     out = {s: v["rms_normalised"] for s, v in signal_fit(model, nom).items()}
     if truth is not None:
         vn = model.vector(nom)
-        vt = model.vector(run_replay(replay_config(truth, setup), setup))
+        vt = model.vector(run_replay(setup.config(truth), setup))
         out["truth_ratio"] = float(np.dot(vt, vt) / np.dot(vn, vn))
     return out
 

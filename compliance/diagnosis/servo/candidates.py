@@ -34,6 +34,21 @@ BASE_REFIT = (
 )
 
 
+# the meter-out throttles 2V2/2V3 are set on site at commissioning (docs/reference-plant.md): a site's needles sit
+# where its engineer left them, not at the plant file's values, so a test run with them installed may recalibrate
+# them, within a factor of 3 either way (a needle's few turns) and with the plant file's values as the prior
+THROTTLES = ("flow_control.opening_conductance", "flow_control.closing_conductance")
+THROTTLE_RANGE = 3.0
+
+
+def _throttle(cfg: PlantConfig, key: str) -> ParamHandle | None:
+    nominal = cfg.p(key)
+    if nominal <= 0.0:
+        return None
+    return replace(param_handle(key, "diagnosis"), low=nominal / THROTTLE_RANGE, high=nominal * THROTTLE_RANGE, log=True,
+                   nominal=nominal, prior=True)
+
+
 def effect_params(name: str) -> tuple[ParamHandle, ...]:
     """The declared parameters of an effect as fitted quantities (declared bounds, log scale, default)."""
     return tuple(param_handle(f"{name}.{p.name}", f"effect {name}") for p in EFFECTS[name].params)
@@ -63,11 +78,16 @@ def base_param(cfg: PlantConfig, key: str) -> ParamHandle | None:
     return replace(param_handle(key, "diagnosis"), low=lo, high=hi, log=log, nominal=nominal, prior=True)
 
 
-def base_params(cfg: PlantConfig, keys=BASE_REFIT) -> tuple[ParamHandle, ...]:
-    """The recalibratable base parameters that apply to ``cfg``."""
+def base_params(cfg: PlantConfig, keys=BASE_REFIT, throttles: bool = False) -> tuple[ParamHandle, ...]:
+    """The recalibratable base parameters that apply to ``cfg`` (with the flow-control throttles when the recording
+    ran with them installed: ``THROTTLES``)."""
     out = []
     for k in keys:
         fp = base_param(cfg, k)
+        if fp is not None:
+            out.append(fp)
+    for k in THROTTLES if throttles else ():
+        fp = _throttle(cfg, k)
         if fp is not None:
             out.append(fp)
     return tuple(out)

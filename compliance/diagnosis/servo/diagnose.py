@@ -28,7 +28,7 @@ from compliance.model.parameters import apply
 from compliance.effects import EFFECTS
 from compliance.errors import InputError, SimulationError
 from compliance.diagnosis.servo.candidates import Candidate, base_params, effect_candidate, signature_order
-from compliance.diagnosis.servo.fit import FitContext, FitResult, replays_bound, screen_level
+from compliance.diagnosis.servo.fit import FitContext, FitResult, competing, replays_bound, screen_level
 from compliance.diagnosis.servo.fitted_model import fitted_plant, save_fitted
 from compliance.diagnosis.servo.effect_sets import CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_enough, contributions, full_name, prune
 from compliance.diagnosis.evidence.discriminating_test import design_test
@@ -37,14 +37,14 @@ from compliance.diagnosis.servo.instrument_candidates import PREFIX, instrument_
 from compliance.diagnosis.verdicts.candidate_set import is_instrument
 from compliance.diagnosis.servo.lag_split import adopted_fit, split_scan
 from compliance.diagnosis.servo.friction_form import OPTION as FORM_OPTION, form_after_effects, friction_form_check
-from compliance.diagnosis.evidence.replay_fit import ReplaySetup, run_replay
+from compliance.validation.replay import ReplaySetup, run_replay
 from compliance.diagnosis.evidence.residuals import UNITS, null_recording, own_floor_objective, signal_fit
 from compliance.diagnosis.servo.selection import (AMBIGUOUS_BIC, EXPLAINED_ENOUGH, NOISE_TOLERANCE, RESIDUAL_LIMIT, ambiguity_set, honest,
                                          score_all, signals_left, verdict)
 from compliance.diagnosis.servo.report_data import SCHEMA, Diagnosis
 from compliance.diagnosis.evidence.locate_misfit import event_rms, mask_agreement, where_words
 from compliance.diagnosis.servo.parallel_fits import (ExtendSet, FitEffect, FitWithBase, RecalibrateBase, RefitSet, ScreenAddition,
-                                                     ValleyPoint)
+                                                     SecondStart, ValleyPoint)
 from compliance.diagnosis.verdicts.candidate_set import BASE, CandidateSet
 from compliance.diagnosis.verdicts.verdict import EXPLAINED, INCOMPLETE, DiagnosisVerdict
 from compliance.diagnosis.servo.stage import Stage, check_effects, prepare_recording
@@ -78,10 +78,11 @@ def _based_search(cfg: PlantConfig, frame, meta: dict, stride: int, jobs: int, n
 
 
 def _run(st: Stage, tasks) -> None:
-    for res, v in st.run_fits(tasks):
+    tasks = list(tasks)
+    for task, (res, v) in zip(tasks, st.run_fits(tasks)):
+        st.sims += res.sims - (task.first.sims if isinstance(task, SecondStart) else 0)  # a second start counts its first fit's too
         st.fits[res.name] = res
         st.vecs[res.name] = v
-        st.sims += res.sims
 
 
 def _fit_singles(st: Stage, names, recalibrate: bool) -> None:
@@ -99,6 +100,8 @@ def _fit_singles(st: Stage, names, recalibrate: bool) -> None:
     fits = [FitEffect(effect_candidate(e), screen) for e in signature_order(names, excess)]
     fits += [FitEffect(c, -math.inf if within else None) for c in instrument_candidates(st.model.signals, st.setup.closed_loop)]
     _run(st, tasks + sorted(fits, key=lambda t: -replays_bound(t.candidate)))  # the longest fits first
+    # a second local fit only where it can still matter: candidates within COMPETE of the best first fit
+    _run(st, [SecondStart(f) for f in competing([f for k, f in st.fits.items() if k != "nominal"]) if f.second_from])
     base_fit = st.fits.get("base")
     singles = [f for f in st.fits.values() if f.name != "nominal"]
     best = min(singles, key=lambda f: f.chi2, default=None)

@@ -96,7 +96,7 @@ def screen_addition(ctx: FitContext, current: FitResult, single: FitResult) -> t
     One task of the worker pool per effect.
     """
     params, starts = _start_points(current, single)
-    chis = scan_points(ctx, params, starts)
+    chis = scan_points(ctx, params, starts, keep=1.0)
     i = min(range(len(chis)), key=chis.__getitem__)
     return single.name, chis[i], starts[i], len(starts)
 
@@ -109,7 +109,7 @@ def extend_fit(ctx: FitContext, current: FitResult, single: FitResult, start: li
     """
     params, starts = _start_points(current, single)
     if start is None:
-        chis = scan_points(ctx, params, starts)
+        chis = scan_points(ctx, params, starts, keep=1.0)
         start = starts[min(range(len(chis)), key=chis.__getitem__)]
     name = full_name(CandidateSet.parse(current.name).effects + CandidateSet.parse(single.name).effects, params)
     return least_squares_fit(ctx, name, params, start, simplex_fev=SET_SIMPLEX_FEV)

@@ -25,6 +25,7 @@ below J^T J (the floors' own noise level).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -38,13 +39,16 @@ from compliance.effects import EFFECTS
 from compliance.errors import InputError
 from compliance.diagnosis.servo.candidates import Candidate
 from compliance.diagnosis.servo.instrument_candidates import instrumented
-from compliance.diagnosis.evidence.replay_fit import ReplaySetup
+from compliance.validation.replay import ReplaySetup
 from compliance.diagnosis.evidence.residuals import ResidualModel, evaluate
+from compliance.diagnosis.estimation.simplex import simplex_search
+from compliance.diagnosis.estimation.standard_errors import fit_errors
 
 DIFF_STEP = 0.01  # forward-difference step, 1 % of each parameter's (log) range
 MAX_NFEV = 6  # least-squares polishing evaluations (besides the Jacobian's)
 SIMPLEX_FEV = 16  # simplex evaluations per fitted parameter
-SECOND_START = 2.0  # a second local fit starts from a grid point within this chi-square ratio of the best
+SECOND_START = 2.0  # a second local fit starts from a grid point within this chi-square ratio of the best ...
+COMPETE = 2.0  # ... of a candidate whose first fit is within this ratio of the best candidate's (the others have lost)
 MEMO = 16  # replays a fit context remembers (each its residuals and simulated signals: ~2 MB for 30 s at 1 kHz)
 HAC_SECONDS = 1.0  # s; Newey-West bandwidth: residual correlation of about one stick-slip episode
 # share of the nominal excess chi-square an effect's best grid point must remove to be refined (our choice: a candidate
@@ -74,17 +78,24 @@ class FitContext:
     model: ResidualModel
     sims: int = 0
     memo: dict = field(default_factory=dict, repr=False)  # (keys, values) -> (residuals, replay): the latest MEMO
+    stopped: bool = False  # the last ``residual`` stopped its replay early
+    stopped_sims: int = 0  # replays stopped early (counted in ``sims`` too)
 
-    def residual(self, params, values) -> tuple[np.ndarray, dict | None]:
-        """Normalised data residuals of a parameter set, and the replay (None if it failed).
+    def residual(self, params, values, limit: float = math.inf) -> tuple[np.ndarray, dict | None]:
+        """Normalised data residuals of a parameter set, and the replay (None if it failed or stopped).
 
         Instrumentation parameters (``servo.instrument_candidates``) act on the logger model and on the
         states the re-synchronisations read (the plant's, not the instrument's). A parameter set
         replayed moments ago (a fit's best grid point where its simplex starts, the fitted values
         the caller replays again) is not replayed twice: values equal to 10 significant digits
         (a round trip through the fit's unit cube) give the same replay.
+
+        ``limit``: the caller only needs to know whether the chi-square exceeds it; the replay may
+        stop at the first segment where it does (``evidence.residuals.Bound``), and ``stopped`` says
+        so (the residuals after that segment are then zero).
         """
         key = (tuple(fp.key for fp in params), tuple(float(f"{v:.10g}") for v in values))
+        self.stopped = False
         if key in self.memo:
             return self.memo[key]
         setup = instrumented(self.setup, params, values)
@@ -93,8 +104,11 @@ class FitContext:
             cfg = apply(self.cfg, params, values)
         except InputError:
             return self.model.vector(None), None
-        out = evaluate(self.model, cfg, setup)
-        self.memo[key] = out
+        vec, sim, self.stopped = evaluate(self.model, cfg, setup, limit)
+        if self.stopped:
+            self.stopped_sims += 1
+            return vec, None
+        out = self.memo[key] = (vec, sim)
         while len(self.memo) > MEMO:
             self.memo.pop(next(iter(self.memo)))
         return out
@@ -135,6 +149,7 @@ class FitResult:
     message: str = ""
     scan: list = field(default_factory=list)
     cov: np.ndarray | None = None  # covariance of the fitted values [SI], from the final Jacobian
+    second_from: list | None = None  # start of a second local fit not run yet (``fit_candidate``'s ``second``)
 
     @property
     def k(self) -> int:
@@ -180,32 +195,35 @@ def chi2_parts(model: ResidualModel, vec: np.ndarray) -> tuple[float, dict]:
 
 
 def _objective(ctx: FitContext, params, cache: dict):
+    """``fun(u, limit)``: the residual vector (data, then priors) at the unit-cube point ``u``; with a finite ``limit``
+    on its sum of squares the replay may stop once it exceeds it (``FitContext.residual``)."""
     prior_idx = [i for i, fp in enumerate(params) if fp.prior]
 
-    def fun(u):
+    def fun(u, limit=math.inf):
         key = tuple(np.round(u, 12))
-        if key in cache:
-            return cache[key]
+        hit = cache.get(key)
+        if hit is not None and (hit[1] or float(np.dot(hit[0], hit[0])) > limit):
+            return hit[0]
         values = [fp.from_unit(x) for fp, x in zip(params, u)]
-        vec, _ = ctx.residual(params, values)
+        prior = [params[i].prior_residual(values[i]) for i in prior_idx]
+        vec, _ = ctx.residual(params, values, limit - sum(p * p for p in prior))
         if prior_idx:
-            vec = np.concatenate([vec, [params[i].prior_residual(values[i]) for i in prior_idx]])
-        cache[key] = vec
+            vec = np.concatenate([vec, prior])
+        cache[key] = (vec, not ctx.stopped)
         return vec
 
     return fun
 
 
 def _nelder_mead(fun, u0: np.ndarray, maxfev: int, step: float = 0.05) -> np.ndarray:
-    """Simplex search of sum(fun(u)^2) in the unit cube (points outside are clipped and penalised)."""
-    from scipy.optimize import minimize
-
+    """Simplex search of sum(fun(u)^2) in the unit cube (points outside are clipped and penalised; ``servo.simplex``)."""
     k = u0.size
 
-    def f(u):
+    def f(u, limit=math.inf):
         uc = np.clip(u, 0.0, 1.0)
-        out = float(np.dot(r := fun(uc), r))
-        return out * (1.0 + 10.0 * float(np.sum((u - uc) ** 2)))
+        pen = 1.0 + 10.0 * float(np.sum((u - uc) ** 2))
+        out = float(np.dot(r := fun(uc, limit / pen), r))
+        return out * pen
 
     simplex = [u0]
     for i in range(k):
@@ -214,9 +232,7 @@ def _nelder_mead(fun, u0: np.ndarray, maxfev: int, step: float = 0.05) -> np.nda
         simplex.append(v)
     f0 = f(u0)
     # stop when the simplex spans < 0.2 % of the range and its values differ by < 0.1 % (the roughness level)
-    res = minimize(f, u0, method="Nelder-Mead",
-                   options={"initial_simplex": np.array(simplex), "maxfev": maxfev, "xatol": 2e-3, "fatol": 1e-3 * f0})
-    return np.clip(res.x, 0.0, 1.0)
+    return np.clip(simplex_search(f, np.array(simplex), maxfev, xatol=2e-3, fatol=1e-3 * f0), 0.0, 1.0)
 
 
 def least_squares_fit(ctx: FitContext, name: str, params: tuple[ParamHandle, ...], start: list[float], *,
@@ -250,67 +266,28 @@ def least_squares_fit(ctx: FitContext, name: str, params: tuple[ParamHandle, ...
     chi2, parts = chi2_parts(ctx.model, vec)
     t_res = ctx.setup.time[ctx.model.index]
     dt_res = float(np.median(np.diff(t_res))) if t_res.size > 1 else 1.0
-    stderr, cov = _stderr(params, values, res.jac, n, ctx.model, vec, max(1, int(round(HAC_SECONDS / dt_res))))
+    stderr, cov = fit_errors(params, values, res.jac, n, ctx.model, vec, max(1, int(round(HAC_SECONDS / dt_res))))
     out = FitResult(name, tuple(params), values, stderr, chi2, parts, n, ctx.sims - sims0,
                     time.perf_counter() - t0, str(res.message))
     out.cov = cov
     return out
 
 
-def hac_information(jac_data: np.ndarray, vec: np.ndarray, model: ResidualModel, lag: int) -> np.ndarray:
-    """Newey-West (1987) estimate of the residual scores' covariance S, per signal block.
+def scan_points(ctx: FitContext, params, points: list[list[float]], keep: float | None = None) -> list[float]:
+    """Chi-square (data + prior) at each point of a scan (SI values per point).
 
-    Parameters
-    ----------
-    jac_data : ndarray (n, k)
-        Jacobian rows of the data residuals.
-    vec : ndarray (n,)
-        Data residuals (normalised).
-    model : ResidualModel
-        Gives the per-signal blocks (each a time series).
-    lag : int
-        Bandwidth L in residual samples (Bartlett weights 1 - l/(L + 1)).
+    ``keep``: only points within ``keep`` times the best so far matter to the caller (the argmin: 1;
+    a second start within ``SECOND_START`` of the best: that ratio); a replay stops once its point
+    is known to be beyond, and its value is then a lower bound above that level.
     """
-    k = jac_data.shape[1]
-    s = np.zeros((k, k))
-    # one block per signal; a joint model of several recordings (servo/joint_recordings.py) has blocks of its own lengths
-    sizes = getattr(model, "block_sizes", None) or [model.index.size] * len(model.signals)
-    start = 0
-    for m in sizes:
-        g = jac_data[start:start + m] * vec[start:start + m, None]
-        start += m
-        s += g.T @ g
-        for lg in range(1, min(lag, m - 1) + 1):
-            c = g[lg:].T @ g[:-lg]
-            s += (1.0 - lg / (lag + 1.0)) * (c + c.T)
-    return s
-
-
-def _stderr(params, values, jac, n, model, vec, lag: int) -> tuple[list[float], np.ndarray]:
-    """Standard errors [SI] and the covariance [SI] of the fitted values (Newey-West sandwich)."""
-    k = len(params)
-    jd, jp = jac[:n], jac[n:]  # data rows, prior rows (independent, unit variance)
-    try:
-        a_inv = np.linalg.pinv(jac.T @ jac)
-        s = hac_information(jd, vec, model, lag)
-        plain = jd.T @ jd
-        if np.trace(s) < np.trace(plain):
-            s = s * (np.trace(plain) / max(np.trace(s), 1e-300))  # never below the floors' noise
-        cov = a_inv @ (s + jp.T @ jp) @ a_inv
-    except np.linalg.LinAlgError:
-        cov = np.full((k, k), np.inf)
-    su = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-    d = np.array([fp.stderr(v, 1.0) for fp, v in zip(params, values)])  # dvalue/du (linear in sigma_u)
-    return [fp.stderr(v, float(x)) for fp, v, x in zip(params, values, su)], cov * np.outer(d, d)
-
-
-def scan_points(ctx: FitContext, params, points: list[list[float]]) -> list[float]:
-    """Chi-square (data + prior) at each point of a scan (SI values per point)."""
     out = []
+    best = math.inf
     for values in points:
-        vec, _ = ctx.residual(params, values)
         prior = sum(fp.prior_residual(v) ** 2 for fp, v in zip(params, values))
+        limit = keep * best - prior if keep is not None and math.isfinite(best) else math.inf
+        vec, _ = ctx.residual(params, values, limit)
         out.append(float(np.dot(vec, vec)) + prior)
+        best = min(best, out[-1])
     return out
 
 
@@ -323,7 +300,7 @@ def replays_bound(cand: Candidate) -> int:
 
 
 def fit_candidate(ctx: FitContext, cand: Candidate, base_fit: FitResult | None, *, max_nfev: int = MAX_NFEV,
-                  screen: float | None = None) -> FitResult:
+                  screen: float | None = None, second: bool = True) -> FitResult:
     """Fit one effect on top of the recalibrated base, co-fitting the recalibrated base parameters.
 
     The effect's grid is scanned with the base parameters at their recalibrated values; the
@@ -334,6 +311,10 @@ def fit_candidate(ctx: FitContext, cand: Candidate, base_fit: FitResult | None, 
 
     ``screen`` (a chi-square): when no grid point gets below it, the candidate is not refined and
     its result is the best grid point (``message`` says so; no standard errors).
+
+    ``second``: False leaves the second local fit to the caller (``second_start``), who runs it only
+    for a candidate that still competes once every first fit is known; the result's
+    ``second_from`` holds its start.
     """
     t0 = time.perf_counter()
     sims0 = ctx.sims
@@ -346,7 +327,7 @@ def fit_candidate(ctx: FitContext, cand: Candidate, base_fit: FitResult | None, 
     for g in grid:
         points.append([g.get(fp.name, d) for fp, d in zip(eparams, defaults)] + bvalues)
     all_params = tuple(eparams) + bparams
-    chis = scan_points(ctx, all_params, points)
+    chis = scan_points(ctx, all_params, points, keep=SECOND_START)
     best = int(np.argmin(chis))
     if screen is not None and chis[best] > screen:
         vec, _ = ctx.residual(all_params, points[best])
@@ -359,13 +340,34 @@ def fit_candidate(ctx: FitContext, cand: Candidate, base_fit: FitResult | None, 
     if len(eparams) > 1:
         others = [i for i in np.argsort(chis) if points[i][0] != points[best][0]]
         if others and chis[others[0]] <= SECOND_START * chis[best]:
-            alt = least_squares_fit(ctx, cand.name, all_params, points[others[0]], max_nfev=max_nfev)
-            if alt.chi2 < res.chi2:
-                res = alt
+            if second:
+                alt = least_squares_fit(ctx, cand.name, all_params, points[others[0]], max_nfev=max_nfev)
+                if alt.chi2 < res.chi2:
+                    res = alt
+            else:
+                res.second_from = list(points[others[0]])
     res.sims = ctx.sims - sims0
     res.seconds = time.perf_counter() - t0
     res.scan = [(dict(zip([fp.key for fp in all_params], p)), c) for p, c in zip(points, chis)]
     return res
 
 
-__all__ = ["FitContext", "FitResult", "fit_candidate", "replays_bound", "screen_level", "least_squares_fit", "scan_points", "chi2_parts"]
+def second_start(ctx: FitContext, first: FitResult, *, max_nfev: int = MAX_NFEV) -> FitResult:
+    """``first`` or the second local fit from ``first.second_from``, whichever fits better (``fit_candidate``)."""
+    t0 = time.perf_counter()
+    alt = least_squares_fit(ctx, first.name, first.params, first.second_from, max_nfev=max_nfev)
+    best = alt if alt.chi2 < first.chi2 else first
+    out = dataclasses.replace(best, sims=first.sims + alt.sims, seconds=first.seconds + time.perf_counter() - t0,
+                              second_from=None, scan=first.scan)
+    out.cov = best.cov
+    return out
+
+
+def competing(fits, factor: float = COMPETE) -> list:
+    """The fits that still compete: a chi-square within ``factor`` of the best one."""
+    finite = [f.chi2 for f in fits if math.isfinite(f.chi2)]
+    best = min(finite, default=math.inf)
+    return [f for f in fits if f.chi2 <= factor * best]
+
+
+__all__ = ["FitContext", "FitResult", "competing", "fit_candidate", "second_start", "replays_bound", "screen_level", "least_squares_fit", "scan_points", "chi2_parts"]

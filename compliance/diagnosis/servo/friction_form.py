@@ -35,7 +35,7 @@ from compliance.effects import EFFECTS
 from compliance.errors import InputError, SimulationError
 from compliance.diagnosis.servo.candidates import effect_candidate
 from compliance.diagnosis.servo.fit import chi2_parts
-from compliance.diagnosis.evidence.replay_fit import run_replay
+from compliance.validation.replay import run_replay
 from compliance.diagnosis.servo.selection import beats, score_all
 from compliance.diagnosis.servo.parallel_fits import FitEffect, run_fits
 

@@ -1,8 +1,10 @@
-"""Joint diagnosis of several closed-loop recordings of one plant: shared physics, each test's own conditions.
+"""Joint diagnosis of several recordings of one plant: shared physics, each test's own conditions.
 
 ``diagnose_joint(cfg, recordings)`` runs the single-recording engine's stages on each recording
-(``servo.diagnose.prepare_recording``: the replay with the recording's own load, start, supply pressure
-and controller gains from its sidecar, its noise floors) and then fits every candidate - the
+(``servo.diagnose.prepare_recording``: the replay with the recording's own load, start, supply pressure,
+controller gains, flow-control valves and loop switch from its sidecar, its noise floors; a closed-loop
+test, a full stroke driven by its valve command, a hold whose positioner went to manual: a site's
+commissioning tests) and then fits every candidate - the
 recalibration of base parameters and each declared effect - with *one* parameter set shared by
 all recordings. The objective is the sum of the per-recording chi-squares, each recording's
 residuals normalised by its own floors (``JointContext``); the information criteria count every
@@ -33,86 +35,18 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from compliance.effects import EFFECTS
 from compliance.errors import InputError
 from compliance.files.jsonable import json_number
 from compliance.model.config import PlantConfig, plant_from_dict
 from compliance.diagnosis.servo.candidates import base_params, effect_candidate, signature_order
-from compliance.diagnosis.servo.fit import FitContext, FitResult, chi2_parts, screen_level
+from compliance.diagnosis.servo.fit import FitContext, FitResult, chi2_parts, competing, least_squares_fit, screen_level
 from compliance.diagnosis.servo.report_data import SCHEMA
 from compliance.diagnosis.servo.selection import AMBIGUOUS_BIC, RESIDUAL_LIMIT, ambiguity_set, honest, score_all, verdict
 from compliance.diagnosis.verdicts.verdict import EXPLAINED, DiagnosisVerdict
-from compliance.diagnosis.servo.parallel_fits import FitEffect, RecalibrateBase
+from compliance.diagnosis.servo.parallel_fits import FitEffect, RecalibrateBase, RefitSet, SecondStart
+from compliance.diagnosis.estimation.joint_residuals import JointContext, JointModel
 
-
-
-@dataclass
-class JointModel:
-    """The residual models of several recordings as one: signal blocks labelled ``recording:signal``."""
-
-    parts: list
-    labels: list
-
-    @property
-    def size(self) -> int:
-        """Length of the stacked residual vector."""
-        return int(sum(p.size for p in self.parts))
-
-    @property
-    def signals(self) -> tuple:
-        """Block labels ``label:signal``, in vector order."""
-        return tuple(f"{lab}:{s}" for lab, p in zip(self.labels, self.parts) for s in p.signals)
-
-    @property
-    def block_sizes(self) -> list:
-        """Length of each block (a signal of one recording), for the per-block autocorrelation of ``servo.fit``."""
-        return [p.index.size for p in self.parts for _ in p.signals]
-
-    @property
-    def index(self) -> np.ndarray:
-        """The first recording's fitted samples (only their spacing is read: ``servo.fit.HAC_SECONDS`` in samples)."""
-        return self.parts[0].index
-
-    def split(self, vec: np.ndarray) -> dict:
-        """Block label -> its part of a residual vector."""
-        out, start = {}, 0
-        for lab, m in zip(self.signals, self.block_sizes):
-            out[lab] = vec[start:start + m]
-            start += m
-        return out
-
-
-@dataclass
-class JointContext:
-    """What every joint fit shares: one ``FitContext`` per recording (its own configuration, replay, floors)."""
-
-    contexts: list
-    labels: list
-    sims: int = 0
-
-    @property
-    def model(self) -> JointModel:
-        """The stacked residual model."""
-        return JointModel([c.model for c in self.contexts], self.labels)
-
-    @property
-    def setup(self):
-        """The first recording's replay (its time base gives the residual spacing)."""
-        return self.contexts[0].setup
-
-    @property
-    def cfg(self) -> PlantConfig:
-        """The first recording's configuration (nominal values of recalibrated parameters)."""
-        return self.contexts[0].cfg
-
-    def residual(self, params, values) -> tuple[np.ndarray, list | None]:
-        """Stacked normalised residuals of one shared parameter set (each recording replayed with its conditions)."""
-        vecs, sims = [], []
-        for c in self.contexts:
-            v, s = c.residual(params, values)
-            vecs.append(v)
-            sims.append(s)
-        self.sims += len(self.contexts)
-        return np.concatenate(vecs), (None if any(s is None for s in sims) else sims)
 
 
 def _joint_context(labels, parts) -> JointContext:
@@ -203,16 +137,75 @@ def _stages(cfg: PlantConfig, recordings, stride: int, jobs, scheduler) -> tuple
     from compliance.campaign.executor import warm_up
     from compliance.processes import map_tasks
 
-    for i, (frame, meta) in enumerate(recordings, 1):
-        if "reference" not in frame.columns:
-            raise InputError(f"{meta.get('source_path', f'recording {i}')}: a joint diagnosis needs closed-loop recordings "
-                             "(a 'reference' column); diagnose an open-loop recording on its own")
     warm_up(cfg)  # the compiled core loaded once, before the workers fork
     stages, stats = map_tasks(_prepare_task, (cfg, stride), list(recordings), workers=jobs, scheduler=scheduler,
                               progress=False, label="replays", retries=0)
     if stats.failed:  # bad input (InputError) is raised by the executor itself; this is a bug
         raise RuntimeError(f"replay of recording {stats.errors[0][0] + 1} failed: {stats.errors[0][1]}")
     return stages, [f"R{i}" for i in range(1, len(stages) + 1)]
+
+
+def _throttled(cfg: PlantConfig, setup) -> bool:
+    return cfg.flow_control_installed if setup.flow_control is None else bool(setup.flow_control)
+
+
+def _commissioned(cfg: PlantConfig, stages, labels, recordings, stride: int, jobs, scheduler):
+    """The site's flow-control throttles fitted on the full strokes that ran with them, and the stages on them.
+
+    A site's needles 2V2/2V3 sit where its commissioning engineer left them (``servo.candidates.THROTTLES``),
+    and a full stroke's open-loop replay integrates a few per cent of throttle error into millimetres: left
+    at the plant file's values they would hold most of every stroke's residual and each candidate would be
+    judged on them. They are test conditions, like the supply pressure: fitted first (one shared pair,
+    priors on the file's values), and every candidate is then fitted on top.
+
+    Returns
+    -------
+    (PlantConfig, list, FitResult or None)
+        The configuration with the fitted throttles (unchanged when no full stroke ran with them or
+        the fit does not improve on the file's values), its stages, the fit.
+    """
+    from compliance.model.config import plant_to_toml
+    from compliance.model.parameters import apply
+
+    # the tests the throttles are commissioned by: full strokes at full command, driven by it (IEC 60308 stroke times);
+    # elsewhere (a hold at null, small steps) they barely act, and fitted there they would wander to their bounds
+    chosen = [i for i, st in enumerate(stages) if _throttled(cfg, st.setup) and not st.setup.closed_loop]
+    params = base_params(cfg, keys=(), throttles=True)
+    if not chosen or not params:
+        return cfg, stages, None
+    ctx = _joint_context([labels[i] for i in chosen], [(plant_to_toml(stages[i].rc), stages[i].setup, stages[i].model)
+                                                       for i in chosen])
+    fit = least_squares_fit(ctx, "flow_control", params, [fp.nominal for fp in params])
+    fit.sims = ctx.sims
+    if not fit.chi2 < sum(stages[i].fits["nominal"].chi2 for i in chosen):
+        return cfg, stages, fit
+    cfg = apply(cfg, params, fit.values)
+    stages, _ = _stages(cfg, recordings, stride, jobs, scheduler)
+    return cfg, stages, fit
+
+
+def _with_settings(fits: dict, settings, stages, labels, jobs, scheduler) -> None:
+    """Each effect that still competes refitted together with the site's throttles (in place, when that fits better):
+    the throttles were fitted on the nominal plant, and an effect that changes a stroke moves them too. The refits
+    run on the workers, one task each."""
+    from compliance.model.config import plant_to_toml
+    from compliance.processes import PerProcess, map_tasks
+
+    if settings is None or not settings.params:
+        return
+    rivals = competing([f for k, f in fits.items() if k in EFFECTS])
+    tasks = [RefitSet(f.name, tuple(f.params) + tuple(settings.params), list(f.values) + list(settings.values)) for f in rivals]
+    if not tasks:
+        return
+    payload = PerProcess(_joint_context, tuple(labels), [(plant_to_toml(s.rc), s.setup, s.model) for s in stages])
+    results, stats = map_tasks(_task, payload, tasks, workers=jobs, scheduler=scheduler, progress=False,
+                               label="joint fits", retries=1)
+    if stats.failed:
+        raise RuntimeError(f"joint fit failed: {stats.errors[0][1]}")
+    for f, res in zip(rivals, results):
+        res.sims += f.sims
+        if res.chi2 < f.chi2:
+            fits[f.name] = res
 
 
 def _fit_all(stages, labels, names, recalibrate, jobs, scheduler) -> tuple[dict, object]:
@@ -238,12 +231,21 @@ def _fit_all(stages, labels, names, recalibrate, jobs, scheduler) -> tuple[dict,
                                label="joint fits", retries=1)
     if stats.failed:
         raise RuntimeError(f"joint fit failed: {stats.errors[0][1]}")
-    return {res.name: res for res in results}, stats
+    fits = {res.name: res for res in results}
+    # a second local fit only where it can still matter (servo.fit.competing)
+    second = [SecondStart(f) for f in competing(list(fits.values())) if f.second_from]
+    if second:
+        more, stats2 = map_tasks(_task, payload, second, workers=jobs, scheduler=scheduler, progress=False,
+                                 label="joint fits", retries=1)
+        if stats2.failed:
+            raise RuntimeError(f"joint fit failed: {stats2.errors[0][1]}")
+        fits.update({res.name: res for res in more})
+    return fits, stats
 
 
 def diagnose_joint(cfg: PlantConfig, recordings, *, effects=None, jobs: int | None = None, scheduler: str | None = None,
                    stride: int = 5, recalibrate: bool | tuple = True) -> JointDiagnosis:
-    """Diagnose several closed-loop recordings of one plant together (see the module docstring).
+    """Diagnose several recordings of one plant together (see the module docstring).
 
     Parameters
     ----------
@@ -265,7 +267,7 @@ def diagnose_joint(cfg: PlantConfig, recordings, *, effects=None, jobs: int | No
     Raises
     ------
     InputError
-        No recording, an open-loop recording, an unknown effect, a recording the replay cannot use.
+        No recording, an unknown effect, a recording the replay cannot use.
     """
     from compliance.diagnosis.servo.stage import check_effects
 
@@ -274,7 +276,9 @@ def diagnose_joint(cfg: PlantConfig, recordings, *, effects=None, jobs: int | No
         raise InputError("a joint diagnosis needs at least one recording")
     names = check_effects(cfg, effects)
     stages, labels = _stages(cfg, recordings, stride, jobs, scheduler)
+    cfg, stages, settings = _commissioned(cfg, stages, labels, recordings, stride, jobs, scheduler)
     fits, stats = _fit_all(stages, labels, names, recalibrate, jobs, scheduler)
+    _with_settings(fits, settings, stages, labels, jobs, scheduler)
     model = JointModel([s.model for s in stages], labels)
     n = model.size
     nvec = np.concatenate([s.nvec for s in stages])
@@ -296,6 +300,10 @@ def diagnose_joint(cfg: PlantConfig, recordings, *, effects=None, jobs: int | No
             for lab, s in zip(labels, stages)]
     sims = sum(s.sims for s in stages) + sum(f.sims for k, f in fits.items() if k != "nominal")
     notes = [f"{lab}: {note}" for lab, s in zip(labels, stages) for note in s.setup.notes]
+    if settings is not None:
+        sims += settings.sims
+        notes.insert(0, "the flow-control throttles as commissioned on site, fitted first on the full strokes that ran with them: "
+                     + ", ".join(f"{fp.key} = {v:.4g} {fp.unit}" for fp, v in zip(settings.params, settings.values)))
     return JointDiagnosis(verdict_name, reason, winner, ambiguous, fits, scores, objectives, recs, n,
                           time.perf_counter() - t0, sims, stats.workers, stats.backend, notes)
 
@@ -328,4 +336,4 @@ def format_joint(d: dict, quiet: bool = False) -> str:
     return "\n".join(lines)
 
 
-__all__ = ["JointContext", "JointDiagnosis", "JointModel", "diagnose_joint", "format_joint"]
+__all__ = ["JointDiagnosis", "diagnose_joint", "format_joint"]

@@ -15,7 +15,7 @@ run of such values around the fit). When it spans more than a factor ``PINNED_SP
 the interval instead of presenting the fitted split as measured.
 
 Inside an undetermined interval the split is estimated by the segments, not by the pooled
-chi-square: every re-synchronised segment of the replay (``evidence.replay_fit``) shows the lag in its
+chi-square: every re-synchronised segment of the replay (``validation.replay``) shows the lag in its
 transient, but a few segments where a stick-slip event happens or not on a model-form detail
 (a slip in the replay that the bench did not make) can hold most of the pooled chi-square and
 pull the pooled optimum along the valley. Each valley point is therefore also scored by least

@@ -3,7 +3,7 @@
 The recording's replay set-up and residual model are the executor's context, built into a
 ``FitContext`` once per worker process (:class:`~compliance.processes.PerProcess`); each task is a
 small frozen record of what to fit (``RecalibrateBase``, ``FitEffect``, ``FitWithBase``, ``ExtendSet``,
-``RefitSet``), to screen (``ScreenAddition``) or a point of a lag's valley to replay (``ValleyPoint``), run by
+``RefitSet``, ``SecondStart``), to screen (``ScreenAddition``) or a point of a lag's valley to replay (``ValleyPoint``), run by
 ``_run_task``.
 """
 
@@ -15,11 +15,11 @@ from dataclasses import dataclass
 from compliance.model.config import plant_from_dict
 from compliance.diagnosis.servo.candidates import Candidate
 from compliance.model.parameters import ParamHandle
-from compliance.diagnosis.servo.fit import FitContext, FitResult, fit_candidate, least_squares_fit
+from compliance.diagnosis.servo.fit import FitContext, FitResult, fit_candidate, least_squares_fit, second_start
 from compliance.diagnosis.servo.recalibration import forward_select_base
 from compliance.diagnosis.servo.effect_sets import SET_SIMPLEX_FEV, extend_fit, screen_addition
 from compliance.diagnosis.servo.lag_split import valley_point
-from compliance.diagnosis.evidence.replay_fit import ReplaySetup
+from compliance.validation.replay import ReplaySetup
 from compliance.processes import PerProcess, map_tasks
 
 
@@ -38,13 +38,24 @@ class RecalibrateBase:
 
 @dataclass(frozen=True)
 class FitEffect:
-    """One candidate on the nominal plant; not refined when no grid point gets below ``screen`` (a chi-square)."""
+    """One candidate on the nominal plant; not refined when no grid point gets below ``screen`` (a chi-square).
+    Its second local fit, if any, is left to a ``SecondStart`` task (``second_from``)."""
 
     candidate: Candidate
     screen: float | None = None
 
     def fit(self, ctx: FitContext) -> FitResult:
-        return fit_candidate(ctx, self.candidate, None, screen=self.screen)
+        return fit_candidate(ctx, self.candidate, None, screen=self.screen, second=False)
+
+
+@dataclass(frozen=True)
+class SecondStart:
+    """The second local fit of a candidate that still competes (``fit.second_start``)."""
+
+    first: FitResult
+
+    def fit(self, ctx: FitContext) -> FitResult:
+        return second_start(ctx, self.first)
 
 
 @dataclass(frozen=True)
@@ -140,4 +151,5 @@ def run_fits(tasks, jobs: int, payload, scheduler: str | None = None, client=Non
     return results
 
 
-__all__ = ["ExtendSet", "FitEffect", "FitWithBase", "RecalibrateBase", "RefitSet", "ScreenAddition", "ValleyPoint", "run_fits"]
+__all__ = ["ExtendSet", "FitEffect", "FitWithBase", "RecalibrateBase", "RefitSet", "ScreenAddition", "SecondStart", "ValleyPoint",
+           "run_fits"]

@@ -9,7 +9,10 @@ parameters are refitted together (``servo.fit.least_squares_fit``, with their pr
 
 from __future__ import annotations
 
+import math
 import time
+
+import numpy as np
 
 from compliance.model.parameters import ParamHandle
 from compliance.diagnosis.servo.candidates import base_scan_values
@@ -23,18 +26,20 @@ AT_FLOOR = 1.2  # chi2/N at which the recalibration stops: the fit is at the noi
 
 
 def forward_select_base(ctx: FitContext, params: tuple[ParamHandle, ...], *, penalty: float, max_params: int = 2,
-                        max_nfev: int = MAX_NFEV, map_fn=None) -> tuple[FitResult, list[dict]]:
+                        max_nfev: int = MAX_NFEV) -> tuple[FitResult, list[dict]]:
     """Greedy recalibration: add the base parameter whose 1-D scan helps most, refit, repeat.
 
     A parameter joins only when it lowers chi-square by more than ``penalty`` (the information
-    criterion's price of one parameter). ``map_fn`` may run the scans in parallel.
+    criterion's price of one parameter). Only the ``REFINE_TOP`` parameters whose scans reach lowest
+    matter to a round, so a scan replay stops once its point is beyond the ``REFINE_TOP``-th best
+    parameter so far (``_scan``); a parameter whose every point stopped keeps a lower bound above
+    that level, and the round chooses as it would with full replays.
 
     Returns
     -------
     (FitResult, list of dict)
         The recalibration (possibly with no parameters) and the log of each round.
     """
-    map_fn = map_fn or default_map
     t0 = time.perf_counter()
     sims0 = ctx.sims
     chosen: list[ParamHandle] = []
@@ -50,11 +55,7 @@ def forward_select_base(ctx: FitContext, params: tuple[ParamHandle, ...], *, pen
                 trials.append((fp, tuple(chosen) + (fp,), values + [v]))
         if not trials:
             break
-        chis = list(map_fn(_scan_task, [(tp, tv) for _, tp, tv in trials], ctx=ctx))
-        best_by_param: dict[str, tuple[float, float, ParamHandle]] = {}
-        for (fp, tp, tv), c in zip(trials, chis):
-            if fp.key not in best_by_param or c < best_by_param[fp.key][0]:
-                best_by_param[fp.key] = (c, tv[-1], fp)
+        best_by_param = _scan(ctx, trials)
         # refine the most promising parameters in 1-D before choosing: a coarse scan point can
         # miss a 25 % miscalibration and hand the round to a parameter that only mimics it
         for key in sorted(best_by_param, key=lambda k: best_by_param[k][0])[:REFINE_TOP]:
@@ -98,14 +99,19 @@ def _refine_1d(ctx: FitContext, chosen: tuple, values: list, fp: ParamHandle, st
     return float(res.fun), fp.from_unit(res.x)
 
 
-def _scan_task(item, ctx: FitContext) -> float:
-    params, values = item
-    return scan_points(ctx, params, [list(values)])[0]
+def _scan(ctx: FitContext, trials: list) -> dict[str, tuple[float, float, ParamHandle]]:
+    """Parameter key -> (its scan's lowest chi-square + prior, that value, the parameter) over ``trials``
+    ((parameter, parameters, values) each), each replay stopped once beyond the ``REFINE_TOP``-th best parameter."""
+    best: dict[str, tuple[float, float, ParamHandle]] = {}
+    for fp, tp, tv in trials:
+        ranked = sorted(b[0] for b in best.values())
+        limit = ranked[REFINE_TOP - 1] if len(ranked) >= REFINE_TOP else math.inf
+        prior = sum(f.prior_residual(v) ** 2 for f, v in zip(tp, tv))
+        vec, _ = ctx.residual(tp, list(tv), limit - prior)
+        c = float(np.dot(vec, vec)) + prior
+        if fp.key not in best or c < best[fp.key][0]:
+            best[fp.key] = (c, tv[-1], fp)
+    return best
 
 
-def default_map(fn, items, ctx):
-    """Serial map with a context argument (the engine passes a parallel one)."""
-    return [fn(it, ctx=ctx) for it in items]
-
-
-__all__ = ["forward_select_base", "default_map", "JOIN_GAIN", "AT_FLOOR"]
+__all__ = ["forward_select_base", "JOIN_GAIN", "AT_FLOOR"]

@@ -17,7 +17,7 @@ from compliance.effects import EFFECTS
 from compliance.errors import InputError
 from compliance.diagnosis.servo.fit import FitResult, chi2_parts
 from compliance.diagnosis.servo.parallel_fits import run_fits
-from compliance.diagnosis.evidence.replay_fit import ReplaySetup, prepare_replay, replay_config, run_replay
+from compliance.validation.replay import ReplaySetup, prepare_replay, run_replay
 from compliance.diagnosis.evidence.residuals import build_residual_model, signal_fit, with_fail_level
 from compliance.diagnosis.evidence.locate_misfit import locate_mismatch
 from compliance.plants import kind_of
@@ -64,7 +64,7 @@ def prepare_recording(cfg: PlantConfig, frame, meta: dict, stride: int, jobs: in
     """Stages 1-2: the nominal replay, floors, located windows (``sims``: replays already run for this diagnosis;
     ``client``: the run's Dask client, None for the local pool)."""
     setup = prepare_replay(cfg, frame, meta)
-    rc = replay_config(cfg, setup)
+    rc = setup.config(cfg)
     nominal_sim = run_replay(rc, setup)
     model = build_residual_model(rc, setup, stride=stride, nominal=nominal_sim)
     model = with_fail_level(model, model.vector(nominal_sim))
