@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import sys
 
-from compliance.cli.common import add_jobs, add_outputs, add_parser, add_quiet, check_args_outputs
+from compliance.cli.common import add_allow_conflicts, add_jobs, add_outputs, add_parser, add_quiet, check_args_outputs
+from compliance.errors import InputError
 
 
 def register(subparsers):
@@ -30,14 +31,17 @@ def register(subparsers):
     )
     p.add_argument("requirements", metavar="REQUIREMENTS", help="requirement file: a TOML file or a shipped name")
     p.add_argument("--duty", required=True, metavar="DUTY.toml", help="the duty (schema govcheck-duty/1, docs/sizing.md)")
-    p.add_argument("--out", metavar="FILE.toml", help="write the proposed configuration here")
-    p.add_argument("--no-check", action="store_true", help="propose only; do not run the campaign")
+    p.add_argument("--out", metavar="FILE.toml", help="write the proposed configuration here (when the run has finished; "
+                                                     "never over the duty, its template or the requirement file)")
+    p.add_argument("--no-check", action="store_true", help="propose only; do not run the campaign (no results: takes no "
+                                                          "--json, --remedies or --jobs)")
     p.add_argument("--remedies", action="store_const", const="default", default=None,
                    help="hand the proposal to the remedies search (as `govcheck check --remedies`)")
     from compliance.cli.sweep import add_remedies_options
 
     add_remedies_options(p)
     add_outputs(p, "json")
+    add_allow_conflicts(p)
     add_jobs(p)
     add_quiet(p, "print only the verdict line")
     return p
@@ -73,19 +77,52 @@ def _sizing_text(rec: dict, rounds: list) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _refuse_unused(args) -> None:
+    """With --no-check nothing is checked, so an option that shapes the check would do nothing: refused."""
+    if not args.no_check:
+        return
+    for flag, value in (("--json", args.json), ("--remedies", args.remedies), ("--jobs", args.jobs),
+                        ("--save-remedy", args.save_remedy), ("--catalogue", args.catalogue),
+                        ("--yield-units", args.yield_units), ("--scheduler", args.scheduler),
+                        ("--remedies-state", args.remedies_state)):
+        if value is not None:
+            raise InputError(f"{flag} does nothing with --no-check (the proposal is not checked, so there are no results); "
+                             f"drop {flag} or --no-check")
+
+
+def _sized_configuration(cfg, out: str | None):
+    """The proposal as it will be written (rendered to TOML and read back: what is checked is what is saved)."""
+    import hashlib
+    import tomllib
+
+    from compliance.model.config import plant_from_dict, plant_to_toml
+
+    text = plant_to_toml(cfg)
+    return plant_from_dict(tomllib.loads(text), out or "<sized configuration>", hashlib.sha256(text.encode()).hexdigest()), text
+
+
 def run(args) -> int:
-    """Size, set the governor, check (stepping the cylinders up when needed), write; optionally search remedies."""
+    """Size, set the governor, check (stepping the cylinders up when needed), optionally search remedies, then write.
+
+    Every input and output is checked first; the proposal (--out) is written only when the run has
+    finished, so an interrupted or failed run leaves nothing behind.
+    """
+    from compliance.cli.common import checked_requirements
     from compliance.cli.sweep import check_remedies_options, remedies_kwargs, save_remedy
-    from compliance.model.config import load_plant, save_plant
-    from compliance.requirements.loading import load_requirements
+    from compliance.files.atomic import write_text_atomic
+    from compliance.files.shipped import resolve_shipped
+    from compliance.model.config import load_plant
     from compliance.sweep.sizing.duty_file import load_duty
     from compliance.sweep.sizing.size_servo import size_and_check, size_servo, time_constant_target
 
-    check_args_outputs(args, (args.out, "--out", (".toml",)), (args.save_remedy, "--save-remedy", (".toml",)))
+    _refuse_unused(args)
     check_remedies_options(args)
     duty = load_duty(args.duty)
-    reqset = load_requirements(args.requirements)
+    template_path = resolve_shipped(duty.template, "plant")
+    check_args_outputs(args, (args.out, "--out", (".toml",)), (args.save_remedy, "--save-remedy", (".toml",)),
+                       inputs={str(template_path): f"the template of {args.duty}", args.duty: "--duty"})
     template = load_plant(duty.template)
+    reqset = checked_requirements(args.requirements, [duty.stroke], args)  # before any simulation
     if args.no_check:
         from compliance.sweep.sizing.governor_design import design_governor
 
@@ -94,38 +131,37 @@ def run(args) -> int:
         if not args.quiet:
             sys.stdout.write(_sizing_text(rec, [{}]))
         if args.out:
-            save_plant(cfg, args.out, overwrite=True)
+            write_text_atomic(args.out, _sized_configuration(cfg, args.out)[1])
         return 0
     from compliance.campaign.results_files import summary_table
+    from compliance.pipeline.chain import Check, remedy_search
+    from compliance.results.check_result import CheckResult
 
     cfg, rec, results, rounds = size_and_check(duty, template, reqset, workers=args.jobs, progress=not args.quiet)
     if not args.quiet:
         sys.stdout.write(_sizing_text(rec, rounds))
-    if args.out:
-        save_plant(cfg, args.out, overwrite=True)
-        cfg = load_plant(args.out)
+    cfg, text = _sized_configuration(cfg, args.out)  # what is judged is what --out will hold, written at the end
     from compliance.campaign.uncertainty import ranged_parameters
-    from compliance.results.check_result import CheckResult
 
     if ranged_parameters(cfg):  # judged as `govcheck check` will judge the written file: with the bands of its declared ranges
-        from compliance.pipeline.chain import check
-
-        results = check(cfg, reqset, uncertainty="local", jobs=args.jobs, progress=not args.quiet)
+        prepared = Check.of(cfg, reqset, uncertainty="local", allow_conflicts=args.allow_conflicts)
+        results = prepared.run(jobs=args.jobs, progress=not args.quiet)
     else:
         results = CheckResult.of(results)
     results = results.with_(sizing={"duty": duty.path, "record": rec, "rounds": rounds})
     if args.remedies:
-        from compliance.pipeline.chain import remedy_search
-
         results = results.with_(remedies=remedy_search(cfg, reqset, "default", jobs=args.jobs, progress=not args.quiet,
                                                        **remedies_kwargs(args)))
-        save_remedy(args, cfg, results.remedies)
     table = summary_table(results)
     sys.stdout.write(table.rstrip().splitlines()[-1] + "\n" if args.quiet else table)
     if args.remedies and not args.quiet:
         from compliance.sweep.summary_text import remedies_markdown
 
         sys.stdout.write("\n" + remedies_markdown(results.remedies))
+    if args.out:
+        write_text_atomic(args.out, text)
+    if args.remedies:
+        save_remedy(args, cfg, results.remedies)
     if args.json:
         results.to_json(args.json)
     return 0 if results.passed else 1

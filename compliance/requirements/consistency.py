@@ -150,6 +150,50 @@ def _tau_vs_rate_limit(reqset, stroke, tau_req, v_req) -> list[dict]:
     return out
 
 
+def _interval(req, stroke):
+    """(low, high, low strict, high strict) of the values ``req`` admits (SI); None for an open side."""
+    lim = req.resolved_limit(stroke)
+    c = req.comparator
+    if c == "within":
+        return lim[0], lim[-1], False, False
+    if c in ("<=", "<"):
+        return None, lim[0], False, c == "<"
+    if c in (">=", ">"):
+        return lim[0], None, c == ">", False
+    return None, None, False, False
+
+
+def _shared_cases(a, b) -> list[tuple[str, str]]:
+    """(procedure, operating point) pairs both requirements judge (a point a requirement declares not applicable is left out)."""
+    return [(p, o) for p in a.procedures if p in b.procedures for o in a.operating_points
+            if o in b.operating_points and o not in a.not_applicable and o not in b.not_applicable]
+
+
+def _disjoint_windows(stroke, a, b) -> list[dict]:
+    """Two limits on the same metric and reading whose admissible intervals do not overlap (``conflict``)."""
+    if a.metric != b.metric or a.source != b.source or a.options != b.options:
+        return []
+    cases = _shared_cases(a, b)
+    if not cases:
+        return []
+    lo_a, hi_a, slo_a, shi_a = _interval(a, stroke)
+    lo_b, hi_b, slo_b, shi_b = _interval(b, stroke)
+    los = [(v, s) for v, s in ((lo_a, slo_a), (lo_b, slo_b)) if v is not None]
+    his = [(v, s) for v, s in ((hi_a, shi_a), (hi_b, shi_b)) if v is not None]
+    if not los or not his:
+        return []
+    lo, lo_strict = max(los, key=lambda x: (x[0], x[1]))
+    hi, hi_strict = min(his, key=lambda x: (x[0], not x[1]))
+    if lo < hi or (lo == hi and not (lo_strict or hi_strict)):
+        return []
+    p, o = cases[0]
+    more = f" (and {len(cases) - 1} more)" if len(cases) > 1 else ""
+    return [_finding(CONFLICT, a, b, p, low=lo, high=hi, text=(
+        f"{a.id} ({a.metric} {a.limit_text}) and {b.id} ({b.metric} {b.limit_text}) judge the same {a.metric} on {p} at "
+        f"{o}{more}, and no value lies in both: together they admit only values >= {lo:.6g} and <= {hi:.6g} (SI), "
+        "an empty window"))]
+
+
 def consistency_findings(reqset, stroke: float) -> list[dict]:
     """Every pair of limits in ``reqset`` that cannot hold together or narrow each other.
 
@@ -167,6 +211,9 @@ def consistency_findings(reqset, stroke: float) -> list[dict]:
     """
     reqs = [r for r in reqset.requirements if r.enabled and r.limit is not None]
     out = []
+    for i, a in enumerate(reqs):
+        for b in reqs[i + 1:]:
+            out += _disjoint_windows(stroke, a, b)
     for a in reqs:
         for b in reqs:
             if b.metric not in _SPEEDS:
