@@ -76,7 +76,7 @@ def basis(result: CheckResult) -> dict:
                      "(section 6)")
     else:
         validated = "not validated: no recording of this servo was compared with the model"
-    bases = Counter(str(e.basis) for e in result.requirements if e.basis)
+    bases = Counter(str(e.basis) for e in result.requirements if e.basis and e.limit is not None)  # open ones: no verdict
     return {"model": plant.name, "params": ", ".join(parts), "n_params": sum(counts.values()),
             "n_unused": len(plant.parameters) - len(used), "assumed": counts.get("assumed", 0),
             "effects": [e.name for e in plant.effects], "fitted": fitted, "validated": validated,

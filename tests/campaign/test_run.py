@@ -220,7 +220,12 @@ def test_plant_a_against_shpp_end_to_end(tmp_path, capsys):
     # flagged; the same servo at the rated 12 kN over the whole stroke is a stated variant (advisory)
     for rid in ("IEC61362-TCLOSE", "IEEE125-TCLOSE"):
         row = [x for x in {e["id"]: e for e in r["requirements"]}[rid]["rows"] if x["run"] == "full-stroke@in-service"][0]
-        assert 5.25 < row["value"] < 6.5 and row["status"] == "fail" and row["basis"] == "assumed"
+        assert 5.25 < row["value"] < 6.5 and row["basis"] == "assumed"
+        # the point value fails; FAIL only when its whole band does (the stroke's start charge is assumed: a
+        # band reaching back inside 4.75-5.25 s makes the row UNCERTAIN, with its deciding assumption named)
+        band = row["band"]
+        assert band["low"] <= row["value"] <= band["high"]
+        assert row["status"] == ("fail" if band["low"] > 5.25 else "uncertain") and band["deciding"]
         assert row["flag"].startswith("no straight part")
         assert not [x for x in {e["id"]: e for e in r["requirements"]}[rid]["rows"] if x["run"] == "full-stroke@region2-80"]
     const = [x for x in {e["id"]: e for e in r["requirements"]}["SHPP-TCLOSE-CONST"]["rows"] if x["run"] == "full-stroke@region2-80"][0]
