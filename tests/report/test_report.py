@@ -272,7 +272,7 @@ def test_page_one_states_basis_failures_and_not_evaluated(pdf_text):
     assert "open requirements (no limit) are not counted" in p1
     for rid in res["summary"]["failed"]:
         assert rid in p1, rid
-    assert "What would make it pass: not searched (govcheck check --remedies)" in p1  # no remedies in the results: says so, in words
+    assert "What would make it pass: not searched (the remedies search was not run)" in p1  # no remedies in the results: says so, in words
     assert res["plant"]["digest"][:16] in p1.replace(" ", "")
     assert "Accepted for the plant owner" in p1
 
