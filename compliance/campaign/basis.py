@@ -71,7 +71,11 @@ def row_basis(cfg, reqset, req, row) -> tuple[Basis, str]:
     proc = reqset.procedures.get(row["procedure"])
     fc = proc.settings.get("flow_control", True) if proc is not None and proc.kind == "full_stroke" else op.flow_control
     installed = cfg.flow_control_installed if fc is None else bool(fc)
-    found = _derived(cfg, op, installed, _stroke_metric(req, row))
+    limiter_sets = (proc is not None and proc.kind == "full_stroke" and proc.settings.get("drive") == "governor"
+                    and op.setpoint_limiter is not False and getattr(cfg, "setpoint_rate_limited", False))
+    # with the governor's rate limiter setting the stroke rate the throttles are its backstop: the time is the
+    # model's prediction of how the gate follows the limited set-point under this load, not the derivation's target
+    found = None if limiter_sets else _derived(cfg, op, installed, _stroke_metric(req, row))
     if found:
         key, der = found
         return Basis.BY_CONSTRUCTION, (
@@ -79,6 +83,12 @@ def row_basis(cfg, reqset, req, row) -> tuple[Basis, str]:
             f"{der['load_text']}: at this load the figure is the derivation's target, not evidence; measure the stroke")
     if req.metric == "cross_adjustment_change":
         on = [e for e in _COUPLING_EFFECTS if e in cfg.effects]
+        picked = next((s for s in row.get("samples") or [] if s.get("label") == row.get("which")), None)
+        if picked and (picked.get("detail") or {}).get("device") == "limiter":
+            return Basis.MODELLED, (
+                f"the governor's set-point rate limiter sets each direction's rate separately; the model changed "
+                f"{picked['detail'].get('parameter')} and ran both strokes again under this load: the other direction's "
+                "time is the model's prediction (nothing in the controller couples the two rates)")
         if not on:
             return Basis.BY_CONSTRUCTION, (
                 "the model's supply is ideal (no supply_droop or line_dynamics effect) and each meter-out throttle sits on "

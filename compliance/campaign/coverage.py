@@ -21,7 +21,7 @@ CASES_BASIS = ("a judged test case is one requirement \u00d7 procedure \u00d7 op
 
 
 def case_coverage(entries: list[dict]) -> dict:
-    """Judged test cases evaluated and not evaluated, on the one basis :data:`CASES_BASIS`.
+    """Judged test cases evaluated, excluded and not evaluated, on the one basis :data:`CASES_BASIS`.
 
     Parameters
     ----------
@@ -31,28 +31,42 @@ def case_coverage(entries: list[dict]) -> dict:
     Returns
     -------
     dict
-        ``{"rows", "evaluated", "not_evaluated", "basis"}``: a case is evaluated when its verdict
-        row is PASS, FAIL or UNCERTAIN (a value was judged against the limit).
+        ``{"rows", "evaluated", "excluded", "not_evaluated", "basis"}``: a case is evaluated when its
+        verdict row is PASS, FAIL or UNCERTAIN (a value was judged against the limit), excluded when an
+        eligibility rule the requirement states excluded every value of it (``judge.EVALUATION_RULE``:
+        not a gap), not evaluated otherwise (a failed run, a missing value).
     """
     rows = [r for e in entries if e.get("limit") is not None for r in e["rows"]]
     evaluated = sum(1 for r in rows if r.get("status") in (Status.PASS, Status.FAIL, Status.UNCERTAIN))
-    return {"rows": len(rows), "evaluated": evaluated, "not_evaluated": len(rows) - evaluated, "basis": CASES_BASIS}
+    excluded = sum(1 for r in rows if r.get("status") == Status.NOT_EVALUATED and r.get("excluded"))
+    return {"rows": len(rows), "evaluated": evaluated, "excluded": excluded,
+            "not_evaluated": len(rows) - evaluated - excluded, "basis": CASES_BASIS}
 
 
 def case_coverage_text(cov: dict) -> str:
-    """``"87 of 111 judged test cases evaluated, 24 not evaluated"`` from :func:`case_coverage`."""
-    n = cov["rows"]
-    ne = cov.get("not_evaluated", n - cov["evaluated"])
-    return f"{cov['evaluated']} of {n} judged test cases evaluated, {ne} not evaluated"
+    """``"91 of 115 judged test cases evaluated, 24 excluded by an eligibility rule, 0 not evaluated"``."""
+    n, ex = cov["rows"], cov.get("excluded") or 0
+    ne = cov.get("not_evaluated", n - cov["evaluated"] - ex)
+    return (f"{cov['evaluated']} of {n} judged test cases evaluated, "
+            + (f"{ex} excluded by an eligibility rule, " if ex else "") + f"{ne} not evaluated")
 
 
-def _judged_pairs(entries) -> set[tuple[str, str]]:
-    """(run id, request key) of every verdict row."""
-    out = set()
+def _judged_pairs(entries) -> tuple[set[tuple[str, str]], dict]:
+    """(run id, request key) of every row that judged a value against a limit, and the reasons of the rows
+    that did not (open limit, every value excluded, no value) by the same pair."""
+    judged, other = set(), {}
     for e in entries:
         for r in e["rows"]:
-            out.add((r["run"], e["request_key"]))
-    return out
+            pair = (r["run"], e["request_key"])
+            if r.get("status") in (Status.PASS, Status.FAIL, Status.UNCERTAIN):
+                judged.add(pair)
+            elif r.get("status") == Status.OPEN:
+                other.setdefault(pair, []).append(f"{e['id']} has no limit (open: the purchaser's data sheet); its value is reported")
+            elif r.get("excluded"):
+                other.setdefault(pair, []).append(f"{e['id']}: every value excluded by its eligibility rule ({r['excluded']})")
+            else:
+                other.setdefault(pair, []).append(f"{e['id']}: {r.get('reason') or 'no value'}")
+    return judged, other
 
 
 def _why_not(reqset, run_id: str, key: str, samples, error) -> str:
@@ -84,7 +98,8 @@ def _why_not(reqset, run_id: str, key: str, samples, error) -> str:
 
 
 def unjudged(reqset, jobs, outcomes, entries) -> list[dict]:
-    """Every (run, metric request) with a computed value that no verdict row judged, with the reason.
+    """Every (run, metric request) with a computed value that no verdict row judged against a limit, with the reason
+    (no row, or rows that are open, excluded or not evaluated: their own reasons).
 
     Parameters
     ----------
@@ -99,12 +114,14 @@ def unjudged(reqset, jobs, outcomes, entries) -> list[dict]:
     list of dict
         ``{"run", "metric", "values", "reason"}``; ``values`` counts the computed values.
     """
-    judged = _judged_pairs(entries)
+    judged, other = _judged_pairs(entries)
     out = []
     for job, o in zip(jobs, outcomes):
         for key, samples in o.samples.items():
             n = sum(1 for s in samples if s.value is not None)
             if n == 0 or (job.key, key) in judged:
                 continue
-            out.append({"run": job.key, "metric": key, "values": n, "reason": _why_not(reqset, job.key, key, samples, o.error)})
+            why = "; ".join(dict.fromkeys(other[(job.key, key)])) if (job.key, key) in other else \
+                _why_not(reqset, job.key, key, samples, o.error)
+            out.append({"run": job.key, "metric": key, "values": n, "reason": why})
     return out

@@ -3,7 +3,9 @@
 A run offers candidate values (``Sample``) of each metric; the row keeps the worst eligible
 one against the limit (``compliance.requirements.verdict``), or, for an open limit (the purchaser's
 data-sheet value), the least favourable value with no verdict. A requirement's status
-combines its rows. Values are also formatted in each metric's display unit for tables.
+combines its rows by the evaluation rule (:data:`EVALUATION_RULE`): a row whose every value was
+excluded by a stated eligibility rule (a ramped, saturated, rate-limited or dead-zone dominated
+step) is an *excluded case*, not a gap. Values are also formatted in each metric's display unit.
 """
 
 from __future__ import annotations
@@ -16,9 +18,15 @@ from compliance.metrics.catalogue import METRICS
 from compliance.presentation.values import metric_text, resolved_limit, row_texts
 from compliance.requirements.requirement_set import RequirementSet
 from compliance.procedures.outcomes import Sample, request_key
-from compliance.requirements.verdict import Basis, Status, Verdict, evaluate, requirement_status, worst_index
+from compliance.requirements.verdict import Basis, Status, Verdict, evaluate, worst_index
 
-__all__ = ["judge", "judge_row", "sample_dict"]
+__all__ = ["EVALUATION_RULE", "evaluated_status", "explain_fails_under_uncertain", "judge", "judge_row", "sample_dict"]
+
+# docs/requirements.md, "When a requirement is evaluated"
+EVALUATION_RULE = ("a requirement is evaluated when every operating point it lists has at least one evaluated case "
+                   "(procedure x point row) and every other case is either evaluated or excluded by a stated eligibility "
+                   "rule (ramped, saturated, rate limited, dead-zone dominated, not from rest); it fails when any evaluated "
+                   "case fails; a case that could not be measured (a failed run, a missing value) leaves it not evaluated")
 
 # keys of the worst row copied into a requirement's entry
 _WORST_KEYS = ("run", "procedure", "operating_point", "value", "margin", "margin_pct", "status", "which", "display",
@@ -63,10 +71,20 @@ def judge_row(req, proc: str, op: str, limit, samples, error: str | None) -> dic
                 "samples": shown}
     if not usable:
         v = Verdict(None, req.comparator, limit, None, None, Status.NOT_EVALUATED, _why(samples))
-        return {**base, **v.as_dict(), "which": None, "samples": shown}
+        row = {**base, **v.as_dict(), "which": None, "samples": shown}
+        if samples and all(not s.eligible for s in samples):  # every value excluded by a stated rule: an excluded case
+            row["excluded"] = _excluded_text(samples)
+        return row
     verdicts = [evaluate(s.value, req.comparator, limit) for s in usable]
     w = worst_index(verdicts)
-    return {**base, **verdicts[w].as_dict(), "which": usable[w].label, "samples": shown}
+    row = {**base, **verdicts[w].as_dict(), "which": usable[w].label, "samples": shown}
+    flag = (usable[w].detail or {}).get("flag")
+    if flag:  # the value was taken by a fallback the reading names (e.g. a stroke with no straight part timed end to end)
+        row["flag"] = flag
+    excluded = [s for s in samples if not s.eligible]
+    if excluded:
+        row["excluded"] = _excluded_text(excluded)
+    return row
 
 
 def _non_responding_row(req, base: dict, limit, silent, shown) -> dict:
@@ -80,6 +98,25 @@ def _non_responding_row(req, base: dict, limit, silent, shown) -> dict:
                 "reason": why, "which": s.label, "samples": shown, "non_responding": labels}
     v = Verdict(None, req.comparator, tuple(limit), None, None, Status.FAIL, why + ", beyond any upper limit")
     return {**base, **v.as_dict(), "which": s.label, "samples": shown, "non_responding": labels}
+
+
+def _excluded_text(samples) -> str:
+    """"<label>: <rule's reason>" of every excluded value, joined."""
+    return "; ".join(f"{s.label}: {s.reason}" for s in samples if not s.eligible)
+
+
+def evaluated_status(req, rows: list[dict], verdicts) -> Status:
+    """Status of a requirement with a limit from its rows by :data:`EVALUATION_RULE`."""
+    st = [v.status for v in verdicts]
+    if Status.FAIL in st:
+        return Status.FAIL
+    evaluated = [r for r, v in zip(rows, verdicts) if v.status == Status.PASS]
+    gaps = [r for r, v in zip(rows, verdicts) if v.status == Status.NOT_EVALUATED and not r.get("excluded")]
+    listed = [r for r in rows if not r.get("extended")]
+    covered = {r["operating_point"] for r in evaluated if not r.get("extended")}
+    if not rows or gaps or any(o not in covered for o in {r["operating_point"] for r in listed}):
+        return Status.NOT_EVALUATED
+    return Status.PASS
 
 
 def _why(samples) -> str:
@@ -155,7 +192,7 @@ def judge(cfg, reqset: RequirementSet, jobs: list[Job], outcomes, loosened: dict
         elif req.limit is None:
             status = Status.OPEN
         else:
-            status = requirement_status(verdicts)
+            status = evaluated_status(req, rows, verdicts)
         worst = None
         if rows and req.limit is not None:
             wi = worst_index(verdicts)
@@ -187,6 +224,7 @@ def judge(cfg, reqset: RequirementSet, jobs: list[Job], outcomes, loosened: dict
             "rows": rows,
             "basis": requirement_basis(rows) if req.enabled and req.limit is not None else Basis.NOT_EVALUATED,
             "coverage": {"rows": len(rows), "evaluated": sum(1 for r in rows if r.get("status") in (Status.PASS, Status.FAIL)),
+                         "excluded": sum(1 for r in rows if r.get("status") == Status.NOT_EVALUATED and r.get("excluded")),
                          "extended": sum(1 for r in rows if r.get("extended"))},
             "reading": req.reading,
             "alternative": req.alternative,
@@ -196,3 +234,41 @@ def judge(cfg, reqset: RequirementSet, jobs: list[Job], outcomes, loosened: dict
             "loosened": loosen,
         })
     return entries, notes
+
+
+def _band_text(band: dict, metric: str) -> str:
+    from compliance.presentation.values import metric_text
+
+    return f"[{metric_text(band['low'], metric, unicode=False)} .. {metric_text(band['high'], metric, unicode=False)}]"
+
+
+def explain_fails_under_uncertain(entries: list[dict]) -> None:
+    """Give every FAIL row of an UNCERTAIN requirement the sentence that explains it (``status_note``).
+
+    A requirement is UNCERTAIN when a band straddles its limit; a row may still fail at the plant file's
+    values. Unbanded, its note says so and which band made the requirement uncertain; failing across its
+    own whole band, it is a certain failure and the requirement is FAIL (entries are updated in place).
+    """
+    for e in entries:
+        if e.get("status") != Status.UNCERTAIN:
+            continue
+        w = e.get("worst") or {}
+        certain = []
+        for r in e["rows"]:
+            if r.get("status") != Status.FAIL or r.get("status_note"):
+                continue
+            band = r.get("band")
+            if band is None:
+                deciding = e.get("band")
+                where = f"its deciding row {w.get('run')} ({w.get('which')})"
+                r["status_note"] = (
+                    f"fails at the plant file's values; this row was not banded itself: {e['id']} is UNCERTAIN because "
+                    f"{where} has a band {_band_text(deciding, e['metric']) if deciding else ''} that straddles the limit "
+                    "over the declared parameter ranges")
+            else:
+                r["status_note"] = (f"fails at the plant file's values and over its whole band {_band_text(band, e['metric'])}: "
+                                    "a failure whatever the declared ranges")
+                certain.append(r)
+        if certain:
+            e["status"] = Status.FAIL
+            e["status_note"] = f"{len(certain)} row(s) fail over their whole band: a failure, not an uncertainty"

@@ -9,6 +9,8 @@ The gate trips when
   (``allow_not_evaluated``); the reason it could not be evaluated is in the row,
 - a requirement present in the baseline is missing from the candidate,
 - a requirement new in the candidate fails,
+- a requirement uncertain in the baseline (its band straddles the limit, so it may pass) fails in the
+  candidate,
 - a requirement's worst-case margin shrinks by more than ``max_margin_loss`` percentage
   points (margins in % of the binding limit, docs/metrics.md), when the user sets it.
 A requirement already failing in the baseline is reported, not counted as a regression.
@@ -51,6 +53,8 @@ def _status_reasons(rid: str, b, c, why: str | None, allowed: bool):
         return [f"{bs} -> not_evaluated: could not be evaluated: {why}"], None
     if bs == Status.PASS and cs != Status.PASS:
         return [f"{bs} -> {cs}"], None
+    if bs == Status.UNCERTAIN and cs == Status.FAIL:  # the baseline could pass; the candidate fails outright
+        return [f"{bs} -> {cs}: the baseline's band reached the limit, the candidate fails it"], None
     return [], None
 
 
@@ -140,7 +144,10 @@ def _gate_cell(row: dict, tripped_word: str) -> str:
         return f"{tripped_word}: " + "; ".join(row["reasons"])
     if row.get("allowed"):
         return f"allowed: {row['allowed']}"
-    text = "still failing" if row["preexisting_failure"] else "ok"
+    cs = row["candidate"]["status"]
+    text = ("still failing" if row["preexisting_failure"] else
+            "no regression (candidate fails; not passing in the baseline either)" if cs == Status.FAIL else
+            "no regression (candidate uncertain)" if cs == Status.UNCERTAIN else "ok")
     if row.get("not_evaluated_reason"):
         text += f" (not evaluated: {row['not_evaluated_reason']})"
     return text

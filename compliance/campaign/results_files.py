@@ -97,6 +97,9 @@ def summary_lines(result: CheckResult) -> list[str]:
     s, c = result.summary, result.summary.counts
     out = [f"plant {result.plant.name} ({result.plant.path}) against "
            f"{result.requirement_set.name} ({result.requirement_set.path})"]
+    remedy_yield = result.plant.provenance.get("remedy_yield")
+    if remedy_yield:  # a configuration written by --save-remedy: the yield its search showed
+        out.append(f"  remedy: {remedy_yield}")
     cov = s.coverage
     out.append(
         f"{c.passed} pass, {c.pass_by_construction} pass by construction (not evidence), "

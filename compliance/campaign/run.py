@@ -25,7 +25,7 @@ from compliance.version import __version__
 from compliance.campaign.plan import Job, plan
 from compliance.campaign.executor import execute
 from compliance.processes import available_cores
-from compliance.campaign.judge import judge, sample_dict
+from compliance.campaign.judge import EVALUATION_RULE, explain_fails_under_uncertain, judge, sample_dict
 from compliance.errors import InputError
 from compliance.requirements.requirement_set import RequirementSet
 from compliance.requirements.vetting import Vetting, vet
@@ -201,7 +201,11 @@ def run_records(runs: CampaignRuns, reqset: RequirementSet) -> list[dict]:
 
 def assemble(cfg, reqset: RequirementSet, runs: CampaignRuns, entries: list[dict], notes: list[str], vetting: Vetting,
              bands: dict | None, command_line: str | None = None) -> dict:
-    """The results dict of a judged campaign (schema ``govcheck-results/1``, docs/results-schema.md)."""
+    """The results dict of a judged campaign (schema ``govcheck-results/1``, docs/results-schema.md).
+
+    After the bands: a failing row under an UNCERTAIN requirement gets the sentence that explains it
+    (``judge.explain_fails_under_uncertain``)."""
+    explain_fails_under_uncertain(entries)
     results = {
         "schema": RESULTS_SCHEMA,
         "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
@@ -210,7 +214,7 @@ def assemble(cfg, reqset: RequirementSet, runs: CampaignRuns, entries: list[dict
         "plant": plant_section(cfg),
         "requirement_set": reqset.as_dict(),
         "summary": summary_section(entries, notes, bands),
-        "coverage": {"unjudged": unjudged(reqset, runs.jobs, runs.outcomes, entries)},
+        "coverage": {"unjudged": unjudged(reqset, runs.jobs, runs.outcomes, entries), "evaluation_rule": EVALUATION_RULE},
         "findings": list(vetting.findings),
         "uncertainty": bands,
         "requirements": entries,

@@ -86,20 +86,63 @@ Exit codes: 0 all pass, 1 a requirement failed (or a gate tripped), 2 invalid in
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``govcheck`` console script."""
-    parser = build_parser()
-    try:
-        args = parser.parse_args(argv)
-    except SystemExit as exc:  # argparse: usage error (2) or --help/--version (0)
-        return int(exc.code or 0) if not isinstance(exc.code, str) else 2
-    if not getattr(args, "command", None):
-        parser.print_help(sys.stderr)
-        print("govcheck: error: no COMMAND given; choose one of the commands above (govcheck COMMAND --help)", file=sys.stderr)
-        return 2
-    from compliance.processes import raise_if_stopping, stop_on_signals
+    """Entry point of the ``govcheck`` console script.
+
+    The signal handling is set first, before the command modules (and numpy, numba, pandas...) are
+    imported: a Ctrl-C or SIGTERM at any moment from here on ends the run with one line and exit
+    130 / 143, never a KeyboardInterrupt traceback.
+    """
+    from compliance.processes.stopping import stop_on_signals
 
     stop_on_signals()  # SIGTERM unwinds like Ctrl-C: workers killed, temporary files removed, exit 143 (Ctrl-C 130)
+    command = None
     try:
+        parser = build_parser()
+        try:
+            args = parser.parse_args(argv)
+        except SystemExit as exc:  # argparse: usage error (2) or --help/--version (0)
+            return int(exc.code or 0) if not isinstance(exc.code, str) else 2
+        command = getattr(args, "command", None)
+        if not command:
+            parser.print_help(sys.stderr)
+            print("govcheck: error: no COMMAND given; choose one of the commands above (govcheck COMMAND --help)",
+                  file=sys.stderr)
+            return 2
+        code = _run(args)
+        if argv is None:  # the govcheck command itself (tests pass argv): a signal after the run cannot change its end
+            from compliance.processes.stopping import ignore_late_signals
+
+            ignore_late_signals()
+        return code
+    except KeyboardInterrupt as exc:  # while starting (imports, parsing) or between the run's end and its exit
+        return _interrupted(command, exc)
+
+
+def _interrupted(command: str | None, exc: KeyboardInterrupt) -> int:
+    from compliance.processes.stopping import Terminated
+
+    term = isinstance(exc, Terminated)
+    print(f"govcheck{' ' + command if command else ''}: {'terminated' if term else 'interrupted'}; nothing more written",
+          file=sys.stderr)
+    return 143 if term else 130
+
+
+def _check_source_date_epoch() -> None:
+    """A malformed ``SOURCE_DATE_EPOCH`` is refused before any command module loads (numpy reads it on import too)."""
+    import os
+
+    if os.environ.get("SOURCE_DATE_EPOCH", "").strip():
+        from compliance.files.reproducible import fixed_created
+
+        fixed_created()
+
+
+def _run(args) -> int:
+    """Run the parsed command; map every way it can end to an exit code and one line on stderr."""
+    from compliance.processes import raise_if_stopping
+
+    try:
+        _check_source_date_epoch()
         code = args._run(args)
         sys.stdout.flush()  # inside the try: a reader that went away is met here, not at the interpreter's exit
         raise_if_stopping()  # a signal whose exception Python swallowed (in a fork hook) still ends as interrupted
@@ -107,11 +150,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"govcheck {args.command}: error: {exc}", file=sys.stderr)
         return exc.exit_code
     except KeyboardInterrupt as exc:
-        from compliance.processes import Terminated
-
-        term = isinstance(exc, Terminated)
-        print(f"govcheck {args.command}: {'terminated' if term else 'interrupted'}; nothing more written", file=sys.stderr)
-        return 143 if term else 130
+        return _interrupted(args.command, exc)
     except BrokenPipeError:  # the reader went away (govcheck linear ... | head -n 1): stop quietly, as cat does
         _silence_stdout()
         return 141

@@ -6,8 +6,9 @@ import shlex
 import sys
 from pathlib import Path
 
-from compliance.cli.common import (add_document_options, add_jobs, add_outputs, add_parser, add_quiet, add_reproducible,
-                                   check_args_outputs, document_options, sidecar_plant)
+from compliance.cli.common import (add_allow_conflicts, add_document_options, add_jobs, add_outputs, add_parser, add_quiet,
+                                   add_reproducible, check_args_outputs, checked_requirements, document_options,
+                                   sidecar_plant)
 from compliance.errors import InputError
 
 
@@ -42,6 +43,7 @@ def register(subparsers):
     p.add_argument("--no-prediction", action="store_true", help="judge the recordings only (no replay of the tests)")
     add_outputs(p, "json", "junit", "report", "pdf", help={"json": "write the site results (docs/acceptance.md) to FILE.json"})
     add_document_options(p)
+    add_allow_conflicts(p)
     add_jobs(p)
     add_quiet(p, "print only the verdict line")
     add_reproducible(p)
@@ -97,13 +99,17 @@ def run(args) -> int:
     from compliance.requirements.verdict import Overall
 
     check_args_outputs(args)
+    if args.diagnose and args.no_prediction:
+        raise InputError("--diagnose needs the prediction (it explains where the machine and the model disagree); "
+                         "drop --no-prediction")
+    if args.jobs is not None and args.no_prediction:  # the recordings are judged in this process
+        raise InputError(f"--jobs {args.jobs}: the prediction's replays run in parallel, and --no-prediction runs none; "
+                         "drop --jobs")
     site, config = _site_and_config(args.inputs)
     reqset = load_requirements(args.requirements)
     recordings = read_site(site, args.column_map)  # every file read and checked before any replay
     cfg = _plant(config, recordings)
-    if args.diagnose and args.no_prediction:
-        raise InputError("--diagnose needs the prediction (it explains where the machine and the model disagree); "
-                         "drop --no-prediction")
+    checked_requirements(reqset, [cfg.p("cylinder.stroke")], args)  # as every command that loads a requirement set
     results = accept(site, reqset, cfg, recordings=recordings, predict=not args.no_prediction, diagnose=args.diagnose,
                      workers=args.jobs, progress=not args.quiet and sys.stderr.isatty(), command_line=_command_line(args))
     if is_reproducible(args.reproducible):

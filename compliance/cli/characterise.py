@@ -97,8 +97,11 @@ def _run_valve(args) -> int:
     temperature = parse_quantity(args.temperature, "K", "--temperature")
     exhaust = parse_quantity(args.exhaust_pressure, "Pa", "--exhaust-pressure", pressure=True)
     laws = tuple(LAWS)
-    if args.laws:
+    if args.laws is not None:
         laws = tuple(x.strip() for x in args.laws.split(",") if x.strip())
+        if not laws:
+            raise InputError(f"--laws {args.laws!r}: no flow law named; give a comma-separated subset of "
+                             f"{', '.join(LAWS)} (or leave --laws out for all of them)")
         for law in laws:
             if law not in LAWS:
                 raise InputError(f"--laws: '{law}' not known; known: {', '.join(LAWS)}")

@@ -5,8 +5,9 @@ from __future__ import annotations
 import shlex
 import sys
 
-from compliance.cli.common import (add_document_options, add_jobs, add_outputs, add_parser, add_plant_argument, add_quiet,
-                                   add_reproducible, check_args_outputs, document_options, plant_source)
+from compliance.cli.common import (add_allow_conflicts, add_document_options, add_jobs, add_outputs, add_parser,
+                                   add_plant_argument, add_quiet, add_reproducible, check_args_outputs, document_options,
+                                   plant_source)
 
 
 def register(subparsers):
@@ -35,8 +36,9 @@ def register(subparsers):
     p.add_argument("--requirements", "-r", required=True, metavar="REQ",
                    help="requirement file: a TOML file or a shipped name (" + ", ".join(names) + ")")
     add_outputs(p, "json", "junit", "report", "pdf")
-    p.add_argument("--appendix", choices=("none", "summary", "full"), default="summary",
-                   help="report appendix: none, summary (configuration, requirement file, versions; default) or full (+ every run)")
+    p.add_argument("--appendix", choices=("none", "summary", "full"), default=None,
+                   help="with --report/--pdf: report appendix: none, summary (configuration, requirement file, versions; "
+                        "default) or full (+ every run)")
     p.add_argument("--linear", action="store_true",
                    help="add the linear analysis to the results and report: every operating point, the stroke x load map, "
                         "the linear/nonlinear cross-check and the HYGOV parameters (adds ~20-40 s)")
@@ -46,9 +48,7 @@ def register(subparsers):
     p.add_argument("--uncertainty", type=int, default=None, metavar="N",
                    help="bands from a Latin-hypercube Monte Carlo of N plants over the plant file's declared ranges "
                         "(instead of the local sensitivities); 0 = point values only")
-    p.add_argument("--allow-conflicts", action="store_true",
-                   help="judge a requirement set even when two mandatory limits cannot hold together (without it such a set "
-                        "is refused with exit code 2 before any simulation; docs/requirements.md)")
+    add_allow_conflicts(p)
     from compliance.cli.sweep import add_remedies_options
 
     add_remedies_options(p)
@@ -81,6 +81,12 @@ def _check_first(args) -> None:
     from compliance.pipeline.chain import check_uncertainty
 
     check_uncertainty(args.uncertainty)
+    if args.appendix is not None and not (args.report or args.pdf):
+        from compliance.errors import InputError
+
+        raise InputError(f"--appendix {args.appendix}: shapes the report, and no report is asked for; add --report "
+                         "FILE.html or --pdf FILE.pdf")
+    args.appendix = args.appendix or "summary"
     check_args_outputs(args, (getattr(args, "save_remedy", None), "--save-remedy", (".toml",)))
     check_remedies_options(args)
     if is_reproducible(args.reproducible):

@@ -123,11 +123,11 @@ def add_scheduler(parser, what: str = "the parallel work") -> None:
 
 
 def check_scheduler(args) -> str | None:
-    """The ``--scheduler`` given, checked before any work (a bad address is exit 2); None for the local pool."""
-    from compliance.processes import parse_scheduler
+    """The ``--scheduler`` given, checked before any work (a bad or unreachable address is exit 2); None for the local pool."""
+    from compliance.processes.dask_cluster import check_reachable
 
     value = getattr(args, "scheduler", None)
-    parse_scheduler(value)
+    check_reachable(value)
     return value
 
 
@@ -151,6 +151,17 @@ def add_document_options(parser) -> None:
     parser.add_argument("--revision", metavar="TEXT", help="revision of the report (else [identity] revision)")
 
 
+def check_document_options(args) -> None:
+    """``--document-number`` / ``--revision`` are printed on a report: without --report or --pdf they would go nowhere."""
+    if getattr(args, "report", None) or getattr(args, "pdf", None):
+        return
+    for flag, value in (("--document-number", getattr(args, "document_number", None)),
+                        ("--revision", getattr(args, "revision", None))):
+        if value is not None:
+            raise InputError(f"{flag} {value}: is printed on the report, and no report is asked for; add --report FILE.html "
+                             "or --pdf FILE.pdf")
+
+
 def document_options(args, results_path=None, results_text: str | None = None) -> dict:
     """The ``document`` argument of the report renderers: number, revision and the results file's sha256."""
     import hashlib
@@ -162,6 +173,31 @@ def document_options(args, results_path=None, results_text: str | None = None) -
         data = results_text.encode("utf-8") if results_text is not None else Path(results_path).read_bytes()
         doc["results"] = {"path": display_path(str(results_path)), "digest": hashlib.sha256(data).hexdigest()}
     return doc
+
+
+def add_allow_conflicts(parser) -> None:
+    """``--allow-conflicts``: judge a requirement set whose mandatory limits cannot hold together (every command that loads one)."""
+    parser.add_argument("--allow-conflicts", action="store_true",
+                        help="judge a requirement set even when two mandatory limits cannot hold together (without it such a set "
+                             "is refused with exit code 2 before any simulation; docs/requirements.md)")
+
+
+def checked_requirements(source, strokes, args):
+    """Load the requirement set ``source`` and vet it for every stroke [m] of ``strokes`` (before any work).
+
+    For a command whose plant is not known before its work starts (``size``, ``sweep``, ``accept``);
+    the vetting is the one a check runs (``compliance.requirements.vetting.vet``, as
+    ``compliance.pipeline.chain.Check.of``): a loosened limit, or a conflict between mandatory limits
+    unless ``--allow-conflicts``, is exit 2.
+    """
+    from compliance.requirements.loading import load_requirements
+    from compliance.requirements.vetting import vet
+
+    reqset = source if hasattr(source, "requirements") else load_requirements(source)
+    allow = bool(getattr(args, "allow_conflicts", False))
+    for stroke in dict.fromkeys(strokes):
+        vet(reqset, stroke, allow)
+    return reqset
 
 
 def check_jobs(args) -> None:
@@ -181,20 +217,26 @@ def standard_outputs(args, *extra) -> list:
     return out + [e for e in extra if e[0] is not None]
 
 
-def check_args_outputs(args, *extra) -> None:
+def check_args_outputs(args, *extra, inputs: dict | None = None) -> None:
     """Check ``--jobs`` and every output path before any work (nothing written on failure).
 
-    Every other argument that names an existing file is an input, and no output may be one of them.
+    Every other argument that names an existing file is an input, and no output may be one of them;
+    ``inputs`` (``{path: what it is}``) adds files the run reads that no argument names (a duty's template).
     """
     from compliance.files.outputs import check_outputs
 
     from compliance.files.reproducible import fixed_created, is_reproducible
 
     check_jobs(args)
+    check_document_options(args)
     if is_reproducible(getattr(args, "reproducible", False)):
         fixed_created()  # a bad SOURCE_DATE_EPOCH is refused now, not after the work
     outputs = standard_outputs(args, *extra)
-    check_outputs(*outputs, inputs=input_files(args, {o[1].split("/")[-1].lstrip("-").replace("-", "_") for o in outputs}))
+    if getattr(args, "reproducible", False) is True and not outputs:
+        raise InputError("--reproducible: makes the files a run writes byte-identical, and this run writes none; add an "
+                         "output (--json FILE.json, ...) or drop --reproducible")
+    found = input_files(args, {o[1].split("/")[-1].lstrip("-").replace("-", "_") for o in outputs})
+    check_outputs(*outputs, inputs={**(inputs or {}), **found})
 
 
 _POSITIONAL = {"config": "CONFIG", "inputs": "[CONFIG] RECORDING", "recordings": "RECORDING", "sweep": "SWEEP",

@@ -85,6 +85,9 @@ def run(args) -> int:
     first, meta = read_recording(args.recordings[0], args.column_map, required=("time",))
     if _is_friction(first):
         return _run_friction(args, first, meta)
+    if args.friction_bore is not None:
+        raise InputError(f"--friction-bore {args.friction_bore}: the bore of a friction-bench run, and "
+                         f"{args.recordings[0]} is a servo recording (it has a valve command); drop --friction-bore")
     if len(args.recordings) > 1:
         return _run_joint(args, plant_arg, effects)
     frame, meta = read_recording(args.recordings[0], args.column_map)
@@ -176,6 +179,11 @@ def _run_friction(args, first, meta) -> int:
         raise InputError("--save-model: a friction-bench diagnosis fits a friction law, not a plant configuration; use --json")
     if args.scheduler:
         raise InputError("--scheduler: friction-bench runs are fitted on the local process pool (seconds per seal); use --jobs")
+    for flag, value in (("--effects", args.effects), ("--no-recalibration", args.no_recalibration or None),
+                        ("--suggest-test", args.suggest_test or None)):
+        if value is not None:
+            raise InputError(f"{flag}: shapes the diagnosis of a servo recording, and {args.recordings[0]} is a "
+                             "friction-bench run (force, no valve command), fitted with the friction laws; drop it")
     runs = [(first, meta)]
     for path in args.recordings[1:]:
         f, m = read_recording(path, args.column_map, required=("time",))
@@ -201,6 +209,66 @@ def _run_friction(args, first, meta) -> int:
     return 0
 
 
+def refuse_joint_options(args) -> None:
+    """The outputs and options a joint diagnosis of several recordings does not make are refused, not dropped."""
+    for flag, value in (("--save-model", args.save_model), ("--report", args.report), ("--pdf", args.pdf),
+                        ("--suggest-test", args.suggest_test), ("--document-number", args.document_number),
+                        ("--revision", args.revision)):
+        if value:
+            raise InputError(f"{flag}: not available for a joint diagnosis of several recordings (use --json)")
+
+
+def check_distinct_recordings(paths) -> None:
+    """Each recording of a joint diagnosis once: the same file twice, or a byte-identical copy under another name,
+    would count one test as two."""
+    import hashlib
+
+    by_name: dict = {}
+    by_bytes: dict = {}
+    for path in paths:
+        p = Path(path)
+        key = p.resolve()
+        if key in by_name:
+            raise InputError(f"{path}: given twice; a joint diagnosis needs different recordings of the plant")
+        by_name[key] = path
+        if not p.is_file():
+            continue  # the reader names a missing file
+        digest = hashlib.sha256(p.read_bytes()).hexdigest()
+        if digest in by_bytes:
+            raise InputError(f"{path}: the same bytes as {by_bytes[digest]} (a copy under another name); a joint diagnosis "
+                             "needs different recordings of the plant")
+        by_bytes[digest] = path
+
+
+def one_sidecar_plant(paths, recs, required: bool = True) -> str | None:
+    """The plant the recordings' sidecars name: one and the same for all, or an error naming the two that differ.
+
+    With ``required`` (no CONFIG given) every sidecar must name it; otherwise sidecars that name none are left be.
+    """
+    named = [(path, sidecar_plant(meta, path)) for path, (_, meta) in zip(paths, recs)]
+    given = [(path, plant) for path, plant in named if plant]
+    if not given:
+        if required:
+            raise InputError(f"{paths[0]}: no CONFIG given and the sidecar names no 'plant'")
+        return None
+    first_path, first = given[0]
+    for path, plant in given[1:]:
+        if _same_plant(plant, first):
+            continue
+        raise InputError(f"{path}: its sidecar names plant '{plant}', and {first_path}'s names '{first}'; a joint diagnosis "
+                         "fits one plant to recordings of that one plant (correct the sidecar that is wrong)")
+    missing = [path for path, plant in named if not plant]
+    if missing and required:
+        raise InputError(f"{missing[0]}: its sidecar names no 'plant' while {first_path}'s names '{first}'; give CONFIG")
+    return first
+
+
+def _same_plant(a: str, b: str) -> bool:
+    import os
+
+    return a == b or (os.path.isfile(a) and os.path.isfile(b) and os.path.samefile(a, b))
+
+
 def _run_joint(args, plant_arg, effects) -> int:
     """Several recordings of one plant: one diagnosis with shared physics (diagnosis.servo.joint_recordings)."""
     from compliance.cli.progress import progress
@@ -208,21 +276,12 @@ def _run_joint(args, plant_arg, effects) -> int:
     from compliance.model.config import load_plant
     from compliance.recordings.reader import read_recording
 
-    for flag, value in (("--save-model", args.save_model), ("--report", args.report), ("--suggest-test", args.suggest_test)):
-        if value:
-            raise InputError(f"{flag}: not available for a joint diagnosis of several recordings (use --json)")
+    refuse_joint_options(args)
     check_scheduler(args)  # a bad address is exit 2 before any work
-    seen = set()
-    for path in args.recordings:
-        key = Path(path).resolve()
-        if key in seen:
-            raise InputError(f"{path}: given twice; a joint diagnosis needs different recordings of the plant")
-        seen.add(key)
+    check_distinct_recordings(args.recordings)
     recs = [read_recording(path, args.column_map) for path in args.recordings]
-    plant = plant_arg or sidecar_plant(recs[0][1], args.recordings[0])
-    if not plant:
-        raise InputError(f"{args.recordings[0]}: no CONFIG given and the sidecar names no 'plant'")
-    cfg = load_plant(plant)
+    named = one_sidecar_plant(args.recordings, recs, required=not plant_arg)
+    cfg = load_plant(plant_arg or named)
     for path, (frame, meta) in zip(args.recordings, recs):
         check_sidecar_conditions(cfg, frame, meta, path)
     with progress(1, "diagnose", quiet=args.quiet, unit="stage", first=f"{len(recs)} recordings, shared physics") as bar:

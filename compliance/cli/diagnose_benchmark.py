@@ -46,8 +46,8 @@ def register(sub):
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     add_plant_argument(p, help="plant configuration the cases are generated from and diagnosed against (default plant-a)")
-    p.add_argument("--cases", type=int, default=3, help="cases per effect and null cases (default 3)")
-    p.add_argument("--seed", type=int, default=1, help="seed of the case generator (default 1)")
+    p.add_argument("--cases", type=int, default=None, help="cases per effect and null cases (default 3)")
+    p.add_argument("--seed", type=int, default=None, help="seed of the case generator (default 1)")
     p.add_argument("--effects", help="effects to generate cases of (default: all declared)")
     p.add_argument("--library", help="candidate effects the diagnosis chooses from (default: all declared)")
     add_jobs(p, "cases diagnosed in parallel")
@@ -97,6 +97,14 @@ def run(args) -> int:
 
     check_args_outputs(args, (args.markdown, *MARKDOWN_OUTPUT))
     scheduler = check_scheduler(args)
+    if args.practice:  # recordings, not generated cases: the generator's options would do nothing
+        for flag, value in (("--cases", args.cases), ("--seed", args.seed), ("--effects", args.effects),
+                            ("--no-null", args.no_null or None), ("--no-miscalibrations", args.no_miscalibrations or None)):
+            if value is not None:
+                raise InputError(f"{flag}: shapes the generated cases, and --practice diagnoses recordings instead; "
+                                 f"drop {flag} or --practice")
+    args.cases = 3 if args.cases is None else args.cases
+    args.seed = 1 if args.seed is None else args.seed
     if args.cases < 1:
         raise InputError(f"--cases {args.cases}: expected at least 1")
     if not 0 <= args.seed < 2**32:

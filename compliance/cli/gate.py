@@ -6,7 +6,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from compliance.cli.common import add_jobs, add_outputs, add_parser, add_quiet, add_reproducible, check_args_outputs
+from compliance.cli.common import (add_allow_conflicts, add_jobs, add_outputs, add_parser, add_quiet, add_reproducible,
+                                   check_args_outputs)
 from compliance.errors import InputError, did_you_mean
 
 
@@ -42,6 +43,7 @@ def register(subparsers):
                         "the PR comment still says why it could not be evaluated)")
     p.add_argument("--markdown", metavar="FILE.md", help="write a Markdown summary for a pull-request comment")
     add_outputs(p, "json", help={"json": "write the gate result as JSON to FILE.json"})
+    add_allow_conflicts(p)
     add_jobs(p)
     add_quiet(p, "no progress bar; print only the gate line")
     add_reproducible(p)
@@ -49,7 +51,7 @@ def register(subparsers):
 
 
 def _is_results(path: str) -> bool:
-    return path.endswith(".json")
+    return path.endswith((".json", ".json.gz"))  # .json.gz: a sweep's best candidate is stored compressed
 
 
 def _requirements_for(args, baseline_results):
@@ -97,7 +99,7 @@ def run(args) -> int:
     """Obtain both results, compare, print, write; exit 1 when the gate trips."""
     from compliance.campaign.regression_gate import compare, gate_markdown, gate_table
     from compliance.campaign.results_files import read_results
-    from compliance.pipeline.chain import check
+    from compliance.pipeline.chain import Check
     from compliance.files.atomic import write_json_atomic, write_text_atomic
     from compliance.files.reproducible import is_reproducible, make_reproducible
     from compliance.model.config import load_plant
@@ -107,6 +109,11 @@ def run(args) -> int:
     if args.max_margin_loss is not None and not args.max_margin_loss >= 0:
         raise InputError(f"--max-margin-loss {args.max_margin_loss}: expected a number of percentage points >= 0")
     check_args_outputs(args, (args.markdown, "--markdown", (".md", ".markdown")))
+    if _is_results(args.baseline) and _is_results(candidate):  # nothing is run: the options of a run do nothing
+        for flag, value in (("--allow-conflicts", args.allow_conflicts or None), ("--requirements", args.requirements),
+                            ("--jobs", args.jobs)):
+            if value is not None:
+                raise InputError(f"{flag}: both sides are results files, so nothing is run or judged here; drop {flag}")
     base = read_results(args.baseline) if _is_results(args.baseline) else None
     cand = read_results(candidate) if _is_results(candidate) else None
     sources = {"baseline": args.baseline, "candidate": candidate}
@@ -118,9 +125,11 @@ def run(args) -> int:
             print(f"govcheck gate: note: {reqset.path} changed since the baseline was made "
                   f"(digest {str(base.requirement_set.digest)[:12]} -> {reqset.digest[:12]})", file=sys.stderr)
     _check_allowed_ids(args.allow_not_evaluated, reqset, base, cand)
-    for name, cfg in configs.items():
-        results = check(cfg, reqset, uncertainty=None, jobs=args.jobs, progress=not args.quiet,
-                        command_line=f"govcheck gate ({name} {sources[name]})")
+    # every side's inputs vetted (conflicts at each plant's stroke) before either is simulated
+    prepared = {name: Check.of(cfg, reqset, uncertainty=None, allow_conflicts=args.allow_conflicts)
+                for name, cfg in configs.items()}
+    for name, ready in prepared.items():
+        results = ready.run(jobs=args.jobs, progress=not args.quiet, command_line=f"govcheck gate ({name} {sources[name]})")
         base, cand = (results, cand) if name == "baseline" else (base, results)
     result = compare(base, cand, args.max_margin_loss, allow_not_evaluated=args.allow_not_evaluated)
     table = gate_table(result)

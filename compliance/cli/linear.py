@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from compliance.cli.common import add_outputs, add_parser, add_plant_argument, add_quiet, add_reproducible, check_args_outputs
+from compliance.errors import InputError
 from compliance.presentation.quantities import fmt_quantity
 
 _PLOT_SUFFIXES = (".png", ".svg", ".pdf")
@@ -42,8 +43,14 @@ def register(subparsers):
     p.add_argument("--crosscheck", action="store_true", help="compare with nonlinear 1 %% and 5 %% steps at the paper's operating points")
     p.add_argument("--governor", action="store_true",
                    help="equivalent gate-servo parameters for HYGOV / HYGOV4 (Tg, VELM, UO/UC, GMAX/GMIN), ANDES table, PSS/E record")
-    p.add_argument("--stroke-load", default="default",
-                   help="load during the governor's large moves: a force, 'curve' or 'none' (default: the load curve)")
+    p.add_argument("--rating", metavar="MVA", help="with --governor: the unit's rating Tn, the machine base of the ANDES and "
+                   "PSS/E numbers (default: the system base)")
+    p.add_argument("--system-base", metavar="MVA", help="with --governor: the study's system base Sb (default 100 MVA)")
+    p.add_argument("--dispatch", metavar="MW", help="with --governor: the unit's power at the operating point, as the "
+                   "study dispatches it (sets At so the gate starts there; default: rating x operating gate)")
+    p.add_argument("--stroke-load", default=None,
+                   help="with --governor: load during the governor's large moves: a force, 'curve' or 'none' "
+                        "(default: the load curve)")
     add_outputs(p, "json", help={"json": "write everything as JSON to FILE.json"})
     p.add_argument("--governor-json", metavar="FILE.json", help="write only the HYGOV parameters as JSON (implies --governor)")
     p.add_argument("--plot", metavar="FILE.png", help="write the report's figures of the analysis: Bode, closed-loop poles, the "
@@ -64,6 +71,30 @@ def _point(cfg, args, governor: bool):
     load = parse_load(args.load, f"--load {args.load!r}", require_unit=False) if args.load is not None else (load_n if governor else None)
     flow_control = args.flow_control if args.flow_control is not None else (True if governor else None)
     return x, load, flow_control
+
+
+def _study(args, governor: bool) -> dict:
+    """--rating / --system-base / --dispatch [MVA, MVA, MW], checked before any work; each needs --governor."""
+    from compliance.units import parse_quantity
+
+    out = {}
+    for flag, key, unit in (("--rating", "rating_mva", "MVA"), ("--system-base", "system_mva", "MVA"),
+                            ("--dispatch", "dispatch_mw", "MW")):
+        text = getattr(args, flag.lstrip("-").replace("-", "_"))
+        if text is None:
+            continue
+        if not governor:
+            raise InputError(f"{flag} {text}: a basis of the governor export; it needs --governor (or --governor-json)")
+        try:
+            float(text)
+        except ValueError:
+            value = parse_quantity(text, "W", f"{flag} {text!r}") / 1e6  # VA and W share pint's dimension
+        else:  # a bare number would be SI (watts): a power system's figures are MVA and MW, so say it
+            raise InputError(f"{flag} {text}: give the unit, e.g. '{text} {unit}'")
+        if not value > 0 or value != value or value == float("inf"):
+            raise InputError(f"{flag} {text}: expected a positive power in {unit} (e.g. '50 {unit}')")
+        out[key] = value
+    return out
 
 
 def _q(v, si: str, unit: str = "", decimals: int = 3, suffix: str = "") -> str:
@@ -112,16 +143,20 @@ def run(args) -> int:
     from compliance.files.jsonable import jsonable
     from compliance.linear.analysis import analyse
 
-    check_args_outputs(args, (args.governor_json, "--governor-json", (".json",)), (args.plot, "--plot", _PLOT_SUFFIXES))
-    cfg = plant_from_args(args)
     governor = bool(args.governor or args.governor_json)
-    x, load, flow_control = _point(cfg, args, governor)
+    if args.stroke_load is not None and not governor:
+        raise InputError(f"--stroke-load {args.stroke_load}: the load of the governor's large moves; it needs --governor "
+                         "(or --governor-json), without which no large move is run")
+    study = _study(args, governor)
     sl = None
     if governor:  # parsed before any work: a bad --stroke-load is exit 2 with nothing run
         from compliance.units.amounts import parse_load
 
-        sl = "default" if args.stroke_load == "default" else parse_load(args.stroke_load, f"--stroke-load {args.stroke_load!r}",
-                                                                           require_unit=False)
+        sl = "default" if args.stroke_load is None else parse_load(args.stroke_load, f"--stroke-load {args.stroke_load!r}",
+                                                                   require_unit=False)
+    check_args_outputs(args, (args.governor_json, "--governor-json", (".json",)), (args.plot, "--plot", _PLOT_SUFFIXES))
+    cfg = plant_from_args(args)
+    x, load, flow_control = _point(cfg, args, governor)
     a = analyse(cfg, x, load, flow_control=flow_control, gain=args.gain)
     summary = _summary(cfg, a, flow_control)
     print(summary.splitlines()[0] if args.quiet else summary)
@@ -152,6 +187,7 @@ def run(args) -> int:
 
         reuse = a if args.gain == "mean" else None  # Tg_linear is the mean-slope figure of the same point
         gov = governor_parameters(cfg, position=x, load=load, stroke_load=sl, flow_control=flow_control, linear=reuse)
+        gov.study = study
         print(f"\nequivalent gate-servo parameters ({gov.basis()['circuit']}; pu on the machine base, gate = stroke):")
         print(gov.table())
         out["governor"] = gov.to_dict()

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from compliance.cli.common import (add_outputs, add_parser, add_plant_argument, add_scheduler, check_args_outputs,
-                                   check_scheduler, plant_from_args)
+from compliance.cli.common import (add_jobs, add_outputs, add_parser, add_plant_argument, add_scheduler,
+                                   check_args_outputs, check_scheduler, plant_from_args)
 from compliance.errors import InputError
 
 
@@ -27,6 +27,7 @@ def register(sub):
                    help="fit the parameters the paper leaves unstated to its figures, print before/after and save "
                         "the calibrated configuration (default models/plant-a-calibrated.toml; docs/calibration.md)")
     add_scheduler(p, "the --calibrate search")
+    add_jobs(p, "local worker processes of the --calibrate search")
     return p
 
 
@@ -38,6 +39,8 @@ def run(args) -> int:
     scheduler = check_scheduler(args)
     if scheduler is not None and not args.calibrate:
         raise InputError(f"--scheduler {scheduler}: only the --calibrate search runs in parallel; add --calibrate")
+    if args.jobs is not None and not args.calibrate:
+        raise InputError(f"--jobs {args.jobs}: only the --calibrate search runs in parallel; add --calibrate")
     cfg = plant_from_args(args)
     if cfg.options["cylinder.arrangement"] != "tandem":
         from compliance.files.display import display_path
@@ -46,7 +49,7 @@ def run(args) -> int:
     if args.calibrate:
         from compliance.papers.calibration_run import run_calibration
 
-        return run_calibration(cfg, args.calibrate, json_path=args.json, scheduler=scheduler)
+        return run_calibration(cfg, args.calibrate, json_path=args.json, scheduler=scheduler, workers=args.jobs)
     comp = compare(cfg, explain=not args.no_explain)
     print(format_table(comp))
     if args.json:

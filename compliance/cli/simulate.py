@@ -49,7 +49,7 @@ def register(sub):
     p.add_argument("--duration", default="10 s", help=f"simulated time (default 10 s, at most {MAX_DURATION:g} s)")
     p.add_argument("--flow-control", choices=("on", "off"), help="install/remove the 2V2/2V3 flow-control valves (default: as configured)")
     p.add_argument("--noise", action="store_true", help="add seeded sensor noise (20 um position, 300 Pa pressures, 16-bit)")
-    p.add_argument("--seed", type=int, default=0, help="noise seed, a whole number >= 0 (default 0)")
+    p.add_argument("--seed", type=int, default=None, help="with --noise: noise seed, a whole number >= 0 (default 0)")
     p.add_argument("-o", "--output", required=True, metavar="FILE.csv",
                    help="output file: .csv, .csv.gz, .parquet, or COMTRADE (IEEE C37.111-2013, BINARY32): .cfg (with "
                         "FILE.dat beside it) or the single file .cff; the sidecar FILE.toml goes beside it")
@@ -143,12 +143,15 @@ def build_scenario(cfg, args):
     elif args.open_loop_command:
         cmd = _command_profile(args.open_loop_command, cfg.p("valve.command_limit"))
         _check_within(cmd, duration, "--command")
-    if args.seed < 0:
-        raise InputError(f"--seed {args.seed}: expected a whole number >= 0")
+    if args.seed is not None and not args.noise:
+        raise InputError(f"--seed {args.seed}: seeds the sensor noise, and no --noise is asked for; add --noise or drop --seed")
+    seed = 0 if args.seed is None else args.seed
+    if seed < 0:
+        raise InputError(f"--seed {seed}: expected a whole number >= 0")
     fc = None if args.flow_control is None else args.flow_control == "on"
     noise = SensorNoise(20e-6, 10e-6, 300.0, 1e6 / 65536) if args.noise else None
     return Scenario(duration=duration, initial_position=x0, reference=ref, command=cmd, load=load,
-                    flow_control=fc, noise=noise, seed=args.seed)
+                    flow_control=fc, noise=noise, seed=seed)
 
 
 def _check_output(path: str) -> None:
@@ -156,7 +159,21 @@ def _check_output(path: str) -> None:
 
     check_output(path, "-o/--output", OUTPUT_SUFFIXES)
     if path.lower().endswith(".cfg"):
-        check_output(Path(path).with_suffix(".dat"), "-o/--output (its COMTRADE .dat)")
+        dat = Path(path).with_suffix(".dat")
+        check_output(dat, "-o/--output (its COMTRADE .dat)")
+        if dat.exists() and not _written_by_simulate(path):
+            raise InputError(f"-o {path}: its COMTRADE data file {dat} exists and was not written by govcheck simulate "
+                             "(no govcheck sidecar beside it); choose another output name (nothing is overwritten)")
+
+
+def _written_by_simulate(output: str) -> bool:
+    """The files of ``output`` are an earlier govcheck simulate run: its sidecar carries the mark."""
+    from compliance.recordings.metadata import sidecar_path
+
+    side = sidecar_path(output)
+    if not side.is_file():
+        return False
+    return side.read_text(encoding="utf-8", errors="replace").split("\n", 1)[0].strip() == SIDECAR_MARK
 
 
 def sidecar_text(cfg, scenario, plant: str) -> str:

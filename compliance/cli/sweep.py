@@ -10,7 +10,7 @@ import shlex
 import sys
 from pathlib import Path
 
-from compliance.cli.common import add_jobs, add_parser, add_quiet, add_scheduler, check_scheduler
+from compliance.cli.common import add_allow_conflicts, add_jobs, add_parser, add_quiet, add_scheduler, check_scheduler
 from compliance.errors import InputError
 from compliance.sweep.remedies.outcome import RemedyStatus
 
@@ -42,6 +42,7 @@ def register(subparsers):
                    help="tolerance yield of CANDIDATE: 'base', 'best' or a candidate number of an earlier sweep "
                         "in the same output folder")
     p.add_argument("--units", type=int, default=None, help="override the number of Monte Carlo units of --yield")
+    add_allow_conflicts(p)
     add_quiet(p, "no progress; print only the result line")
     return p
 
@@ -88,6 +89,14 @@ def _yield_candidate(which: str, out: Path, spec) -> dict:
     return {a.param.path: float(row[a.param.path]) for a in spec.adjust}
 
 
+def _check_requirement_set(spec, args) -> None:
+    """The sweep's requirement set is checked like every other command's (before any candidate runs)."""
+    from compliance.cli.common import checked_requirements
+    from compliance.model.config import load_plant
+
+    checked_requirements(spec.requirements, [load_plant(spec.base).p("cylinder.stroke")], args)
+
+
 def _command_line(args) -> str:
     parts = ["govcheck", "sweep", args.sweep]
     for flag in ("out", "scheduler", "jobs", "samples"):
@@ -119,6 +128,12 @@ def run(args) -> int:
             raise InputError(f"--{flag} {v}: expected a positive number")
     check_scheduler(args)  # a bad address is exit 2 before any work
     spec = load_sweep(args.sweep)
+    if args.units is not None and not args.yield_of:
+        raise InputError(f"--units {args.units}: the Monte Carlo units of --yield; without --yield no yield is run")
+    if args.samples is not None and spec.method == "grid":
+        raise InputError(f"--samples {args.samples}: overrides the latin-hypercube sample count, and {spec.path} searches a "
+                         "grid (method = \"grid\"), whose size its steps set")
+    _check_requirement_set(spec, args)
     if args.samples:
         spec = replace(spec, samples=args.samples)
     out = _out_dir(args, spec)
@@ -149,7 +164,7 @@ def add_remedies_options(p) -> None:
     p.add_argument("--save-remedy", metavar="FILE.toml",
                    help="with --remedies: write the verified remedy as a configuration file that govcheck check accepts "
                         "(written only when a remedy is found)")
-    p.add_argument("--catalogue", metavar="FILE.toml", default="default",
+    p.add_argument("--catalogue", metavar="FILE.toml", default=None,
                    help="with --remedies: hardware catalogue of orderable options (default: the shipped "
                         "models/hardware-catalogue.toml; 'none' for settings only)")
     p.add_argument("--yield-units", type=int, default=None, metavar="N",
@@ -157,21 +172,47 @@ def add_remedies_options(p) -> None:
                         ">= 95 %% at 95 %% confidence; 0 skips it)")
     add_scheduler(p, "the --remedies search (needs --remedies)")
     p.add_argument("--remedies-state", metavar="DIR",
-                   help="with --remedies: keep every judged candidate in DIR so an interrupted search resumes there")
+                   help="with --remedies: keep every judged candidate in DIR so an interrupted search resumes there "
+                        "(DIR is made if missing; its parent folder must exist)")
 
 
 def check_remedies_options(args) -> None:
-    """Refuse inconsistent or bad remedies options before any work (exit 2)."""
-    used = [f for f in ("save_remedy", "yield_units", "scheduler", "remedies_state") if getattr(args, f, None) is not None]
+    """Refuse inconsistent or bad remedies options before any work (exit 2).
+
+    Every option that shapes ``--remedies`` does nothing without it and is refused, not ignored.
+    """
+    used = [f for f in ("save_remedy", "catalogue", "yield_units", "scheduler", "remedies_state")
+            if getattr(args, f, None) is not None]
     if used and not args.remedies:
-        raise InputError(f"--{used[0].replace('_', '-')} needs --remedies")
+        raise InputError(f"--{used[0].replace('_', '-')} needs --remedies (without it no remedy is searched, so the "
+                         "option would do nothing)")
     if args.yield_units is not None and args.yield_units < 0:
         raise InputError(f"--yield-units {args.yield_units}: expected 0 or a positive number of units")
     check_scheduler(args)
-    if args.remedies and args.catalogue not in ("default", "none"):
+    if args.remedies_state is not None:
+        _check_state_folder(args.remedies_state)
+    if args.remedies and args.catalogue not in (None, "default", "none"):
         from compliance.sweep.sizing.hardware_catalogue import load_catalogue
 
         load_catalogue(args.catalogue)  # a bad catalogue is exit 2 before any simulation
+
+
+def _check_state_folder(text: str) -> None:
+    """``--remedies-state DIR``: a folder (made if missing) in a folder that exists and is writable."""
+    import os
+
+    state = Path(text)
+    if not text.strip():
+        raise InputError("--remedies-state: empty path; expected a folder name")
+    if state.exists() and not state.is_dir():
+        raise InputError(f"--remedies-state {text}: is a file; expected a folder for the judged candidates")
+    parent = state.parent if str(state.parent) else Path(".")
+    if not state.exists() and not parent.is_dir():
+        raise InputError(f"--remedies-state {text}: folder '{parent}' does not exist (govcheck makes only the state "
+                         "folder itself, never its parents)")
+    where = state if state.exists() else parent
+    if not os.access(where, os.W_OK | os.X_OK):
+        raise InputError(f"--remedies-state {text}: folder '{where}' is not writable")
 
 
 def remedies_kwargs(args) -> dict:
@@ -179,7 +220,8 @@ def remedies_kwargs(args) -> dict:
     from compliance.sweep.candidates.candidate_store import CandidateStore
     from compliance.sweep.check_remedies import YIELD_UNITS
 
-    return {"catalogue": None if args.catalogue == "none" else args.catalogue, "scheduler": args.scheduler,
+    catalogue = "default" if args.catalogue is None else (None if args.catalogue == "none" else args.catalogue)
+    return {"catalogue": catalogue, "scheduler": args.scheduler,
             "yield_units": YIELD_UNITS if args.yield_units is None else args.yield_units,
             "store": CandidateStore(args.remedies_state) if args.remedies_state else None}
 

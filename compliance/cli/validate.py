@@ -142,6 +142,9 @@ def run(args) -> int:
     modes = MODES if mode == "both" else (mode,)
     if args.max_windows < 0:
         raise InputError(f"--max-windows {args.max_windows}: expected a number of windows >= 0")
+    if args.noise is not None and modes == ("plant_only",):
+        raise InputError(f"--noise {args.noise}: the position noise of the closed-loop replay, and --mode plant_only "
+                         "runs none; drop --noise or use --mode both")
     if args.pdf and not args.report:
         raise InputError("--pdf needs --report FILE.html")
     check_args_outputs(args)  # fail before the work, nothing written

@@ -11,6 +11,7 @@ import dataclasses
 import gzip
 import json
 import math
+import zlib
 from pathlib import Path, PurePath
 
 import numpy as np
@@ -84,7 +85,7 @@ def read_json(path, what: str) -> dict:
         raise InputError(f"{p}: {what} file not found") from None
     except IsADirectoryError:
         raise InputError(f"{p}: is a folder; expected a {what} JSON file") from None
-    except (UnicodeDecodeError, json.JSONDecodeError, gzip.BadGzipFile, EOFError) as exc:
+    except (UnicodeDecodeError, json.JSONDecodeError, gzip.BadGzipFile, EOFError, zlib.error) as exc:
         raise InputError(f"{p}: not a JSON {what} file ({exc})") from None
     if not isinstance(data, dict):
         raise InputError(f"{p}: expected a JSON object ({what}), got {type(data).__name__}")

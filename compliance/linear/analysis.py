@@ -29,6 +29,7 @@ from compliance.linear.trim import TrimPoint, linearise_plant, minimal_realisati
 
 PADE_ORDER = 3  # delays as 3rd-order Pade: phase error < 1 deg up to omega*T = 2 (well beyond crossover)
 STEP_FRACTION = 0.05  # predicted step: 5 % of stroke (the linear shape does not depend on the size)
+_PID_INPUTS = ["reference_m", "position_measured_m"]  # python-control names carry the unit after the last underscore
 METRIC_NAMES = ("time_constant", "gain_margin_db", "phase_margin_deg", "bandwidth_hz", "damping_ratio",
                 "pneumatic_damping_ratio", "natural_frequency_hz", "dominant_time_constant")
 
@@ -53,12 +54,12 @@ def pid_controller(cfg: PlantConfig, discrete: bool = False) -> control.StateSpa
         a = first_order_filter_gain(fc, ts)  # alpha = 1 - exp(-w_f T_s)
         k0 = kp + ki * ts
         return control.ss([[1.0, 0.0], [0.0, 1.0 - a]], [[ts, -ts], [0.0, a]], [[ki, kd * a / ts]],
-                          [[k0, -k0 - kd * a / ts]], ts, inputs=["r", "xm"], outputs=["u_d"])
+                          [[k0, -k0 - kd * a / ts]], ts, inputs=_PID_INPUTS, outputs=["u_d_V"])
     if fc <= 0.0:
         raise InputError(f"{cfg.path or cfg.name}: controller.filter_cutoff must be > 0 for the continuous linear model")
     wf = 2.0 * math.pi * fc
     return control.ss([[0.0, 0.0], [0.0, -wf]], [[1.0, -1.0], [0.0, wf]], [[ki, kd * wf]],
-                      [[kp, -kp - kd * wf]], inputs=["r", "xm"], outputs=["u_d"])
+                      [[kp, -kp - kd * wf]], inputs=_PID_INPUTS, outputs=["u_d_V"])
 
 
 def _augment(cfg: PlantConfig, plant: control.StateSpace) -> control.StateSpace:
@@ -82,7 +83,7 @@ def _augment(cfg: PlantConfig, plant: control.StateSpace) -> control.StateSpace:
     # stack [x; xm] over the states of gm (g's states come first in control.series(g, h))
     A, B = gm.A, gm.B
     C = np.vstack([np.hstack([g.C, np.zeros((1, n2 - n1))]), gm.C])
-    return control.ss(A, B, C, np.zeros((2, 1)), outputs=["x", "xm"])
+    return control.ss(A, B, C, np.zeros((2, 1)), inputs=["u_d_V"], outputs=["position_m", "position_measured_m"])
 
 
 def _close(g2: control.StateSpace, k: control.StateSpace) -> control.StateSpace:
@@ -93,7 +94,7 @@ def _close(g2: control.StateSpace, k: control.StateSpace) -> control.StateSpace:
     A = np.block([[Ag + Bg @ Dk[:, 1:2] @ c_m, Bg @ Ck], [Bk[:, 1:2] @ c_m, Ak]])
     B = np.vstack([Bg @ Dk[:, 0:1], Bk[:, 0:1]])
     C = np.hstack([c_x, np.zeros((1, Ak.shape[0]))])
-    return control.ss(A, B, C, [[0.0]], g2.dt, inputs=["r"], outputs=["x"])
+    return control.ss(A, B, C, [[0.0]], g2.dt, inputs=["reference_m"], outputs=["position_m"])
 
 
 def close_loop(cfg: PlantConfig, plant: control.StateSpace, discrete: bool = False):
@@ -123,9 +124,10 @@ def close_loop(cfg: PlantConfig, plant: control.StateSpace, discrete: bool = Fal
 
 def _loop(g2, k):
     """Loop transfer L = C_y * G_m (broken at the valve command), for margins and Nyquist."""
-    cy = control.ss(k.A, k.B[:, 1:2], -k.C, -k.D[:, 1:2], k.dt)
-    gm = control.ss(g2.A, g2.B, g2.C[1:2], [[0.0]], g2.dt)
-    return control.series(gm, cy)
+    cy = control.ss(k.A, k.B[:, 1:2], -k.C, -k.D[:, 1:2], k.dt, inputs=["position_measured_m"], outputs=["u_d_return_V"])
+    gm = control.ss(g2.A, g2.B, g2.C[1:2], [[0.0]], g2.dt, inputs=["u_d_V"], outputs=["position_measured_m"])
+    L = control.series(gm, cy)
+    return control.ss(L.A, L.B, L.C, L.D, L.dt, inputs=["u_d_V"], outputs=["u_d_return_V"])
 
 
 def _damping(p):
@@ -214,7 +216,7 @@ def analyse(cfg: PlantConfig, position: float, load: float | str | None = None, 
     kind_of(cfg).check_linear(cfg)
     op = trim(cfg, position, load, flow_control=flow_control)
     A, B, C, names, info = linearise_plant(op, cfg, gain)
-    plant = control.ss(A, B, C, [[0.0]], states=names, inputs=["u_d"], outputs=["position"])
+    plant = control.ss(A, B, C, [[0.0]], states=names, inputs=["u_d_V"], outputs=["position_m"])
     Am, Bm, Cm = minimal_realisation(A, B, C, np.array(info["state_scales"]))
     if Am.size == 0:  # nothing of the valve command reaches the position at the numerical precision of the scales
         raise InputError(
@@ -222,7 +224,7 @@ def analyse(cfg: PlantConfig, position: float, load: float | str | None = None, 
             f"to the position left (every mode is numerically uncontrollable or unobservable); the states differ in "
             f"speed beyond what double precision resolves - check cylinder.moving_mass = {cfg.p('cylinder.moving_mass'):g} kg "
             "and the other scales of the configuration")
-    gmin = control.ss(Am, Bm, Cm, [[0.0]], inputs=["u_d"], outputs=["position"])
+    gmin = control.ss(Am, Bm, Cm, [[0.0]], inputs=["u_d_V"], outputs=["position_m"])
     T, Lc = close_loop(cfg, gmin)
     Td, Ld = close_loop(cfg, gmin, discrete=True)
     figs, data = _figures(cfg, op, plant, gmin, Lc, Ld, T, Td, n_freq, detail)

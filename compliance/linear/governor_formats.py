@@ -28,9 +28,13 @@ __all__ = ["GovernorModel", "HYGOV_DYR_ORDER", "ANDES_MODELS"]
 # PSS/E HYGOV CONs in .dyr order after BUS 'HYGOV' ID (PSS/E Model Library; ANDES io/psse-dyr.yaml)
 HYGOV_DYR_ORDER = ("R", "r", "Tr", "Tf", "Tg", "VELM", "GMAX", "GMIN", "Tw", "At", "Dturb", "qNL")
 ANDES_MODELS = ("HYGOV", "HYGOVDB", "HYGOV4")  # ANDES 2.0's hydro governors (no IEEEG3)
-# Governor and turbine parameters govcheck does not know: ANDES 2.0 defaults, to be replaced by the unit's data
-_HYGOV_OTHERS = {"R": 0.05, "r": 1.0, "Tr": 1.0, "Tf": 0.05, "Tw": 1.0, "At": 1.0, "Dturb": 0.0, "qNL": 0.1}
 HYGOV4_RATIO = 0.10  # opening/closing rates differing by more than this favour HYGOV4 (our choice)
+SYSTEM_MVA = 100.0  # [MVA] the system base of PSS/E and ANDES cases unless they say otherwise (SBASE, config.mva)
+# The bare positioner in HYGOV: the speed-governor loop made transparent so the gate follows its set-point
+# through the servo's own lag and rate limit (our choices, each far from the servo's time scales):
+DESIRED_GATE_TAU = 0.01  # [s] 1/R on the system base: the desired gate follows the set-point 23x faster than Tg
+TEMPORARY_DROOP = 1e6  # r on the system base: no proportional path (ANDES shifts the rate bounds by LG_y/r)
+FILTER_TAU = 1e-3  # [s] Tf: the input filter, 10x faster than the desired-gate loop
 
 
 @dataclass
@@ -52,6 +56,7 @@ class GovernorModel:
     end_stop: list = field(default_factory=list)  # commissioning strokes from the end stops (comparison)
     GMAX: float = 1.0
     GMIN: float = 0.0
+    study: dict = field(default_factory=dict)  # rating_mva, system_mva, dispatch_mw of the exported ANDES / PSS/E forms
 
     def _best(self, direction: str, key: str) -> float:
         return max(m[key] for m in self.moves if m["direction"] == direction)
@@ -80,9 +85,12 @@ class GovernorModel:
         why = [f"opening and closing rates differ by {100 * ratio:.0f} %" + (" (> 10 %): only HYGOV4 carries both (UO, UC)"
                                                                            if ratio > HYGOV4_RATIO else " (<= 10 %)")]
         if small > 0.5 * self.VELM:
+            clip = {d: self.hygov4_clipped(d) for d in (0.05, -0.05)}
+            clipped = [f"{100 * d:+.0f} % for {1e3 * t:.0f} ms" for d, t in clip.items() if t > 0]
             why.append(f"a 5 % step asks {small:.2f} pu/s of the lag, comparable with VELM {self.VELM:.2f} pu/s: HYGOV's limit on "
-                       "the integrator ramps the desired gate before the Tg lag and slows small steps; "
-                       "HYGOV4's limit on the gate velocity does not")
+                       "the integrator ramps the desired gate before the Tg lag and slows small steps; HYGOV4's limits "
+                       "act on the gate itself, as the servo's own rate does"
+                       + (f" (they clip a {' and a '.join(clipped)})" if clipped else " (they do not clip a 5 % step)"))
         pick = "HYGOV4" if (ratio > HYGOV4_RATIO or small > 0.5 * self.VELM) else "HYGOV"
         return {"recommended": pick, "andes_models": list(ANDES_MODELS), "opening_closing_rate_difference": ratio,
                 "why": "; ".join(why),
@@ -96,6 +104,24 @@ class GovernorModel:
                           "HYGOVDB's dead band (dbL/dbU) is on the speed input, not the gate: the servo's dead-zone steady "
                           "error has no place in these models (PSS/E HYGOV4's DB2 is ignored by ANDES)."]}
 
+    def hygov4_clipped(self, step: float, dt: float = 1e-4) -> float:
+        """How long [s] HYGOV4's gate-velocity limit (UO/UC) clips a set-point ``step`` [pu] of the bare positioner.
+
+        The HYGOV4 gate loop with unity feedback (Rperm = 1 pu on Sb, Rtemp = 0): LAG' = (e - LAG)/Tp with
+        e = step - gate change, gate' = clip(LAG/Tg, UC, UO) (ANDES 2.0, models/governor/hygov4.py), integrated here.
+        """
+        tp = max(self.dead_time or 0.0, 1e-3)
+        lag = moved = 0.0
+        clipped = 0.0
+        for _ in range(int(10 * (self.Tg + tp) / dt)):
+            lag += dt * ((step - moved) - lag) / tp
+            want = lag / self.Tg
+            rate = min(max(want, self.UC), self.UO)
+            if rate != want:
+                clipped += dt
+            moved += dt * rate
+        return clipped
+
     def servo(self) -> dict:
         """The measured figures, pu on the machine base (gate = stroke)."""
         L = self.stroke
@@ -105,26 +131,88 @@ class GovernorModel:
                 "GMAX": self.GMAX, "GMIN": self.GMIN,
                 "steady_error_pu": {k: v / L for k, v in self.steady_error.items()}}
 
-    def andes(self) -> dict:
-        """Parameters ready for ``ss.add("HYGOV", {...})`` / ``ss.add("HYGOV4", {...})`` (ANDES 2.0 names)."""
-        s = self.servo()
-        tp = max(s["dead_time"] or 0.0, 1e-3)
-        return {"HYGOV": {"Tg": s["Tg"], "VELM": s["VELM"], "GMAX": s["GMAX"], "GMIN": s["GMIN"]},
-                "HYGOV4": {"Tg": s["Tg"], "Tp": tp, "UO": s["UO"], "UC": s["UC"], "PMAX": s["GMAX"], "PMIN": s["GMIN"]},
-                "HYGOV4_bare_positioner": {"Rperm": "Tn/Sb on the machine base (1 pu on Sb: ANDES scales Rperm by Sb/Tn "
-                                                    "while the gate integrator's input stays on Sb)", "Rtemp": 0.0},
-                "Tn": "the unit's rating [MVA]: the machine base of GMAX, GMIN, VELM, UO, UC, PMAX, PMIN",
-                "scaling": "ANDES converts power=True parameters (GMAX, GMIN, VELM, UO, UC, PMAX, PMIN, qNL, Dt, Hdam) "
-                           "from Tn (or the generator's Sn when Tn = 0) to the system base Sb by Tn/Sb, and R, r, Rperm, "
-                           "Rtemp by Sb/Tn; the gate outputs (LAG_y, GATE_y) are then on Sb: divide by Tn/Sb to get gate pu.",
-                "from_the_unit": {k: f"{v} (ANDES default; replace)" for k, v in _HYGOV_OTHERS.items()}}
+    def andes(self, rating_mva: float | None = None, system_mva: float = SYSTEM_MVA,
+              dispatch_mw: float | None = None) -> dict:
+        """Every parameter of ``ss.add("HYGOV4", {...})`` and ``ss.add("HYGOV", {...})`` (ANDES 2.0) as a number
+        on the machine base, for a bare positioner: the gate follows its set-point through the servo's own lag,
+        dead time and rate limits. With the basis each number rests on.
 
-    def dyr(self, bus: int = 1, machine: str = "1") -> str:
-        """A PSS/E HYGOV record (machine base); governor/turbine entries are ANDES defaults to replace."""
-        values = dict(_HYGOV_OTHERS, Tg=self.Tg, VELM=self.VELM, GMAX=self.GMAX, GMIN=self.GMIN)
+        Parameters
+        ----------
+        rating_mva : float, optional
+            Tn, the unit's rating [MVA]: the machine base (default: the system base, Tn = Sb).
+        system_mva : float
+            Sb, the study's system base [MVA] (default 100, PSS/E's and ANDES's).
+        dispatch_mw : float, optional
+            The unit's mechanical power at the operating point [MW], as the case dispatches it; At is chosen so
+            that the gate starts at the operating point (default: Tn times the operating gate, At = 1).
+
+        Returns
+        -------
+        dict
+            ``HYGOV4`` and ``HYGOV`` (complete parameter dicts, ``Tn`` included), ``setpoint`` (per model: the
+            ``paux0`` step per pu of gate, on Sb), ``gate_output`` (what ``GATE_y`` / ``LAG_y`` read per pu of gate),
+            ``gate0`` (the operating gate, pu), ``basis`` (every choice in words) and ``scaling``.
+        """
+        s = self.servo()
+        tn = float(system_mva if rating_mva is None else rating_mva)
+        if not (tn > 0 and system_mva > 0):
+            raise ValueError(f"rating {tn!r} MVA and system base {system_mva!r} MVA must be positive")
+        k = tn / system_mva  # machine base -> system base, ANDES's Tn/Sb for power=True parameters
+        g0 = self.point["position"] / self.stroke
+        p0 = g0 if dispatch_mw is None else dispatch_mw / tn  # [pu on Tn]
+        at = p0 / g0 if g0 > 0 else 1.0
+        tp = max(s["dead_time"] or 0.0, 1e-3)
+        turbine = {"Tw": 1.0, "At": at, "qNL": 0.0}
+        hygov4 = {"Tn": tn, "Tg": s["Tg"], "Tp": tp, "UO": s["UO"], "UC": s["UC"], "PMAX": s["GMAX"], "PMIN": s["GMIN"],
+                  "Rperm": k, "Rtemp": 0.0, "Tr": 1.0, "Dturb": 0.0, "Hdam": 1.0 / k, **turbine}
+        hygov = {"Tn": tn, "R": k / DESIRED_GATE_TAU, "r": TEMPORARY_DROOP * k, "Tr": 1.0 / (TEMPORARY_DROOP * k),
+                 "Tf": FILTER_TAU, "Tg": s["Tg"], "VELM": s["VELM"], "GMAX": s["GMAX"], "GMIN": s["GMIN"], "Dt": 0.0,
+                 **turbine}
+        basis = {
+            "Tn": f"{tn:g} MVA, the machine base of every number here ({'the system base: no rating given' if rating_mva is None else 'the unit rating given'})",
+            "Sb": f"{system_mva:g} MVA, the system base; ANDES scales power=True parameters by Tn/Sb = {k:g} and R, r, "
+                  "Rperm, Rtemp by Sb/Tn",
+            "servo": "Tg, Tp, UO, UC, VELM, PMAX/GMAX, PMIN/GMIN: the servo as measured (basis.sentences)",
+            "Rperm": f"Tn/Sb = {k:g}: 1 pu on Sb, a unity gate loop whose time constant is Tg (HYGOV4's gate integrator is "
+                     "fed on Sb while Rperm is converted)",
+            "Rtemp": "0: no temporary droop, so Tr does nothing (1 s kept as a valid value)",
+            "Hdam": f"Sb/Tn = {1.0 / k:g}: a head of 1 pu on Sb",
+            "At": f"{at:.6g} = dispatch / (Tn x gate0) = {p0:.6g} / {g0:.6g}: the gate starts at the operating point "
+                  f"{g0:.4f} pu ({self.point['position'] * 1e3:.1f} mm) when the case dispatches "
+                  f"{p0 * tn:.6g} MW on this unit",
+            "qNL": "0: the flow follows the gate (the unit's no-load flow is its own data: a power study sets it)",
+            "Tw": "1 s: the water starting time does not move the gate (the unit's own value for a power study)",
+            "Dturb": "0: no turbine damping (the unit's own data)",
+            "HYGOV_R": f"Tn/(Sb x {DESIRED_GATE_TAU:g} s) = {k / DESIRED_GATE_TAU:g}: the desired gate follows the "
+                       f"set-point within {DESIRED_GATE_TAU * 1e3:g} ms (1/R on Sb), so the gate moves with Tg and VELM",
+            "HYGOV_r": f"{TEMPORARY_DROOP:g} x Tn/Sb: no proportional path; Tr = 1/r so that PSS/E's integrator gain "
+                       "1/(r Tr) is 1 as ANDES's is",
+            "HYGOV_Tf": f"{FILTER_TAU * 1e3:g} ms: the speed filter out of the way",
+        }
+        return {"HYGOV4": hygov4, "HYGOV": hygov,
+                "setpoint": {"HYGOV4": k, "HYGOV": k / DESIRED_GATE_TAU,
+                             "note": "paux0 per pu of gate (on Sb, the model's own gain R or Rperm times Tn/Sb): raise "
+                                     "paux0 by this times the gate change [pu of stroke] to move the set-point"},
+                "gate_output": {"per_pu_gate": k, "note": "GATE_y (HYGOV4) and LAG_y (HYGOV) read this per pu of gate"},
+                "gate0": g0, "basis": basis,
+                "scaling": "ANDES converts power=True parameters (GMAX, GMIN, VELM, UO, UC, PMAX, PMIN, qNL, Dt, Hdam) "
+                           "from Tn (or the generator's Sn when Tn = 0, as after reading a .dyr) to the system base Sb by "
+                           "Tn/Sb, and R, r, Rperm, Rtemp by Sb/Tn; the numbers here are given on Tn, once."}
+
+    def dyr(self, bus: int = 1, machine: str = "1", rating_mva: float | None = None, system_mva: float = SYSTEM_MVA,
+            dispatch_mw: float | None = None) -> str:
+        """A PSS/E HYGOV record, every CON a number on the machine base (the bare positioner of :meth:`andes`).
+
+        A .dyr carries no Tn: ANDES takes the generator's MBASE (Sn), which must be ``rating_mva``.
+        """
+        a = self.andes(rating_mva, system_mva, dispatch_mw)["HYGOV"]
+        values = dict(a, Dturb=a["Dt"])
         nums = " ".join(f"{values[k]:.6g}" for k in HYGOV_DYR_ORDER)
-        return (f"{bus} 'HYGOV' '{machine}' {nums} /  govcheck {self.name}: Tg VELM GMAX GMIN from the servo "
-                f"(machine base); R r Tr Tf Tw At Dturb qNL are ANDES defaults, replace with the unit's data")
+        tn = a["Tn"]
+        return (f"{bus} 'HYGOV' '{machine}' {nums} /  govcheck {self.name}: bare gate positioner on MBASE {tn:g} MVA, "
+                f"SBASE {system_mva:g} MVA (Tg VELM GMAX GMIN the servo; R r Tr Tf make the governor transparent; "
+                "Tw At Dturb qNL a turbine whose flow follows the gate)")
 
     def to_dict(self) -> dict:
         """Everything as JSON: the HYGOV block (parameters, rate_limits, units) first, then the other forms."""
@@ -136,11 +224,13 @@ class GovernorModel:
             "units": {"Tg": "s", "VELM": "pu/s", "GMAX": "pu", "GMIN": "pu", "UO": "pu/s", "UC": "pu/s (negative: closing)",
                       "UO_peak": "pu/s", "UC_peak": "pu/s (negative: closing)"},
             "Tg_linear": s["Tg_linear"],
-            "HYGOV4": self.andes()["HYGOV4"],
+            "HYGOV4": self.andes(**self.study)["HYGOV4"],
             "ieee_pes_tr_2013": {"T_G": s["Tg"], "U_O": s["UO"], "U_C": s["UC"], "G_max": s["GMAX"], "G_min": s["GMIN"],
                                  "VELM": s["VELM"]},
-            "andes": self.andes(),
-            "psse_dyr": {"HYGOV": self.dyr()},
+            "andes": self.andes(**self.study),
+            "psse_dyr": {"HYGOV": self.dyr(**self.study),
+                         "basis": "the bare positioner of andes.HYGOV, on the machine base andes.basis names (a .dyr has no "
+                                  "Tn: MBASE, the generator's rating, must be that Tn)"},
             "family": self.family,
             "conventions": self.conventions(),
             "left_out": self.left_out(),
@@ -212,5 +302,5 @@ class GovernorModel:
         w = max(len(r[0]) for r in rows)
         lines = [f"{n:<{w}}  {v:>8} {u:<5} {m}" for n, v, u, m in rows]
         lines.append(f"model: {self.family['recommended']} ({self.family['why']})")
-        lines.append("PSS/E: " + self.dyr())
+        lines.append("PSS/E: " + self.dyr(**self.study))
         return "\n".join(lines)

@@ -10,7 +10,8 @@
   govcheck's linear analysis uses); ``compliance.linear.nlsys_loop`` adds the controller, the closed
   loop and a physically checked ``find_operating_point``;
 - :func:`to_statespace` gives the linearisation as a ``control.StateSpace`` u_d [V] -> position [m]:
-  the model ``govcheck linear`` analyses.
+  the model ``govcheck linear`` analyses (``compliance.linear.linear_model.linear_model`` adds its loop
+  and closed loop, ready for ``control.margin``, ``step_info``, ``dcgain`` and ``bandwidth``).
 
 The valve's pure delays (an effect's ``delay`` parameters) are applied by the simulator outside
 the right-hand side and are not part of the NonlinearIOSystem; add ``control.pade`` if needed.
@@ -33,7 +34,9 @@ __all__ = ["INPUT", "OPENING_INPUT", "OUTPUTS", "STATE_UNITS", "active_states", 
            "to_nlsys", "to_statespace", "valve_command_for_opening"]
 
 INPUT = "valve_command_V"  # [V] at the valve (after compensation, saturation and the centre voltage)
-OPENING_INPUT = "opening"  # [-] the same command expressed as the static opening it gives (signed, > 0 opens)
+# [-] the same command expressed as the static opening it gives (signed, > 0 opens); not "opening_1", the name of
+# the plant's own opening output: control.interconnect joins equal names, and would feed the output back to the input
+OPENING_INPUT = "command_opening_1"
 OUTPUTS = ("position", "pressure_a", "pressure_b") + AUX_NAMES  # then the aux signals (SI)
 # SI unit of every state and output, for the labels (our own table; the core stores bare SI floats)
 STATE_UNITS = {"position": "m", "velocity": "m_s", "pressure_a": "Pa", "pressure_b": "Pa", "temperature_a": "K",
@@ -202,7 +205,9 @@ def to_statespace(cfg: PlantConfig, position: float, load: float | str | None = 
     Returns
     -------
     control.StateSpace
-        States named as in ``STATE_NAMES`` (those of the linear model), input ``u_d``, output ``position``.
+        Input ``u_d_V``, output ``position_m``; states named with their unit (``position_m``, ``pressure_a_Pa``...),
+        or ``z0``, ``z1``... with ``minimal`` (combinations of the physical states, no single unit).
+        ``compliance.linear.linear_model.linear_model`` gives the loop and closed loop around it as well.
     """
     import control
 
@@ -213,5 +218,7 @@ def to_statespace(cfg: PlantConfig, position: float, load: float | str | None = 
     if minimal:
         A, B, C = minimal_realisation(A, B, C, np.asarray(info["state_scales"]))
         names = [f"z{i}" for i in range(A.shape[0])]
-    return control.ss(A, B, C, np.zeros((1, 1)), inputs=["u_d"], outputs=["position"], states=list(names),
+    else:
+        names = [labelled(n) if n in STATE_UNITS else n for n in names]
+    return control.ss(A, B, C, np.zeros((1, 1)), inputs=["u_d_V"], outputs=["position_m"], states=list(names),
                       name=f"{cfg.name}-linear-{position*1e3:.0f}mm")

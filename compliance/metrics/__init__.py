@@ -13,7 +13,8 @@ This module is the public face of the metrics; each family lives in its own modu
 - :mod:`compliance.metrics.trace_windows`: columns, time windows, level crossings;
 - :mod:`compliance.metrics.speed`: speeds and valve-command saturation;
 - :mod:`compliance.metrics.step`: step detection and step responses;
-- :mod:`compliance.metrics.stroke`: full-stroke times, independent adjustment;
+- :mod:`compliance.metrics.step_eligibility`: which steps measure the time constant, and why not;
+- :mod:`compliance.metrics.stroke`: full-stroke figures, stroke time by a named timing, independent adjustment;
 - :mod:`compliance.metrics.position_error`: tracking errors and holding a position;
 - :mod:`compliance.metrics.dead_band`: the hysteresis-loop dead band.
 """
@@ -25,7 +26,8 @@ from compliance.metrics.catalogue import METRICS, STEP_OPTION_DEFAULTS, MetricIn
 from compliance.metrics.position_error import HoldMetrics, hold, tracking_errors
 from compliance.metrics.speed import saturation_fraction, speed, speed_extremes
 from compliance.metrics.step import DETECT_FRACTION, TAU_FRACTION, StepEvent, StepMetrics, find_steps, step_response
-from compliance.metrics.stroke import independent_adjustment, stroke_time, stroke_timing
+from compliance.metrics.step_eligibility import StepLimits, time_constant_eligibility, time_constant_value
+from compliance.metrics.stroke import independent_adjustment, stroke_figures, stroke_time, stroke_timing, timed
 from compliance.metrics.trace_windows import frame_columns
 
 __all__ = [
@@ -37,6 +39,7 @@ __all__ = [
     "HoldMetrics",
     "MetricInfo",
     "StepEvent",
+    "StepLimits",
     "StepMetrics",
     "dead_band",
     "find_steps",
@@ -47,7 +50,11 @@ __all__ = [
     "speed",
     "speed_extremes",
     "step_response",
+    "stroke_figures",
     "stroke_time",
     "stroke_timing",
+    "time_constant_eligibility",
+    "time_constant_value",
+    "timed",
     "tracking_errors",
 ]

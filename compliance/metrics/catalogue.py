@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["METRICS", "STEP_OPTION_DEFAULTS", "MetricInfo"]
+__all__ = ["CHOICE_OPTIONS", "METRICS", "STEP_OPTION_DEFAULTS", "MetricInfo", "option_value"]
 
 
 @dataclass(frozen=True)
@@ -34,8 +34,9 @@ METRICS: dict[str, MetricInfo] = {
         MetricInfo("dead_time", "s", "s", 1.0, ("steps",), "command step to first detectable motion", ("detect",)),
         MetricInfo(
             "time_constant", "s", "s", 1.0, ("steps",),
-            "end of dead time to 63.2 % of the commanded step, first step from rest, steps out of the rate limit only",
-            ("detect",),
+            "end of dead time to 63.2 % of the travel (achieved, or the commanded step), first step from rest, "
+            "steps no limiting device acts on",
+            ("detect", "travel"),
         ),
         MetricInfo("rise_time", "s", "s", 1.0, ("steps",), "10 % to 90 % of the actual change", ("final_window",)),
         MetricInfo("settling_time", "s", "s", 1.0, ("steps",), "step to last exit from the settling band", _SETTLE_OPTS),
@@ -51,8 +52,16 @@ METRICS: dict[str, MetricInfo] = {
         MetricInfo("tracking_rms_error", "m", "mm", 1e3, ("sine",), "RMS of reference - position after the skip"),
         MetricInfo("tracking_max_error", "m", "mm", 1e3, ("sine",), "max |reference - position| after the skip"),
         MetricInfo("dead_band", "m", "mm", 1e3, ("dead_band",), "width of the position/reference hysteresis loop"),
-        MetricInfo("opening_time", "s", "s", 1.0, ("full_stroke",), "2 x time from 25 % to 75 % of stroke, opening"),
-        MetricInfo("closing_time", "s", "s", 1.0, ("full_stroke",), "2 x time from 75 % to 25 % of stroke, closing"),
+        MetricInfo("opening_time", "s", "s", 1.0, ("full_stroke",),
+                   "full-stroke opening time, timed as the requirement's timing names", ("timing",)),
+        MetricInfo("closing_time", "s", "s", 1.0, ("full_stroke",),
+                   "full-stroke closing time, timed as the requirement's timing names", ("timing",)),
+        MetricInfo("start_delay", "s", "s", 1.0, ("full_stroke",),
+                   "full stroke: command to 1 % of the stroke travelled"),
+        MetricInfo("time_to_end", "s", "s", 1.0, ("full_stroke",),
+                   "full stroke: command to 99 % of the stroke travelled (the end stop)"),
+        MetricInfo("cushion_time", "s", "s", 1.0, ("full_stroke",),
+                   "full stroke: 90 % to 99 % of the stroke travelled (the approach to the end stop)"),
         MetricInfo(
             "stroke_speed", "m/s", "mm/s", 1e3, ("full_stroke",),
             "mean speed from 25 % to 75 % of a full stroke (the rate the speed setting sets; stroke / full-stroke time)",
@@ -93,6 +102,24 @@ STEP_OPTION_DEFAULTS = {
     "detect": ("m", "0 mm", "motion threshold for the dead time; 0 = max(1 % of the step, 5 x pre-step noise)"),
     "final_window": ("s", "0.5 s", "window before the next step over which the settled position is taken"),
 }
+
+# options that name a reading (a word from a fixed list, not a quantity): name -> (choices, default, meaning)
+CHOICE_OPTIONS = {
+    "timing": (("full_rate", "end_to_end", "extrapolated"), "full_rate",
+               "how a full-stroke time is timed: full_rate = the stroke at the rate of its straight part (25-75 % "
+               "extrapolated; a stroke with no straight part gets its end-to-end time, flagged); end_to_end = command to "
+               "the end of travel, start delay included; extrapolated = 25-75 % extrapolated whatever the shape"),
+    "travel": (("achieved", "commanded"), "achieved",
+               "what 63.2 % of the time constant refers to: the travel the servo achieved (x_final - x0) or the "
+               "commanded step"),
+}
+
+
+def option_value(options: dict, name: str) -> str:
+    """The value of choice option ``name`` in a requirement's ``options`` (its default when not given)."""
+    v = (options or {}).get(name)
+    return CHOICE_OPTIONS[name][1] if v is None else str(getattr(v, "text", v))
+
 
 # plant B (seed 001): path and axis tracking; kinds as in procedures.kinds.TRACKING / ROBOT_TRACKING
 _ROBOT_TRACKING = ("circle_tracking", "helix_tracking", "stroke_tracking")

@@ -1,7 +1,7 @@
 """Step responses: find the set-point steps of a trace and measure each response.
 
-Dead time and time constant follow IEC 61362 (first detectable motion; 63.2 % of the
-COMMANDED step); rise time (10-90 % of the actual change), settling time (last exit from a
+Dead time and time constant follow IEC 61362 (first detectable motion; 63.2 % of the achieved
+travel, the first-order definition, with 63.2 % of the commanded step beside it); rise time (10-90 % of the actual change), settling time (last exit from a
 band about the final value) and overshoot (per cent of the actual change) match python-control's
 ``step_info`` conventions. Definitions are written out in ``docs/metrics.md``.
 """
@@ -91,6 +91,7 @@ class StepMetrics:
     reasons: dict = field(default_factory=dict)
     marks: dict = field(default_factory=dict)
     time_constant_achieved: float | None = None  # end of dead time to 63.2 % of the ACHIEVED travel x_final - x_start [s]
+    command_peak: float | None = None  # max |valve command| from the step to the later 63.2 % point [V]; None = no command
 
 
 def step_response(
@@ -114,9 +115,10 @@ def step_response(
     event : StepEvent
         The step (from :func:`find_steps`); the response is analysed on [t_step, t_end).
     valve_command : array [V], optional
-        With ``command_saturation`` [V]: a step whose command reaches the valve's full-opening
-        voltage before the 63.2 % point is *rate limited*; its time constant is measured but
-        flagged, since it then reflects flow saturation, not the linear time constant.
+        About the valve centre. Its peak up to the later 63.2 % point is kept (``command_peak``);
+        with ``command_saturation`` [V] a step whose command reaches the flow saturation before the
+        commanded 63.2 % point is flagged *saturated* (``rate_limited``): its time constant then
+        reflects flow saturation, not the linear time constant (``metrics.step_eligibility``).
     settling_band : float
         Half-width of the settling band as a fraction of the actual change (step_info: 0.02).
     settling_band_abs : float
@@ -147,12 +149,20 @@ def step_response(
     tau, rate_limited = _time_constant(time, tt, xx, event, x0, t_move, i_step, valve_command, command_saturation,
                                        reasons, marks)
     rise, settle, over = _step_info(tt, xx, event, x0, xf, thr, settling_band, settling_band_abs, reasons, marks)
-    tau_a = None
+    tau_a = t63a = None
     if t_move is not None and abs(xf - x0) > thr:  # the same definition on the travel the servo actually made
         t63a = crossing(tt, xx, x0 + TAU_FRACTION * (xf - x0), 0, 1 if xf > x0 else -1)
         tau_a = None if t63a is None else t63a - t_move
+        if t63a is not None:
+            marks["tau_632_achieved"] = [t63a, x0 + TAU_FRACTION * (xf - x0)]
+    u_peak = None
+    if valve_command is not None:
+        t63 = marks.get("tau_632", [None])[0]
+        t_to = max((v for v in (t63, t63a) if v is not None), default=event.t_end)
+        u = np.asarray(valve_command, float)[i_step: max(i_step + 1, int(np.searchsorted(time, t_to, side="right")))]
+        u_peak = float(np.max(np.abs(u))) if u.size else None
     return StepMetrics(
-        event, x0, xf, dead_time, tau, rise, settle, over, sse, mpe, vmax, rate_limited, reasons, marks, tau_a
+        event, x0, xf, dead_time, tau, rise, settle, over, sse, mpe, vmax, rate_limited, reasons, marks, tau_a, u_peak
     )
 
 
@@ -210,7 +220,7 @@ def _time_constant(time, tt, xx, event: StepEvent, x0: float, t_move, i_step: in
         u = np.asarray(valve_command, float)[i_step : int(np.searchsorted(time, t63, side="right"))]
         if u.size and np.max(np.abs(u)) >= command_saturation * (1.0 - 1e-9):
             reasons["time_constant"] = (
-                f"rate limited: valve command reached {np.max(np.abs(u)):.2f} V >= flow saturation "
+                f"saturated: valve command reached {np.max(np.abs(u)):.2f} V >= flow saturation "
                 f"{command_saturation:.2f} V (valve fully open, or flow-control valve limiting) before 63.2 %"
             )
             return t63 - t_move, True

@@ -33,10 +33,35 @@ from compliance.errors import InputError
 from compliance.model.parameters import BASE_BY_KEY
 from compliance.units import parse_quantity
 
-__all__ = ["ENTRY_FIELDS", "RECORDING_FIELDS", "parse_model_evidence", "read_assumptions"]
+__all__ = ["EFFECT_ENTRY_FIELDS", "ENTRY_FIELDS", "RECORDING_FIELDS", "check_effect_entry", "parse_model_evidence",
+           "read_assumptions"]
 
 # the fields a parameter entry may hold (the loader refuses any other)
 ENTRY_FIELDS = ("value", "source", "note", "range", "range_note", "derived_for")
+# the fields an effect parameter's entry may hold: the uncertainty bands move base parameters only
+EFFECT_ENTRY_FIELDS = ("value", "source", "note")
+
+
+def check_effect_entry(entry: dict, where: str) -> None:
+    """An ``[effects.NAME]`` parameter given as a table holds only value, source and note.
+
+    A ``range`` there would be read and then never used (the bands move the base parameters'
+    ranges), so it is refused at load rather than accepted and ignored.
+
+    Raises
+    ------
+    InputError
+        A range / derived_for on an effect parameter, an unknown field, or no value.
+    """
+    for key in entry:
+        if key in ("range", "range_note", "derived_for"):
+            raise InputError(f"{where}.{key}: ranges and derivation targets are read on base parameters only (the "
+                             "uncertainty bands move those); an effect parameter's range would be ignored, so it is "
+                             "refused - give the value alone")
+        if key not in EFFECT_ENTRY_FIELDS:
+            raise InputError(f"{where}.{key}: unknown field (an effect parameter's entry holds {', '.join(EFFECT_ENTRY_FIELDS)})")
+    if "value" not in entry:
+        raise InputError(f"{where}: missing 'value'")
 
 
 def _range(entry: dict, key: str, where: str, value: float, atmosphere: float) -> dict:
@@ -44,10 +69,12 @@ def _range(entry: dict, key: str, where: str, value: float, atmosphere: float) -
     raw = entry["range"]
     if not isinstance(raw, list) or len(raw) != 2:
         raise InputError(f"{where}.range: expected [low, high] with units, e.g. [\"300 N\", \"540 N\"]")
-    if spec.unit == "number":
-        lo, hi = (float(v) for v in raw)
+    if spec.unit in ("number", ""):
+        lo, hi = (_pure_number(v, f"{where}.range") for v in raw)
     else:
         lo, hi = (parse_quantity(v, spec.unit, f"{where}.range", pressure=spec.pressure, atmosphere=atmosphere) for v in raw)
+    if lo > hi:
+        raise InputError(f"{where}.range: low {lo:g} is above high {hi:g} {spec.unit}; write the range as [low, high]")
     if not lo <= value <= hi:
         raise InputError(f"{where}.range: [{lo:g}, {hi:g}] {spec.unit} must contain the value {value:g}")
     if lo == hi:
@@ -56,6 +83,23 @@ def _range(entry: dict, key: str, where: str, value: float, atmosphere: float) -
     if not isinstance(note, str) or not note.strip():
         raise InputError(f"{where}.range_note: missing; say why the value may lie anywhere in the range")
     return {"low": lo, "high": hi, "note": note.strip()}
+
+
+def _pure_number(v, where: str) -> float:
+    """One end of a range of a unit-less parameter: a number (or a text of one), never a quantity with a unit."""
+    if isinstance(v, bool):
+        raise InputError(f"{where}: {v!r} is not a number")
+    if isinstance(v, (int, float)):
+        return float(v)
+    try:
+        return float(str(v))
+    except ValueError:
+        pass
+    try:  # a dimensionless quantity ("52.8 %") is a number too
+        return parse_quantity(str(v), "", where)
+    except InputError:
+        raise InputError(f"{where}: {v!r}; this parameter is a pure number, so its range is two plain numbers "
+                         "(e.g. [0.2, 0.4]), without a unit") from None
 
 
 def _derived_for(entry: dict, where: str) -> dict:

@@ -153,6 +153,8 @@ class PlantConfig:
             effects=MappingProxyType({k: MappingProxyType(v) for k, v in new_effects.items()}),
             options=MappingProxyType(new_options),
             provenance=MappingProxyType(dict(provenance)) if provenance is not None else self.provenance,
+            # a range or a derivation target was stated about the value the file gave: a new value drops it
+            assumptions=MappingProxyType({k: a for k, a in self.assumptions.items() if new_params[k] == self.params[k]}),
         )
         _check_physical(cfg, self.path or "<configuration>")
         return cfg
@@ -268,12 +270,8 @@ def plant_to_toml(cfg: PlantConfig) -> str:
         sec, name = spec.name.split(".", 1)
         v = cfg.params[spec.name]
         src = cfg.sources.get(spec.name, "user")
-        if spec.unit == "number":
-            val = _fmt(v)
-        else:
-            unit = spec.unit
-            val = f'"{_fmt(v)} {unit} abs"' if spec.pressure else (f'"{_fmt(v)} {unit}"' if unit else _fmt(v))
-        sections.setdefault(sec, []).append(f'{name} = {{ value = {val}, source = {_toml_str(src)} }}')
+        sections.setdefault(sec, []).append(f'{name} = {{ value = {_quantity(spec, v)}, source = {_toml_str(src)}'
+                                            + _assumption_fields(spec, cfg.assumptions.get(spec.name)) + " }")
     for sec, rows in sections.items():
         lines.append(f"[{sec}]")
         lines.extend(rows)
@@ -310,6 +308,29 @@ def _model_evidence_toml(cfg: PlantConfig) -> list[str]:
         rows = ["{ " + ", ".join(f"{k} = {_toml_str(v)}" for k, v in r.items()) + " }" for r in ev["recordings"]]
         lines.append("recordings = [" + ", ".join(rows) + "]")
     return lines + [""]
+
+
+def _quantity(spec, v: float) -> str:
+    """A parameter's SI value as the file writes it (pressures absolute)."""
+    if spec.unit == "number":
+        return _fmt(v)
+    unit = spec.unit
+    return f'"{_fmt(v)} {unit} abs"' if spec.pressure else (f'"{_fmt(v)} {unit}"' if unit else _fmt(v))
+
+
+def _assumption_fields(spec, a) -> str:
+    """``, range = [...], range_note = ..., derived_for = {...}`` of a parameter the file gave them (model/assumptions.py)."""
+    if not a:
+        return ""
+    out = ""
+    if a.get("range"):
+        r = a["range"]
+        out += f", range = [{_quantity(spec, r['low'])}, {_quantity(spec, r['high'])}], range_note = {_toml_str(r['note'])}"
+    if a.get("derived_for"):
+        d = a["derived_for"]
+        out += (f", derived_for = {{ metric = {_toml_str(d['metric'])}, value = {_toml_str(d['value'])}, "
+                f"load = {_toml_str(d['load_text'])} }}")
+    return out
 
 
 def _toml_str(s: str) -> str:

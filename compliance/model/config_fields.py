@@ -18,7 +18,7 @@ from compliance.model.parameters import BASE_BY_KEY, BASE_PARAMS, OPTION_DEFAULT
 
 CALIBRATED_PREFIX = "calibrated to "  # source of a value fitted by a calibration (papers/calibration_table.py)
 from compliance.model.toml_file import check_table
-from compliance.model.assumptions import ENTRY_FIELDS
+from compliance.model.assumptions import ENTRY_FIELDS, check_effect_entry
 from compliance.units import ATMOSPHERE_PA, convert_array, parse_quantity
 
 SECTIONS = sorted({k.split(".")[0] for k in BASE_BY_KEY} | {k.split(".")[0] for k in OPTIONS})
@@ -176,6 +176,8 @@ def _effect_params(eff, table: dict[str, Any], kw: str) -> dict[str, float]:
         if pk not in names:
             raise InputError(f"{kw}.{pk}: unknown parameter{did_you_mean(pk, names)} (expected {', '.join(names)})")
         spec = eff.param(pk)
+        if isinstance(pv, dict):
+            check_effect_entry(pv, f"{kw}.{pk}")
         v = parse_quantity(pv["value"] if isinstance(pv, dict) else pv, spec.unit, f"{kw}.{pk}")
         lo, hi = spec.bounds
         if v < lo or v > hi:

@@ -19,6 +19,8 @@ from compliance.errors import InputError
 FILE_KINDS = {
     "requirement file": lambda d: str(d.get("schema", "")).startswith("govcheck-requirements"),
     "sweep file": lambda d: str(d.get("schema", "")).startswith("govcheck-sweep"),
+    "hardware catalogue": lambda d: str(d.get("schema", "")).startswith("govcheck-hardware"),
+    "duty file": lambda d: str(d.get("schema", "")).startswith("govcheck-duty"),
     "plant configuration": lambda d: isinstance(d.get("cylinder"), dict) and isinstance(d.get("name"), str),
     "column map": lambda d: isinstance(d.get("columns"), dict),
     "recording sidecar": lambda d: isinstance(d.get("conditions"), dict) or (

@@ -67,8 +67,10 @@ def _stages(cfg: PlantConfig, workers, with_effect: bool):
     return final, first, found
 
 
-def run_calibration(cfg: PlantConfig, out: str, json_path: str | None = None, scheduler: str | None = None) -> int:
-    """Calibrate ``cfg`` to the paper's figures, print the stages, save to ``out`` (``scheduler``: Dask, else local).
+def run_calibration(cfg: PlantConfig, out: str, json_path: str | None = None, scheduler: str | None = None,
+                    workers: int | None = None) -> int:
+    """Calibrate ``cfg`` to the paper's figures, print the stages, save to ``out`` (``scheduler``: Dask, else
+    ``workers`` local processes, default every available core).
 
     Returns
     -------
@@ -85,7 +87,7 @@ def run_calibration(cfg: PlantConfig, out: str, json_path: str | None = None, sc
     if json_path:
         _check_writable(json_path)
     t0, c0 = time.perf_counter(), _cpu_seconds()
-    final, first, found = calibrate_in_stages(cfg, scheduler=scheduler)
+    final, first, found = calibrate_in_stages(cfg, workers=workers, scheduler=scheduler)
     wall, cpu = time.perf_counter() - t0, _cpu_seconds() - c0
     # serial: one figure's test is a few ms, less than a process pool costs per poll
     reach = reach_search(final.best, final.conditions, final.rows_after, workers=1)

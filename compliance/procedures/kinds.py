@@ -13,13 +13,13 @@ from dataclasses import dataclass
 from compliance.units.amounts import parse_amount
 from compliance.errors import InputError
 
-__all__ = ["KINDS", "STROKE_STARTS", "ROBOT_TRACKING", "TRACKING", "Kind", "Setting", "parse_setting"]
+__all__ = ["CHOICES", "KINDS", "STROKE_STARTS", "ROBOT_TRACKING", "TRACKING", "Kind", "Setting", "parse_setting"]
 
 
 @dataclass(frozen=True)
 class Setting:
     """A procedure setting: type (``length``, ``time``, ``frequency``, ``speed``, ``voltage``,
-    ``number``, ``count``, ``bool``, ``directions``, ``pattern``, ``start``), default text (None = required)."""
+    ``number``, ``count``, ``bool``, ``directions``, ``pattern``, or a word from ``CHOICES``), default text (None = required)."""
 
     type: str
     default: object
@@ -44,6 +44,22 @@ STROKE_STARTS = ("end_stop", "rest")
 _START = Setting("start", "end_stop", "initial chamber pressures: 'end_stop' = as the hold at the end left them (the side "
                  "about to drive exhausted, the other at supply); 'rest' = at rest balancing the load about their mean")
 
+# settings whose value is a word from a fixed list: type -> allowed words
+CHOICES = {
+    "start": STROKE_STARTS,
+    # "governor": full set-point change through the closed loop, the set-point rate limiter acting (in service);
+    # "manual": full valve command in open loop, the positioner in manual (the valve and throttles alone)
+    "drive": ("governor", "manual"),
+    # how the stroke times are timed (metrics.stroke.timed)
+    "timing": ("full_rate", "end_to_end", "extrapolated"),
+    # the device that sets each direction's time: "auto" = the set-point rate limiter when one is configured
+    # (the throttles are then its backstop), else the flow-control valves
+    "device": ("auto", "limiter", "throttle"),
+}
+_DRIVE = Setting("drive", "governor", "how the stroke is driven: 'governor' = full set-point change through the closed loop "
+                 "(the set-point rate limiter acting: the stroke in service); 'manual' = full valve command in open loop "
+                 "(the positioner in manual: what the valve and the flow-control valves alone allow)")
+
 KINDS: dict[str, Kind] = {
     k.name: k
     for k in (
@@ -62,16 +78,22 @@ KINDS: dict[str, Kind] = {
             "cycles": Setting("number", 2, "number of periods simulated"),
             "skip_cycles": Setting("number", 0.5, "periods left out of the tracking errors (start transient)"),
         }),
-        Kind("full_stroke", "full command, open loop, from one end to the other through the flow-control valves", {
+        Kind("full_stroke", "full stroke from one end to the other, driven by the governor (in service) or in manual", {
             "directions": Setting("directions", ["opening", "closing"], "which strokes"),
+            "drive": _DRIVE,
             "command": _CMD,
             "flow_control": Setting("bool", True, "flow-control valves 2V2/2V3 in the circuit"),
             "timeout": Setting("time", "30 s", "simulated time per stroke"),
             "start": _START,
         }),
-        Kind("independent_adjustment", "change one flow-control valve; the other direction's time must not change", {
-            "adjust": Setting("directions", ["opening", "closing"], "which valve(s) to change, one at a time"),
-            "factor": Setting("number", 0.5, "factor applied to the adjusted valve's conductance"),
+        Kind("independent_adjustment", "change one direction's speed setting; the other direction's time must not change", {
+            "adjust": Setting("directions", ["opening", "closing"], "which direction's setting to change, one at a time"),
+            "factor": Setting("number", 0.5, "factor applied to the adjusted setting (limiter rate or throttle conductance)"),
+            "device": Setting("device", "auto", "the speed setting adjusted: 'limiter' = the set-point rate limiter's rate of "
+                              "that direction, 'throttle' = that direction's flow-control valve, 'auto' = the limiter when "
+                              "the configuration has one, else the throttle"),
+            "timing": Setting("timing", "full_rate", "how the stroke times are timed (as the opening_time option timing)"),
+            "drive": _DRIVE,
             "command": _CMD,
             "timeout": Setting("time", "30 s", "simulated time per stroke"),
             "start": _START,
@@ -175,9 +197,9 @@ def parse_setting(setting: Setting, value, where: str):
         if not isinstance(value, bool):
             raise InputError(f"{where}: expected true or false, got {value!r}")
         return value
-    if t == "start":
-        if value not in STROKE_STARTS:
-            raise InputError(f"{where}: expected one of {', '.join(repr(v) for v in STROKE_STARTS)}, got {value!r}")
+    if t in CHOICES:
+        if value not in CHOICES[t]:
+            raise InputError(f"{where}: expected one of {', '.join(repr(v) for v in CHOICES[t])}, got {value!r}")
         return value
     allowed = ("opening", "closing") if t == "directions" else ("up", "down")
     if not isinstance(value, list) or not value or any(v not in allowed for v in value):

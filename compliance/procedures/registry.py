@@ -14,6 +14,7 @@ from compliance.procedures.dead_band import run_dead_band
 from compliance.procedures.hold import run_hold
 from compliance.procedures.kinds import KINDS, Kind, Setting, parse_setting
 from compliance.procedures.outcomes import MAX_TRACE_POINTS, TRACE_COLUMNS, RunOutcome, Sample, downsample, request_key
+from compliance.procedures.scenarios import at_operating_point
 from compliance.procedures.sine import run_sine
 from compliance.procedures.steps import RATE_LIMIT_FRACTION, run_steps
 from compliance.procedures.stroke import run_full_stroke, run_independent_adjustment
@@ -69,7 +70,7 @@ def run(cfg, procedure, op, requests) -> RunOutcome:
     t0 = _time.perf_counter()
     out = RunOutcome(procedure.name, op.name, procedure.kind)
     try:
-        _RUNNERS[procedure.kind](cfg, procedure, op, list(requests), out)
+        _RUNNERS[procedure.kind](at_operating_point(cfg, op), procedure, op, list(requests), out)
     except GovcheckError as exc:
         out.error = str(exc)
         out.error_kind = type(exc).__name__

@@ -18,7 +18,10 @@ from compliance.simulation.scenario import scenario_load, stroke_start_pressures
 from compliance.procedures.outcomes import Sample, downsample
 
 __all__ = [
+    "DRIVES",
+    "LIMITER_KEYS",
     "add_drive_samples",
+    "at_operating_point",
     "closed_loop_trace",
     "full_command",
     "full_command_stroke",
@@ -27,6 +30,26 @@ __all__ = [
     "stroke",
     "swing",
 ]
+
+
+# how a full stroke is driven: "governor" = a full set-point change through the closed loop, the governor's
+# set-point rate limiter acting (the stroke the gate makes in service); "manual" = full valve command in open
+# loop, the positioner in manual (what the valve and the flow-control valves alone allow: the backstop)
+DRIVES = ("governor", "manual")
+# the parameters of the governor's set-point rate limiter (docs/physics.md, controller section)
+LIMITER_KEYS = ("controller.setpoint_opening_rate", "controller.setpoint_closing_rate", "controller.end_zone_rate",
+                "controller.end_zone_width", "controller.setpoint_lead_limit")
+
+
+def at_operating_point(cfg, op):
+    """The configuration as operating point ``op`` runs it.
+
+    A point with ``setpoint_limiter = false`` injects the set-point downstream of the governor's rate
+    limiter (the limiter does not act: the time-constant test); every other point runs ``cfg`` as given.
+    """
+    if op.setpoint_limiter is False and cfg.setpoint_rate_limited:
+        return cfg.replace(params={k: 0.0 for k in LIMITER_KEYS}, sources={k: cfg.sources.get(k, "user") for k in LIMITER_KEYS})
+    return cfg
 
 
 def stroke(cfg) -> float:
@@ -72,11 +95,13 @@ def simulate_run(cfg, duration, x0, *, reference=None, command=None, load=None, 
                                   initial_pressures=pressures))
 
 
-def full_command_stroke(cfg, op, direction, command, duration, flow_control, start="end_stop"):
-    """Open-loop run at full valve command from the end of the stroke a ``direction`` starts at.
+def full_command_stroke(cfg, op, direction, command, duration, flow_control, start="end_stop", drive="governor"):
+    """One full stroke from the end a ``direction`` starts at, driven as ``drive`` says.
 
-    With the governor's set-point rate limiter configured, the stroke is a full set-point step
-    through the governor instead (closed loop: the limiter, not the valve, sets the rate).
+    ``drive = "governor"``: the set-point steps to the other end at t = 0 and the closed loop moves the
+    gate, through the governor's set-point rate limiter when one is configured (the stroke in service).
+    ``drive = "manual"``: full valve command in open loop (the positioner in manual: what the valve and
+    the flow-control valves alone allow).
 
     Parameters
     ----------
@@ -86,13 +111,14 @@ def full_command_stroke(cfg, op, direction, command, duration, flow_control, sta
     direction : {"opening", "closing"}
         Opening starts closed (x = 0), closing starts fully open (x = stroke).
     command : "full" or Amount
-        Valve command magnitude about the centre [V].
+        Valve command magnitude about the centre of a manual stroke [V].
     duration : float
         Simulated time [s].
     flow_control : bool or None
         Flow-control valves in the circuit (None = as configured).
     start : {"end_stop", "rest"}
         Initial chamber pressures (:func:`stroke_start_pressures`).
+    drive : {"governor", "manual"}
 
     Returns
     -------
@@ -103,16 +129,17 @@ def full_command_stroke(cfg, op, direction, command, duration, flow_control, sta
     u_open, u_close = full_command(cfg, command)
     x0, u = (0.0, u_open) if direction == "opening" else (stroke(cfg), u_close)
     load = scenario_load(cfg, op)
-    key = (_plant_key(cfg), load, direction, u, duration, flow_control, start)
+    key = (_plant_key(cfg), load, direction, u, duration, flow_control, start, drive)
     if key in _STROKES:  # the steps procedures at one operating point ask for the same strokes
         _STROKES.move_to_end(key)
         return _STROKES[key]
-    if cfg.setpoint_rate_limited:  # the governor's rate limiter is the limiting device: stroke through the governor
+    pressures = stroke_start_pressures(cfg, direction, start)
+    if drive == "governor":
         df = simulate_run(cfg, duration, x0, reference=Profile.constant(stroke(cfg) - x0), load=load,
-                          flow_control=flow_control, pressures=stroke_start_pressures(cfg, direction, start))
+                          flow_control=flow_control, pressures=pressures)
     else:
         df = simulate_run(cfg, duration, x0, command=Profile.constant(u), load=load, flow_control=flow_control,
-                          pressures=stroke_start_pressures(cfg, direction, start))
+                          pressures=pressures)
     _STROKES[key] = df
     if len(_STROKES) > _STROKES_KEPT:
         _STROKES.popitem(last=False)

@@ -1,11 +1,10 @@
 """The ``steps`` procedure: a set-point step sequence in closed loop, one step response per step.
 
-Every step metric is measured on every step with the options each requirement asks for. A
-time constant measured while the servo runs at its rate limit (valve command saturated, peak
-speed near the full-command peak, or mean speed up to 63.2 % near the speed the flow-control
-valves allow on the straight part of a full stroke, under the same load and circuit) is kept for the
-report but not eligible for a verdict: it then reflects flow saturation, not the linear
-time constant (IEC 61362 asks for small steps).
+Every step metric is measured on every step with the options each requirement asks for. A time
+constant measured while a limiting device acts on the step (the set-point rate limiter ramping it,
+the valve command saturated, peak or mean speed near the full-command figures of the same load and
+circuit) or while the valve dead zone governs it is kept for the report but not eligible for a
+verdict, with the rule that excluded it (``metrics.step_eligibility``).
 """
 
 from __future__ import annotations
@@ -13,18 +12,14 @@ from __future__ import annotations
 import numpy as np
 
 from compliance import metrics as M
+from compliance.metrics.catalogue import option_value
+from compliance.metrics.step_eligibility import RATE_LIMIT_FRACTION, StepLimits, time_constant_eligibility
 from compliance.plants import kind_of
 from compliance.errors import InputError
 from compliance.procedures.scenarios import add_drive_samples, closed_loop_trace, full_command_stroke, start_position, stroke
 from compliance.procedures.outcomes import Sample, request_key
 
-__all__ = ["RATE_LIMIT_FRACTION", "flow_saturation_voltage", "run_steps"]
-
-# a step whose peak speed reaches this fraction of the full-command speed is rate limited
-RATE_LIMIT_FRACTION = 0.9
-# a step counts for the time constant only if its 63.2 % point lies this many stall bands away
-# from the set-point: closer in, the response is governed by the valve dead zone, not the loop
-STALL_MARGIN = 2.0
+__all__ = ["RATE_LIMIT_FRACTION", "flow_saturation_voltage", "run_steps", "step_limits"]
 
 
 def _step_profile(x0, size, pattern, lead, dwell, stroke_length, where):
@@ -46,7 +41,7 @@ def _step_profile(x0, size, pattern, lead, dwell, stroke_length, where):
 
 
 def _full_command_speeds(cfg, op):
-    """Speeds at full command from each end under the operating point's load and circuit [m/s].
+    """Speeds at full valve command (open loop) from each end under the operating point's load and circuit [m/s].
 
     Returns ``{direction: (peak, straight)}``: the peak speed, and the speed of the straight part
     of the stroke (25 % -> 75 %, or from 25 % to the end of the run if the stroke is slower), which
@@ -55,7 +50,7 @@ def _full_command_speeds(cfg, op):
     L = stroke(cfg)
     res = {}
     for d in ("opening", "closing"):
-        df = full_command_stroke(cfg, op, d, "full", 8.0, op.flow_control)
+        df = full_command_stroke(cfg, op, d, "full", 8.0, op.flow_control, drive="manual")
         tt, x = M.frame_columns(df, "time", "position")
         _, vo, vc = M.speed_extremes(tt, x)
         travelled = x - x[0] if d == "opening" else x[0] - x
@@ -91,6 +86,23 @@ def flow_saturation_voltage(cfg, direction: int, flow_control: bool | None) -> f
     return dz + (u_sat - dz) * c_thr / c
 
 
+def step_limits(cfg, op, with_speeds: bool) -> StepLimits:
+    """What can limit a step of ``cfg`` at ``op`` (``metrics.step_eligibility.StepLimits``).
+
+    The set-point rate limiter's rates when it acts at this point (``scenarios.at_operating_point`` has
+    already bypassed it where the point injects the step downstream of it), the flow saturation voltage
+    of each direction, the dead-zone stall band, and with ``with_speeds`` the full-command speeds.
+    """
+    p = cfg.params
+    return StepLimits(
+        stall={+1: kind_of(cfg).stall_error(cfg, "opening"), -1: kind_of(cfg).stall_error(cfg, "closing")},
+        command_saturation={+1: flow_saturation_voltage(cfg, +1, op.flow_control),
+                            -1: flow_saturation_voltage(cfg, -1, op.flow_control)},
+        ramp_rate={+1: p.get("controller.setpoint_opening_rate", 0.0), -1: p.get("controller.setpoint_closing_rate", 0.0)},
+        full_speed={(+1 if d == "opening" else -1): v for d, v in _full_command_speeds(cfg, op).items()} if with_speeds else None,
+    )
+
+
 def _opts(options: dict) -> dict:
     """Requirement options -> keyword arguments of metrics.step_response (SI)."""
     kw = {}
@@ -113,27 +125,33 @@ def run_steps(cfg, proc, op, requests, out):
     label, tt, x, r, u = closed_loop_trace(cfg, proc, op, out, duration, x0, ref)
     installed = cfg.flow_control_installed if op.flow_control is None else bool(op.flow_control)
     circuit = "flow-control valves 2V2/2V3 " + ("in" if installed else "out (wide open)")
+    if op.setpoint_limiter is False:
+        circuit += "; step injected downstream of the set-point rate limiter"
+    elif cfg.setpoint_rate_limited:
+        circuit += "; through the set-point rate limiter"
     events = M.find_steps(tt, r, min_size=min(5e-5, 0.5 * size))
     wants_tau = any(m == "time_constant" for m, _ in requests)
-    vmax = _full_command_speeds(cfg, op) if wants_tau else None
-    if vmax:
+    limits = step_limits(cfg, op, wants_tau)
+    if limits.full_speed:
+        vmax = limits.full_speed
         out.notes.append(
             "rate limit check at full command under this load and circuit: peak "
-            f"{vmax['opening'][0]*1e3:.0f} / {vmax['closing'][0]*1e3:.0f} mm/s, straight part "
-            f"{vmax['opening'][1]*1e3:.0f} / {vmax['closing'][1]*1e3:.0f} mm/s (opening / closing)"
+            f"{vmax[1][0]*1e3:.0f} / {vmax[-1][0]*1e3:.0f} mm/s, straight part "
+            f"{vmax[1][1]*1e3:.0f} / {vmax[-1][1]*1e3:.0f} mm/s (opening / closing)"
         )
+    if wants_tau and cfg.setpoint_rate_limited:
+        out.notes.append("the governor's set-point rate limiter acts on these steps (opening "
+                         f"{limits.ramp_rate[1]*1e3:.1f} mm/s, closing {limits.ramp_rate[-1]*1e3:.1f} mm/s): the steps are ramped")
     wanted = {m: (m, {}) for m, info in M.METRICS.items() if "steps" in info.kinds}
     wanted.update({request_key(m, o): (m, o) for m, o in requests if "steps" in M.METRICS[m].kinds})
-    sat = {+1: flow_saturation_voltage(cfg, +1, op.flow_control), -1: flow_saturation_voltage(cfg, -1, op.flow_control)}
     centre = cfg.p("valve.centre_voltage")
-    kind = kind_of(cfg)
-    stall = {+1: kind.stall_error(cfg, "opening"), -1: kind.stall_error(cfg, "closing")}
     per_opts: dict = {}
     for key, (metric, opts) in wanted.items():
-        okey = request_key("", opts)
+        okey = request_key("", {k: v for k, v in opts.items() if k in M.STEP_OPTION_DEFAULTS})
         if okey not in per_opts:
             per_opts[okey] = [M.step_response(tt, x, ev, valve_command=u - centre,
-                                              command_saturation=sat[1 if ev.size > 0 else -1], **_opts(opts))
+                                              command_saturation=limits.command_saturation[1 if ev.size > 0 else -1],
+                                              **_opts(opts))
                               for ev in events]
         for k, (ev, sm) in enumerate(zip(events, per_opts[okey])):
             direction = "up" if ev.size > 0 else "down"
@@ -149,50 +167,16 @@ def run_steps(cfg, proc, op, requests, out):
             if metric == "dead_time" and val is None:
                 detail["non_responding"] = True  # the step never moved: its dead time is the worst case
             if metric == "time_constant":
-                eligible, reason = _tau_eligibility(k, len(events), ev, sm, reason, s["tau_from_rest"], stall, vmax, detail)
+                travel = option_value(opts, "travel")
+                eligible, reason, more = time_constant_eligibility(k, len(events), ev, sm, limits,
+                                                                   from_rest=s["tau_from_rest"], travel=travel)
+                detail.update(more)
+                val = more["tau_achieved"] if travel == "achieved" else more["tau_commanded"]
+                if eligible and val is None:
+                    detail["non_responding"] = True
             out.add(key, Sample(val, lab, reason, eligible, detail))
     # marks for plots (default options)
     for k, (ev, sm) in enumerate(zip(events, per_opts[request_key("", {})])):
         for name, v in sm.marks.items():
             out.marks.append({"trace": label, "step": k + 1, "type": name, "value": v})
     add_drive_samples(cfg, out, tt, x, u, label)
-
-
-def _tau_eligibility(k, n, ev, sm, reason, from_rest, stall, vmax, detail) -> tuple[bool, str | None]:
-    """Whether step ``k`` (0-based, of ``n``) measures the time constant, and why not; fills ``detail``.
-
-    Beside the commanded-step figure the detail keeps the time constant to 63.2 % of the achieved
-    travel and the dead time apart. A step is not judged when it does not start from rest at the
-    operating point (``from_rest``), is rate limited (valve or throttle saturated, peak or mean speed
-    near the full-command figures) or dead-zone dominated (63.2 % point inside twice the stall band).
-    """
-    val = sm.time_constant
-    detail.update(tau_achieved=sm.time_constant_achieved, dead_time=sm.dead_time,
-                  achieved_fraction=(sm.x_final - sm.x_start) / ev.size if ev.size else None)
-    side = 1 if ev.size > 0 else -1
-    if k > 0 and from_rest:
-        return False, (f"not from rest at the operating point: step {k + 1} of {n} starts where step {k} settled "
-                       f"({sm.x_start * 1e3:.1f} mm); the standards' test steps from rest at the point")
-    if (1.0 - M.TAU_FRACTION) * abs(ev.size) < STALL_MARGIN * stall[side]:
-        return False, (f"dead-zone dominated: the 63.2 % point lies {(1 - M.TAU_FRACTION) * abs(ev.size) * 1e3:.2f} mm "
-                       f"from the set-point, inside {STALL_MARGIN:g} x the stall band {stall[side] * 1e3:.2f} mm "
-                       "where the compensated valve shuts")
-    if val is None:  # a step beyond the dead zone that never reached 63.2 %: the worst case, not a gap
-        detail["non_responding"] = True
-        return True, reason
-    detail["peak_speed"] = sm.max_speed
-    if sm.rate_limited:
-        return False, reason
-    if vmax is None:
-        return True, reason
-    peak, straight = vmax["opening" if ev.size > 0 else "closing"]
-    mean_speed = M.TAU_FRACTION * abs(ev.size) / val if val > 0 else float("inf")
-    detail["mean_speed_to_63"] = mean_speed
-    if peak > 0 and sm.max_speed >= RATE_LIMIT_FRACTION * peak:
-        return False, (f"rate limited: peak speed {sm.max_speed*1e3:.0f} mm/s >= "
-                       f"{RATE_LIMIT_FRACTION:.0%} of the full-command speed {peak*1e3:.0f} mm/s")
-    if straight > 0 and mean_speed >= RATE_LIMIT_FRACTION * straight:
-        return False, (f"rate limited: mean speed to 63.2 % {mean_speed*1e3:.0f} mm/s >= "
-                       f"{RATE_LIMIT_FRACTION:.0%} of the flow-control speed {straight*1e3:.0f} mm/s "
-                       "(straight part of the full-command stroke)")
-    return True, reason

@@ -15,7 +15,7 @@ from contextlib import contextmanager
 
 from compliance.errors import InputError
 
-__all__ = ["CONNECT_TIMEOUT", "DASK_SCHEMES", "dask_client", "dask_session", "parse_scheduler"]
+__all__ = ["CONNECT_TIMEOUT", "DASK_SCHEMES", "check_reachable", "dask_client", "dask_session", "parse_scheduler"]
 
 DASK_SCHEMES = ("tcp", "tls", "inproc", "ucx", "ws", "wss")  # what distributed.comm knows
 CONNECT_TIMEOUT = 5.0  # [s] a TCP connect to a live scheduler takes milliseconds; our choice of margin
@@ -50,11 +50,28 @@ def parse_scheduler(text: str | None) -> tuple[str, object]:
             raise InputError(f"--scheduler {text}: expected local:N with N >= 1 workers")
         return "dask-local", n
     if "://" in text:
-        if text.split("://", 1)[0] not in DASK_SCHEMES:
+        scheme, location = text.split("://", 1)
+        if scheme not in DASK_SCHEMES:
             raise InputError(f"--scheduler {text}: unknown address scheme; expected one of "
                              f"{', '.join(s + '://' for s in DASK_SCHEMES)} (e.g. tcp://host:8786) or local:N")
+        if scheme in ("tcp", "tls"):
+            _check_host_port(text, location)
         return "dask", text
     raise InputError(f"--scheduler {text}: expected a Dask scheduler address (tcp://host:8786) or local:N")
+
+
+def _check_host_port(text: str, location: str) -> None:
+    """A TCP address that can exist: a host, and a port 1..65535 when one is given (checked before any work)."""
+    host, sep, port = location.rpartition(":") if not location.endswith("]") else (location, "", "")
+    if not sep:
+        host, port = location, ""
+    host = host.strip("[]")
+    if not host:
+        raise InputError(f"--scheduler {text}: no host; expected tcp://host:8786")
+    if port:
+        if not port.isdigit() or not 1 <= int(port) <= 65535:
+            raise InputError(f"--scheduler {text}: port '{port}' is not a TCP port (1 .. 65535); a Dask scheduler "
+                             "listens on 8786 unless told otherwise")
 
 
 def dask_client(kind: str, target):
@@ -78,6 +95,21 @@ def dask_client(kind: str, target):
     except Exception as exc:  # a service that is not Dask answers with bytes Dask's handshake cannot read
         raise InputError(f"--scheduler {target}: something answers there, but not as a Dask scheduler "
                          f"({exc.__class__.__name__}: {str(exc)[:120]})") from None
+
+
+def check_reachable(text: str | None) -> None:
+    """``--scheduler`` parsed, and a TCP scheduler address reached (one connect, before any work starts).
+
+    An ``inproc://`` address is refused here, at the command line: it names a scheduler inside the
+    same Python process (a library caller's in-process cluster may pass one to ``map_tasks``), and a
+    govcheck command starts none.
+    """
+    kind, target = parse_scheduler(text)
+    if kind == "dask" and target.startswith("inproc://"):
+        raise InputError(f"--scheduler {text}: an inproc:// address names a scheduler inside the same Python process, "
+                         "and a govcheck command starts none; give tcp://host:8786 for a running cluster or local:N")
+    if kind == "dask":
+        _refuse_unreachable(target)
 
 
 def _refuse_unreachable(target: str) -> None:

@@ -24,7 +24,8 @@ import threading
 import time
 from contextlib import contextmanager
 
-__all__ = ["GRACE", "Terminated", "raise_if_stopping", "stop_signal", "stop_on_signals", "worker_pool"]
+__all__ = ["GRACE", "Terminated", "ignore_late_signals", "raise_if_stopping", "stop_signal", "stop_on_signals",
+           "worker_pool"]
 
 GRACE = 3.0  # [s] after a signal, the unwinding's budget before the watchdog ends the process (the issue asks <= 5 s)
 _ARMED = threading.Event()
@@ -81,13 +82,43 @@ def stop_on_signals() -> None:
     sys.unraisablehook = _quiet_stop(sys.unraisablehook)
 
 
+def ignore_late_signals() -> None:
+    """The run is over (its outputs written, its exit code decided): a SIGINT or SIGTERM from now on changes nothing.
+
+    The interpreter's teardown puts Python-level handlers back to the default action, so a Ctrl-C
+    landing there would kill the finished process with the signal instead of its exit code; an
+    ignored signal stays ignored. Call it from the command-line entry only, never in a library caller.
+    """
+    if threading.current_thread() is not threading.main_thread() or _SIGNAL:
+        return
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
 def _quiet_stop(previous):
-    """The stop swallowed by a fork hook or a finaliser is not a bug to print: it is re-raised later, quietly."""
+    """The stop swallowed by a fork hook or a finaliser is not a bug to print: it is re-raised later, quietly.
+
+    So is CPython's own race at exit after a killed pool (3.11: ``concurrent.futures.process._python_exit``
+    wakes each pool's management thread without its lock, and a thread that is closing that pipe at the same
+    moment makes the write fail with EBADF): after a stop, that one error is the pool going away as asked.
+    """
     def hook(unraisable):
-        if not (_SIGNAL and isinstance(unraisable.exc_value, KeyboardInterrupt)):
-            previous(unraisable)
+        if _SIGNAL and (isinstance(unraisable.exc_value, KeyboardInterrupt) or _pool_exit_race(unraisable)):
+            return
+        previous(unraisable)
 
     return hook if getattr(previous, "__name__", "") != "hook" else previous
+
+
+def _pool_exit_race(unraisable) -> bool:
+    import errno
+    import traceback
+
+    exc = unraisable.exc_value
+    if not (isinstance(exc, OSError) and exc.errno == errno.EBADF):
+        return False
+    frames = traceback.extract_tb(unraisable.exc_traceback) if unraisable.exc_traceback else []
+    return any(f.filename.endswith(("concurrent/futures/process.py", "multiprocessing/connection.py")) for f in frames)
 
 
 def _worker_init(initializer, initargs):
@@ -136,3 +167,8 @@ def _kill(pool) -> None:
     pool.shutdown(wait=False, cancel_futures=True)
     for p in procs:
         p.join(timeout=2.0)
+    # the pool's management thread closes its wake-up pipe as it ends; let it end now, so the interpreter's exit
+    # hook does not write to that pipe while it is being closed (EBADF, CPython's race at exit)
+    manager = getattr(pool, "_executor_manager_thread", None)
+    if manager is not None and manager is not threading.current_thread():
+        manager.join(timeout=1.0)

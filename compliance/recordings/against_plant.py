@@ -15,7 +15,7 @@ import pandas as pd
 from compliance.errors import InputError
 from compliance.model.force_limit import check_load_force
 from compliance.recordings.metadata import sidecar_path
-from compliance.recordings.plausibility import check_no_gaps, pressure_slip
+from compliance.recordings.plausibility import check_no_gaps, constant_hint, pressure_slip
 
 __all__ = ["check_against_plant"]
 
@@ -49,13 +49,18 @@ def check_against_plant(cfg, frame: pd.DataFrame, meta: dict, recording) -> None
         Naming the file, the key or column, the value and the likely slip.
     """
     check_no_gaps(recording, frame["time"].to_numpy())
-    side = sidecar_path(recording)
+    side_file = sidecar_path(recording)
+    # the file that declared the conditions: the sidecar, else the column map's [metadata] (never a file that is not there)
+    side = (str(side_file) if side_file.is_file() else
+            f"{meta['column_map']}: metadata" if meta.get("column_map") else f"{recording} (no sidecar)")
     cond = meta.get("conditions") if isinstance(meta.get("conditions"), dict) else {}
     if "load_force" not in cond:
+        where = (side if side_file.is_file() or meta.get("column_map") else
+                 f"{recording}: no sidecar ({side_file.name}, beside the recording, does not exist)")
         raise InputError(
-            f"{side}: the test's load is not given ([conditions] load_force); the replay cannot guess it and a wrong "
+            f"{where}: the test's load is not given ([conditions] load_force); the replay cannot guess it and a wrong "
             "load ends in a non-physical simulation: write load_force in N (> 0 closes; 0 for none; \"curve\" for the "
-            "plant's load curve)")
+            f"plant's load curve){'' if side_file.is_file() else f' in a sidecar {side_file.name} next to the recording'}")
     check_load_force(cfg, _number(cond, "load_force"), f"{side}: conditions.load_force")
     stroke = cfg.p("cylinder.stroke")
     _check_positions(frame, stroke, recording)
@@ -64,9 +69,13 @@ def check_against_plant(cfg, frame: pd.DataFrame, meta: dict, recording) -> None
         t = frame["time"].to_numpy()
         start = float(np.median(frame["position"].to_numpy()[t <= t[0] + START_WINDOW]))
         if abs(x0 - start) > START_MISMATCH * stroke:
-            unit = " (it looks like mm written without a unit)" if abs(x0 / 1e3 - start) < START_MISMATCH * stroke else ""
+            # millimetres written as metres give a start beyond the stroke; a value inside it is a position in m
+            unit = (" (it looks like mm written without a unit)"
+                    if x0 > stroke and abs(x0 / 1e3 - start) < START_MISMATCH * stroke else "")
+            unplugged = constant_hint(frame["position"].to_numpy(), "position")
             raise InputError(f"{side}: conditions.initial_position = {x0:.6g} m{unit} contradicts the recording, which starts "
-                             f"at {start * 1e3:.2f} mm (median of the first {START_WINDOW * 1e3:.0f} ms); correct the sidecar")
+                             f"at {start * 1e3:.2f} mm (median of the first {START_WINDOW * 1e3:.0f} ms){unplugged}; "
+                             "correct the sidecar" + (" or the recording" if unplugged else ""))
     kp, plant_kp = _number(meta.get("controller"), "kp"), cfg.p("controller.kp")
     if kp is not None and kp > 0 and plant_kp > 0 and not 1 / GAIN_MISMATCH < kp / plant_kp < GAIN_MISMATCH:
         ratio = kp / plant_kp
@@ -90,7 +99,8 @@ def _check_positions(frame: pd.DataFrame, stroke: float, recording) -> None:
         bad = np.flatnonzero((v < -margin) | (v > stroke + margin))
         if bad.size:
             med = float(np.median(v))
-            hint = " - it looks like millimetres written without a unit" if med >= 1.0 and med / 1e3 < stroke + margin else ""
+            hint = constant_hint(v, name) or (" - it looks like millimetres written without a unit"
+                                              if med >= 1.0 and med / 1e3 < stroke + margin else "")
             raise InputError(f"{recording}: column '{name}' reaches {float(v[bad[0]]):.6g} m ({bad.size} samples outside "
                              f"the plant's stroke 0..{stroke * 1e3:.0f} mm){hint}; the canonical position is in m "
                              "(or give a column map with the unit)")

@@ -119,8 +119,9 @@ def read_comtrade(path: Path, cmap: ColumnMap | None) -> RecordingSource:
     RecordingSource
         Channels by id (or 0-based index), the file's time axis [s], per-channel facts
         (``resolution`` in the channel unit, ``skew`` [s]) and the recording facts
-        (station, device, start and trigger time stamps, ``trigger_time`` [s] on the file's
-        time axis, edition, data type, form).
+        (station, device, start and trigger time stamps, ``trigger_time`` [s] = trigger stamp minus
+        first-sample stamp, i.e. measured from the first sample, as ``comtrade.Comtrade.trigger_time``;
+        on the file's time axis the trigger is at the first sample's time plus it; edition, data type, form).
 
     Raises
     ------

@@ -120,7 +120,7 @@ def comtrade_bytes(frame: pd.DataFrame, *, station: str, device: str = "govcheck
     start : datetime, optional
         Time stamp of the first data point (default 1970-01-01 00:00:00).
     trigger_time : float
-        Trigger on the frame's time axis [s].
+        Trigger on the frame's time axis [s]; its stamp is ``start`` + (trigger_time - the first sample's time).
     ratios : dict, optional
         Column -> (primary, secondary): those columns are written as secondary values.
     header : str
@@ -148,7 +148,9 @@ def comtrade_bytes(frame: pd.DataFrame, *, station: str, device: str = "govcheck
         ratio = f"{k!r},1.0,S" if k else "1.0,1.0,P"
         lo_hi = f"{lo:.9g},{hi:.9g}" if file_type == "FLOAT32" else f"{int(lo)},{int(hi)}"
         lines.append(f"{i},{name},,,{unit},{a!r},{b!r},0,{lo_hi},{ratio}")
-    lines += ["0", *rates, _stamp(start), _stamp(start + _dt.timedelta(seconds=float(trigger_time))), file_type, f"{mult:g}"]
+    # the first time stamp is the first sample's: the trigger's stamp is measured from it, not from t = 0
+    trigger = start + _dt.timedelta(seconds=float(trigger_time) - float(time[0]))
+    lines += ["0", *rates, _stamp(start), _stamp(trigger), file_type, f"{mult:g}"]
     if revision == "2013":
         lines += ["0,0", "F,0"]  # UTC, local = UTC; time quality F: no clock behind these times
     cfg = ("\r\n".join(lines) + "\r\n").encode("ascii")
@@ -165,7 +167,8 @@ def comtrade_bytes(frame: pd.DataFrame, *, station: str, device: str = "govcheck
         dat = rec.tobytes()
     if not single_file:
         return {".cfg": cfg, ".dat": dat}
-    kind = "ASCII" if file_type == "ASCII" else f"{file_type}: {len(dat)}"
+    # C37.111-2013 names the data section ASCII or BINARY only; which binary type is the .cfg's ft line
+    kind = "ASCII" if file_type == "ASCII" else f"BINARY: {len(dat)}"
     hdr = (header.rstrip() + "\r\n") if header.strip() else ""
     head = b"--- file type: CFG ---\r\n" + cfg + b"--- file type: INF ---\r\n--- file type: HDR ---\r\n" + hdr.encode("utf-8")
     return {".cff": head + f"--- file type: DAT {kind} ---\r\n".encode("ascii") + dat}

@@ -62,6 +62,18 @@ def sniff_decimal(lines: list[str], delim: str | None, given: str) -> str:
     return "," if any(_DECIMAL_COMMA.match(c) for c in cells) else "."
 
 
+def _no_data(path, text: str, skip: int, comment: str) -> None:
+    """Why no data line is left: the column map's ``skip_rows`` took them (named), or the file has none."""
+    total = len(text.splitlines())
+    if skip and skip >= total:
+        raise InputError(f"{path}: the column map's skip_rows = {skip} skips every line (the file has {total}); "
+                         "skip only the lines above the header")
+    if skip and any(line.strip() and not line.strip().startswith(comment) for line in text.splitlines()[:skip]):
+        raise InputError(f"{path}: no data after the column map's skip_rows = {skip} (the file has {total} lines, the "
+                         f"rest blank or '{comment}' comments); skip only the lines above the header")
+    raise InputError(f"{path}: no data (only blank or '{comment}' comment lines)")
+
+
 def read_text_table(path: Path, cmap: ColumnMap | None) -> RecordingSource:
     """Read a delimited text recording (see the module docstring) into raw float columns.
 
@@ -92,7 +104,7 @@ def read_text_table(path: Path, cmap: ColumnMap | None) -> RecordingSource:
         elif stripped and not lines:
             comments.append(stripped[len(comment):].strip())  # the logger's own header lines (instruments.py)
     if not lines:
-        raise InputError(f"{path}: no data (only blank or '{comment}' comment lines)")
+        _no_data(path, text, skip, comment)
     delim = sniff_delimiter(lines[0], path, cmap.delimiter if cmap else "auto")
     decimal = sniff_decimal(lines[1:] if header else lines, delim, cmap.decimal if cmap else "auto")
     names = None

@@ -98,7 +98,8 @@ def check_ranges(path, frame: pd.DataFrame, row) -> None:
         if bad.size:
             i = int(bad[0])
             med = float(np.median(v))
-            slip = " - it looks like millimetres written without a unit" if unit == "m" and high < abs(med) <= 1e3 * high else ""
+            slip = constant_hint(v, name) or (" - it looks like millimetres written without a unit"
+                                              if unit == "m" and high < abs(med) <= 1e3 * high else "")
             raise InputError(
                 f"{path}: {row(i)}: column '{name}' = {float(v[i]):.6g} {unit} is outside {low:g}..{high:g} {unit} "
                 f"({bad.size} sample(s) outside; {why}){slip}; cut or repair the recording, or correct the column map's unit"
@@ -178,3 +179,12 @@ def check_time_base(path, time: np.ndarray, meta: dict, unit_given: bool) -> Non
             f"{path}: column 'time': integer time stamps {dt:g} s apart ({duration:g} s in all) look like milliseconds; "
             "the canonical time is in seconds: convert it, or give a column map with unit = \"ms\" for time"
         )
+
+
+def constant_hint(values: np.ndarray, name: str) -> str:
+    """`` - the column never changes ...`` when a logged signal is one value from start to end (a transducer unplugged
+    or a channel not wired reads a constant), else ``""``."""
+    if values.size > 1 and float(np.ptp(values)) == 0.0:
+        return (f" - column '{name}' holds the same value ({float(values[0]):.6g}) in all {values.size} samples: is its "
+                "transducer unplugged or the channel not logged?")
+    return ""

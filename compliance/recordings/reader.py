@@ -34,7 +34,7 @@ from compliance.recordings.columns import RecordingSource, build_frame, canonica
 from compliance.recordings.comtrade import partner_file, read_comtrade
 from compliance.recordings.delimited import TEXT_SUFFIXES, read_text_table
 from compliance.recordings.mat import read_mat
-from compliance.recordings.instruments import instrument_facts, logger_from_comments
+from compliance.recordings.instruments import check_declarations, instrument_facts, logger_from_comments
 from compliance.recordings.metadata import read_sidecar, si_metadata, sidecar_path
 from compliance.recordings.parquet import read_parquet
 from compliance.recordings.plausibility import check_ranges, check_time_base, relative_time
@@ -105,6 +105,7 @@ def read_recording(path, column_map=None, *, required=DEFAULT_REQUIRED):
     time_spec = cmap.spec("time") if cmap is not None else None
     check_time_base(path, frame["time"].to_numpy(), meta,
                     unit_given=src.time is not None or (time_spec is not None and bool(time_spec.unit)))
+    check_declarations(frame, meta, _declared_in(path, cmap))
     fmt_name = "csv.gz" if fmt == "csv" and path.name.lower().endswith(".gz") else fmt
     meta.update(
         source_path=str(path),
@@ -114,6 +115,14 @@ def read_recording(path, column_map=None, *, required=DEFAULT_REQUIRED):
         dropped_rows=drop,
     )
     return frame, meta
+
+
+def _declared_in(path: Path, cmap: ColumnMap | None) -> str:
+    """Where the recording's ``[logger]`` / ``[channels]`` came from: its sidecar, else the column map."""
+    side = sidecar_path(path)
+    if side.is_file() or cmap is None:
+        return str(side)
+    return f"{cmap.source}: metadata"
 
 
 def _merge_channel_facts(meta: dict, facts: dict) -> None:

@@ -163,15 +163,17 @@ def not_evaluated(result: CheckResult) -> dict:
     """Judged test cases not evaluated, counted by reason, on the basis of the terminal and JSON summaries
     (:func:`compliance.campaign.coverage.case_coverage`)."""
     cov = result.summary.coverage or CaseCoverage(**case_coverage([e.as_dict() for e in result.requirements]))
-    reasons = Counter()
+    reasons, excluded = Counter(), Counter()  # an excluded case (a stated eligibility rule) is not a gap
     for e in result.requirements:
         if e.limit is None:
             continue
         for r in e.rows:
             if r.status == Status.NOT_EVALUATED:
-                reasons[(e.id, str(r.reason or "no value").split(":")[0].split(";")[0].strip())] += 1
+                (excluded if r.excluded else reasons)[(e.id, str(r.reason or "no value").split(":")[0].split(";")[0].strip())] += 1
     items = [{"requirement": rid, "reason": why, "count": n} for (rid, why), n in reasons.most_common()]
+    out = [{"requirement": rid, "reason": why, "count": n} for (rid, why), n in excluded.most_common()]
     return {"cases": cov.rows, "count": cov.not_evaluated, "evaluated": cov.evaluated, "basis": cov.basis or CASES_BASIS,
+            "excluded": cov.excluded or 0, "excluded_reasons": out,
             "text": case_coverage_text(cov.as_dict()), "reasons": items, "requirements": result.summary.counts.not_evaluated}
 
 

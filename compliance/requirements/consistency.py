@@ -123,6 +123,7 @@ def _tau_vs_rate_limit(reqset, stroke, tau_req, v_req) -> list[dict]:
     if not any(reqset.procedures[p].kind == "full_stroke" for p in v_req.procedures):
         return []
     valves_out = _circuit(reqset, tau_req.operating_points) == {False} and False not in _circuit(reqset, v_req.operating_points)
+    limiter_out = {reqset.operating_points[o].setpoint_limiter for o in tau_req.operating_points} == {False}
     out = []
     for p in sorted(set(tau_req.procedures) - set(v_req.procedures)):
         proc = reqset.procedures[p]
@@ -135,15 +136,62 @@ def _tau_vs_rate_limit(reqset, stroke, tau_req, v_req) -> list[dict]:
         circuit = ("the file measures tau with the flow-control valves out and the strokes with them in, so the valves "
                    "may set the stroke rate" if valves_out else
                    "tau and the strokes are judged on the same circuit, so the device that limits the stroke rate must not act on these steps")
+        limiter = (f"The file injects these steps downstream of the set-point rate limiter, so a limiter at or below "
+                   f"{v * 1e3:.1f} mm/s may set the stroke rate too (as commissioned it would ramp them: tau >= 0.632 x "
+                   f"{h * 1e3:.2f} mm / {v * 1e3:.1f} mm/s = {_TAU_FRACTION * h / v:.3f} s > {tau_max:.3g} s)" if limiter_out else
+                   f"A set-point rate limiter at or below {v * 1e3:.1f} mm/s acts on every step and gives tau >= 0.632 x "
+                   f"{h * 1e3:.2f} mm / {v * 1e3:.1f} mm/s = {_TAU_FRACTION * h / v:.3f} s > {tau_max:.3g} s")
         out.append(_finding(RATE_SPLIT, tau_req, v_req, p, step=h, tau_max=tau_max, v_max=v, mean_speed=mean,
                             ramp_tau_min=_TAU_FRACTION * h / v, text=(
             f"{tau_req.id} (time constant <= {tau_max:.3g} s on {p}, steps of {h * 1e3:.2f} mm) and {v_req.id} "
             f"({v_req.metric} <= {v * 1e3:.1f} mm/s on full strokes): reaching 63.2 % of the step within {tau_max:.3g} s needs "
             f"a mean speed of 0.632 x {h * 1e3:.2f} mm / {tau_max:.3g} s = {mean * 1e3:.1f} mm/s > {v * 1e3:.1f} mm/s, so the "
-            f"servo must move faster on these steps than the strokes may: {circuit}. A set-point rate limiter at or below "
-            f"{v * 1e3:.1f} mm/s acts on every step and gives tau >= 0.632 x {h * 1e3:.2f} mm / {v * 1e3:.1f} mm/s = "
-            f"{_TAU_FRACTION * h / v:.3f} s > {tau_max:.3g} s")))
+            f"servo must move faster on these steps than the strokes may: {circuit}. {limiter}")))
     return out
+
+
+def _interval(req, stroke):
+    """(low, high, low strict, high strict) of the values ``req`` admits (SI); None for an open side."""
+    lim = req.resolved_limit(stroke)
+    c = req.comparator
+    if c == "within":
+        return lim[0], lim[-1], False, False
+    if c in ("<=", "<"):
+        return None, lim[0], False, c == "<"
+    if c in (">=", ">"):
+        return lim[0], None, c == ">", False
+    return None, None, False, False
+
+
+def _shared_cases(a, b) -> list[tuple[str, str]]:
+    """(procedure, operating point) pairs both requirements judge (a point a requirement declares not applicable is left out)."""
+    return [(p, o) for p in a.procedures if p in b.procedures for o in a.operating_points
+            if o in b.operating_points and o not in a.not_applicable and o not in b.not_applicable]
+
+
+def _disjoint_windows(stroke, a, b) -> list[dict]:
+    """Two limits on the same metric and reading whose admissible intervals do not overlap (``conflict``)."""
+    if a.metric != b.metric or a.source != b.source or a.options != b.options:
+        return []
+    cases = _shared_cases(a, b)
+    if not cases:
+        return []
+    lo_a, hi_a, slo_a, shi_a = _interval(a, stroke)
+    lo_b, hi_b, slo_b, shi_b = _interval(b, stroke)
+    los = [(v, s) for v, s in ((lo_a, slo_a), (lo_b, slo_b)) if v is not None]
+    his = [(v, s) for v, s in ((hi_a, shi_a), (hi_b, shi_b)) if v is not None]
+    if not los or not his:
+        return []
+    lo, lo_strict = max(los, key=lambda x: (x[0], x[1]))
+    hi, hi_strict = min(his, key=lambda x: (x[0], not x[1]))
+    if lo < hi or (lo == hi and not (lo_strict or hi_strict)):
+        return []
+    p, o = cases[0]
+    more = f" (and {len(cases) - 1} more)" if len(cases) > 1 else ""
+    return [_finding(CONFLICT, a, b, p, low=lo, high=hi, text=(
+        f"{a.id} ({a.metric} {a.limit_text}) and {b.id} ({b.metric} {b.limit_text}) judge the same {a.metric} on {p} at "
+        f"{o}{more}, and no value lies in both: together they admit only values >= {lo:.6g} and <= {hi:.6g} (SI), "
+        "an empty window"))]
 
 
 def consistency_findings(reqset, stroke: float) -> list[dict]:
@@ -163,6 +211,9 @@ def consistency_findings(reqset, stroke: float) -> list[dict]:
     """
     reqs = [r for r in reqset.requirements if r.enabled and r.limit is not None]
     out = []
+    for i, a in enumerate(reqs):
+        for b in reqs[i + 1:]:
+            out += _disjoint_windows(stroke, a, b)
     for a in reqs:
         for b in reqs:
             if b.metric not in _SPEEDS:

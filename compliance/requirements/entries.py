@@ -12,7 +12,7 @@ from __future__ import annotations
 from compliance.units.amounts import parse_amount, parse_load
 from compliance.errors import did_you_mean
 from compliance.errors import InputError
-from compliance.metrics.catalogue import METRICS, STEP_OPTION_DEFAULTS
+from compliance.metrics.catalogue import CHOICE_OPTIONS, METRICS, STEP_OPTION_DEFAULTS
 from compliance.procedures.kinds import KINDS, parse_setting
 from compliance.requirements.schema import OPEN_LIMIT
 from compliance.requirements.requirement_set import LimitHistory, OperatingPoint, Procedure, Requirement
@@ -48,7 +48,8 @@ def build_operating_point(name: str, e: dict, origin) -> OperatingPoint:
     load = parse_load(load_text, _where(origin, "operating_points", name, "load"), named=("curve", "nominal"))
     if load is None:
         load_text = "none"
-    return OperatingPoint(name, e.get("title") or name, pos, load, load_text, e.get("flow_control"), e.get("note") or "")
+    return OperatingPoint(name, e.get("title") or name, pos, load, load_text, e.get("flow_control"), e.get("note") or "",
+                          e.get("setpoint_limiter"))
 
 
 def build_procedure(name: str, e: dict, origin) -> Procedure:
@@ -230,7 +231,8 @@ def _check_procedures(where: _RequirementWhere, metric: str, proc_names, op_name
 
 
 def _metric_options(where: _RequirementWhere, metric: str, given: dict) -> dict:
-    """The requirement's metric options (``options = { band = "2 %" }``) as amounts."""
+    """The requirement's metric options (``options = { settling_band = "2 %" }``): amounts, or a reading's name
+    (``timing = "full_rate"``, ``travel = "achieved"``: ``metrics.catalogue.CHOICE_OPTIONS``)."""
     info = METRICS[metric]
     options = {}
     for k, v in given.items():
@@ -239,6 +241,12 @@ def _metric_options(where: _RequirementWhere, metric: str, given: dict) -> dict:
                 f"{where.key('options')}.{k}: metric '{metric}' takes no option '{k}'"
                 + (f"{did_you_mean(k, info.options)} (options: {', '.join(info.options)})" if info.options else "")
             )
+        if k in CHOICE_OPTIONS:
+            choices = CHOICE_OPTIONS[k][0]
+            if v not in choices:
+                raise InputError(f"{where.key('options')}.{k}: '{v}' is not one of {', '.join(choices)}{did_you_mean(str(v), choices)}")
+            options[k] = v
+            continue
         options[k] = parse_amount(v, STEP_OPTION_DEFAULTS[k][0], f"{where.key('options')}.{k}")
     return options
 

@@ -42,6 +42,9 @@ class OperatingPoint:
     load_text: str
     flow_control: bool | None  # None = as configured in the plant
     note: str = ""
+    # the governor's set-point rate limiter: None = as configured; False = not acting (the set-point is
+    # injected downstream of the limiter, as for the time-constant test)
+    setpoint_limiter: bool | None = None
 
     def as_dict(self) -> dict:
         """Plain-JSON form (as written and SI)."""
@@ -52,6 +55,7 @@ class OperatingPoint:
             "load": self.load,
             "load_text": self.load_text,
             "flow_control": self.flow_control,
+            "setpoint_limiter": self.setpoint_limiter,
             "note": self.note,
         }
 

@@ -28,6 +28,7 @@ class _OpModel(_Strict):
     initial_position: str | None = None
     load: str | None = None
     flow_control: bool | None = None
+    setpoint_limiter: bool | None = None
     note: str | None = None
 
 

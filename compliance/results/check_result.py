@@ -30,9 +30,11 @@ RESULTS_SCHEMA = "govcheck-results/1"
 
 @dataclass(frozen=True, kw_only=True)
 class Coverage(Record):
-    """Every (run, metric request) with a computed value that no row judged, with the reason."""
+    """Every (run, metric request) with a computed value that no row judged, with the reason; the rule by
+    which a requirement's cases make it evaluated (``campaign.judge.EVALUATION_RULE``)."""
 
     unjudged: tuple[Unjudged, ...] = key(default=(), read=records(Unjudged))
+    evaluation_rule: str | None = key(omit_none=True, default=None)
 
 
 def _section(v, where):

@@ -26,6 +26,7 @@ class OperatingPointRecord(Record):
     load: float | str | None = None  # N, "curve", "nominal" or None (no load)
     load_text: str | None = None
     flow_control: bool | None = None  # throttles in (True) / out (False) / as configured (None)
+    setpoint_limiter: bool | None = None  # False: the step is injected downstream of the set-point rate limiter
     note: str = ""
     position: float | None = derived()  # [m] the initial position resolved against the plant's stroke
     load_force: float | None = derived()  # [N] a constant load (nominal resolved); None for none or the curve

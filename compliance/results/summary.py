@@ -50,10 +50,12 @@ class Counts(Record):
 
 @dataclass(frozen=True, kw_only=True)
 class CaseCoverage(Record):
-    """Judged test cases evaluated and not, on the one basis (``compliance.campaign.coverage.CASES_BASIS``)."""
+    """Judged test cases evaluated, excluded by an eligibility rule and not evaluated, on the one basis
+    (``compliance.campaign.coverage.CASES_BASIS``)."""
 
     rows: int = key(default=0)
     evaluated: int = key(default=0)
+    excluded: int | None = key(omit_none=True, default=None)  # every value excluded by a stated eligibility rule
     not_evaluated: int = key(default=0)
     basis: str = key(default="")
 

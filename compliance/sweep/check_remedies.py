@@ -1,8 +1,12 @@
 """``govcheck check --remedies``: the remedies search over a declared space for one configuration.
 
-The space is a sweep file's ``adjust`` table when one is named, else the settings that can be
-changed on site without new hardware, around the configuration's own values (its plant kind's
-``remedy_space``, compliance.plants):
+For a governor with a set-point rate limiter and the default space, the governor design comes first
+(``remedies.governor_stage``: the set-point rate limiter for the stroke times, the flow-control valves as
+its backstop, the time constant tuned on the file's own test, with the hardware as given and then with
+each catalogue option that lowers the load's share of the cylinders' force). When it finds nothing, the
+staged local search runs over a declared space: a sweep file's ``adjust`` table when one is named, else the
+settings that can be changed on site without new hardware, around the configuration's own values (its plant
+kind's ``remedy_space``, compliance.plants):
 controller gains and dead-zone compensation, the meter-out flow-control valves, the supply
 pressure regulator; for a PID governor also its set-point rate limiter (``remedies.limiter_space``).
 Then the options of a hardware catalogue (``sweep.sizing.hardware_catalogue``; the shipped one by default).
@@ -104,8 +108,21 @@ def remedies_for_check(cfg, reqset, sweep_file: str | None, *, workers=None, pro
         given = as_given(ctx, run_kw)
         if given["status"] == RemedyStatus.ALREADY_PASSES:
             return given
-        rem = staged_search(ctx, cfg, adjust, base, cat, iterations=iterations, run_kw=run_kw, limiter=limiter,
-                            verify=lambda v: verify_settings(cfg, reqset, paths, v, workers=workers))
+        gov = None
+        if kind_of(cfg).setpoint_limiter and not (sweep_file and sweep_file != "default"):
+            from compliance.sweep.remedies.governor_stage import governor_stage
+
+            gov = governor_stage(ctx, cfg, reqset, cat, workers=workers, uncertain=uncertain, run_kw=run_kw,
+                                 yield_units=yield_units)
+        if gov is not None and gov["status"] == RemedyStatus.FOUND:
+            rem = gov
+        else:
+            rem = staged_search(ctx, cfg, adjust, base, cat, iterations=iterations, run_kw=run_kw, limiter=limiter,
+                                verify=lambda v: verify_settings(cfg, reqset, paths, v, workers=workers))
+            if gov is not None:
+                rem["governor_design"] = {k: gov[k] for k in ("stages", "skipped_options", "note")}
+                rem["stages"] = gov["stages"] + rem.get("stages", [])
+                rem["evaluated"] += gov["evaluated"]
         rem = finish(rem, given, ctx, cfg, reqset, uncertain, cat, run_kw=run_kw, yield_units=yield_units)
     rem["space_source"] = sweep_file if sweep_file and sweep_file != "default" else "default on-site settings"
     rem["catalogue"] = cat.path if cat else None

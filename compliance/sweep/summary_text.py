@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from compliance.presentation.numbers import fmt_margin_pct, fmt_num, si_prefix, unit_text
+from compliance.sweep.remedies.outcome import RemedyStatus
 
 __all__ = ["remedies_markdown", "summary_markdown", "yield_markdown"]
 
@@ -35,6 +36,8 @@ def remedies_markdown(rem: dict) -> str:
         for b in s["by_parameter"][:4]:
             lines.append(f"  - {b['path']} +{_g(b['step'], b['unit'])}: {_pct(b['delta_margin_pct'])} points")
     pick = rem.get("remedy") or rem.get("closest")
+    if rem.get("status") == RemedyStatus.ALREADY_PASSES:  # the note says it; no "closest" to show
+        pick = None
     if pick:
         title = "Smallest verified change" if rem.get("remedy") else "Closest candidate (does not pass)"
         if not pick["changes"]:  # the configuration as given ranks first: no table of nothing

@@ -6,7 +6,7 @@
 
 Each example is made by the documented govcheck command (printed before it runs). Afterwards
 every HTML and PDF example is checked for text outside its figure or page and for overprinting
-(compliance.report.layout_check; the plant-A body at most 25 pages, the sign-off on page 1), for names of the code base, "seed" and references to missing
+(compliance.report.layout_check; the plant-A body at most 28 pages, the sign-off on page 1), for names of the code base, "seed" and references to missing
 sections (compliance.report.text_check), and every file an example points at must exist.
 Exit 0 when all is made and clean, 1 when a check fails, 2 when a command fails.
 """

@@ -7,7 +7,10 @@ import pytest
 
 from compliance.cli import main
 from tests.bad_inputs import workspace as W
-from tests.bad_inputs.cases import CASES
+from tests.bad_inputs import new_user
+from tests.bad_inputs.cases import CASES as OLDER
+
+CASES = OLDER + new_user.CASES
 
 
 def _materialise(ws, files):
@@ -26,6 +29,14 @@ def test_catalogue_size_and_ids():
     assert len(CASES) >= 120
     kinds = {i.split("-")[0] for i in ids}
     assert {"config", "req", "csv", "mat", "parquet", "comtrade", "sim", "out"} <= kinds
+
+
+def test_new_user_catalogue_covers_the_newer_features():
+    """At least 40 new-user cases over the newer features, every class of them present."""
+    ids = [c.id for c in new_user.CASES]
+    newer = [i for i in ids if not i.startswith("older-")]
+    assert len(newer) >= 40, len(newer)
+    assert {i.split("-")[0] for i in newer} == set(new_user.CLASSES)
 
 
 @pytest.mark.parametrize("case", CASES, ids=[c.id for c in CASES])

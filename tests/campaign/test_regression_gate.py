@@ -115,6 +115,12 @@ def test_same_plant_passes_the_gate(files, capsys):
     assert capsys.readouterr().out.strip() == "GATE: PASS"
     # two results files compare without running anything
     assert main(["gate", "--baseline", str(d / "base.json"), "--candidate", str(d / "base.json"), "-q"]) == 0
+    # a compressed results file (as a sweep stores its best candidate) is a results file too, not a plant
+    import gzip
+
+    packed = d / "base.json.gz"
+    packed.write_bytes(gzip.compress((d / "base.json").read_bytes()))
+    assert main(["gate", "--baseline", str(packed), "--candidate", str(d / "base.json"), "-q"]) == 0
 
 
 def test_gate_bad_inputs(files, tmp_path, capsys):
@@ -128,3 +134,20 @@ def test_gate_bad_inputs(files, tmp_path, capsys):
     assert main(["gate", "--baseline", "plant-a", "--candidate", "plant-a"]) == 2  # no requirement file
     assert "--requirements is needed" in capsys.readouterr().err
     assert main(["gate", "--baseline", str(d / "base.json"), "--candidate", "plant-a", "--max-margin-loss", "-1"]) == 2
+
+
+def test_uncertain_baseline_that_fails_in_the_candidate_trips_and_no_fail_reads_ok():
+    """A baseline whose band straddles the limit may pass; a candidate failing outright is a regression, and a
+    failing candidate row is never labelled 'ok'."""
+    from compliance.campaign.regression_gate import gate_table
+
+    base = results(entry("A", "uncertain", 5.0), entry("B", "not_evaluated", None), entry("C", "uncertain", 2.0))
+    cand = results(entry("A", "fail", -5.0), entry("B", "fail", -3.0), entry("C", "uncertain", 1.0))
+    g = compare(base, cand)
+    rows = {r["id"]: r for r in g["rows"]}
+    assert rows["A"]["tripped"] and "uncertain -> fail" in rows["A"]["reasons"][0]
+    assert not rows["B"]["tripped"] and not rows["C"]["tripped"]
+    table = gate_table(g)
+    line_b = next(line for line in table.splitlines() if line.startswith("B "))
+    assert " ok" not in line_b and "candidate fails" in line_b
+    assert "candidate uncertain" in next(line for line in table.splitlines() if line.startswith("C "))

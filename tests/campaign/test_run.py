@@ -200,8 +200,13 @@ def test_plant_a_against_shpp_end_to_end(tmp_path, capsys):
     assert "cases evaluated" in printed and "assumptions that matter most" in printed
     # the judged test cases on one basis: the same counts as the JSON (and page 1 of the report)
     cov = r["summary"]["coverage"]
-    assert cov["rows"] == cov["evaluated"] + cov["not_evaluated"] > cov["evaluated"] > 0
-    assert f"{cov['evaluated']} of {cov['rows']} judged test cases evaluated, {cov['not_evaluated']} not evaluated" in printed
+    assert cov["rows"] == cov["evaluated"] + cov["excluded"] + cov["not_evaluated"] > cov["evaluated"] > 0
+    excluded = sum(1 for e in r["requirements"] if e["limit"] is not None for row in e["rows"] if row.get("excluded")
+                   and row["status"] == "not_evaluated")
+    assert cov["excluded"] == excluded  # an excluded case (a stated eligibility rule) is counted apart from a gap
+    assert (f"{cov['evaluated']} of {cov['rows']} judged test cases evaluated, "
+            + (f"{excluded} excluded by an eligibility rule, " if excluded else "")
+            + f"{cov['not_evaluated']} not evaluated") in printed
     assert cov["basis"] in printed
     # every computed value is judged or carries the reason it is not (issue 22)
     judged = {(row["run"], e["request_key"]) for e in r["requirements"] for row in e["rows"]}
@@ -210,10 +215,16 @@ def test_plant_a_against_shpp_end_to_end(tmp_path, capsys):
         for key, samples in run["metrics"].items():
             if any(s["value"] is not None for s in samples):
                 assert (run["id"], key) in judged or why.get((run["id"], key)), (run["id"], key)
-    # the closing time at the rated load (12 kN helps closing) is judged by both closing-time requirements
+    # the closing time in service (the load curve helps closing from the open end, then lets the stroke slow down
+    # to ~18 mm/s mid stroke): no straight part, so both closing-time requirements judge its end-to-end time,
+    # flagged; the same servo at the rated 12 kN over the whole stroke is a stated variant (advisory)
     for rid in ("IEC61362-TCLOSE", "IEEE125-TCLOSE"):
-        row = [x for x in {e["id"]: e for e in r["requirements"]}[rid]["rows"] if x["run"] == "full-stroke@region2-80"][0]
-        assert 3.0 < row["value"] < 4.0 and row["status"] == "fail" and row["basis"] == "modelled"
+        row = [x for x in {e["id"]: e for e in r["requirements"]}[rid]["rows"] if x["run"] == "full-stroke@in-service"][0]
+        assert 5.25 < row["value"] < 6.5 and row["status"] == "fail" and row["basis"] == "assumed"
+        assert row["flag"].startswith("no straight part")
+        assert not [x for x in {e["id"]: e for e in r["requirements"]}[rid]["rows"] if x["run"] == "full-stroke@region2-80"]
+    const = [x for x in {e["id"]: e for e in r["requirements"]}["SHPP-TCLOSE-CONST"]["rows"] if x["run"] == "full-stroke@region2-80"][0]
+    assert 3.0 < const["value"] < 4.0 and const["status"] == "fail"
     # every failure is visible in the JUnit file
     tree = ET.parse(junit).getroot()
     failing_rows = sum(1 for e in r["requirements"] for row in e["rows"] if row["status"] == "fail")
@@ -224,11 +235,13 @@ def test_plant_a_against_shpp_end_to_end(tmp_path, capsys):
     acts = ent["IEC61362-ADJ-ACTS"]["rows"][0]
     assert acts["status"] in ("pass", "fail") and acts["value"] is not None
     # 1 % steps stall; 2 % steps put the 63.2 % point inside twice the 0.86 mm stall band
-    # (1.18 mm from the set-point) and 10 % steps saturate the valve: only 5 % steps decide
+    # (1.18 mm from the set-point) and 10 % steps saturate the valve: only 5 % steps decide, and the
+    # requirement is evaluated because every tc-* point has one (the evaluation rule)
+    assert ent["IEC61362-TC"]["status"] in ("pass", "fail", "uncertain")
     for row in ent["IEC61362-TC"]["rows"]:
         assert row["procedure"].removesuffix("-down") in ("steps-2", "steps-5", "steps-10")
         if row["status"] in ("pass", "fail", "uncertain"):
             # the first step of a run: from rest at the operating point, the circuit stated
             assert row["which"].startswith("step 1 of ") and row["procedure"].startswith("steps-5")
         else:
-            assert row["reason"]
+            assert row["reason"] and row["excluded"]

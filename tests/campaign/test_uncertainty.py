@@ -35,6 +35,7 @@ clause = "clause unknown"
 metric = "closing_time"
 comparator = ">="
 limit = "3.47 s"
+options = { timing = "extrapolated" }
 procedures = ["close"]
 operating_points = ["rated"]
 """

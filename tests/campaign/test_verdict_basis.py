@@ -117,8 +117,13 @@ def test_stroke_results_carry_the_ptc29_timing(both):
     for s in run["metrics"]["closing_time"] + run["metrics"]["opening_time"]:
         d = s["detail"]
         assert 0.0 < d["start_delay"] < d["t25_75"][0] < d["t25_75"][1] < d["time_to_end"]
-        assert d["cushion_time"] > 0 and d["cushion_at_rate"] == pytest.approx(0.09 * s["value"])
+        assert d["cushion_time"] > 0 and d["cushion_at_rate"] == pytest.approx(0.09 * d["extrapolated"])
         assert "flow-control valves" in d["circuit"]
+        # the full-rate reading: the extrapolated time on a straight stroke, else the end-to-end time, flagged
+        if d["straight"]:
+            assert s["value"] == d["extrapolated"] and "flag" not in d
+        else:
+            assert s["value"] == d["time_to_end"] and d["flag"].startswith("no straight part")
 
 
 def test_a_by_construction_pass_alone_is_not_an_overall_pass(tmp_path_factory, plant):

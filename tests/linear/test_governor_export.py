@@ -62,7 +62,24 @@ def test_json_states_every_basis_and_the_forms(gov):
     assert fields[:3] == ["1", "'HYGOV'", "'1'"] and len(fields) == 3 + len(HYGOV_DYR_ORDER)
     values = dict(zip(HYGOV_DYR_ORDER, map(float, fields[3:])))
     assert values["Tg"] == pytest.approx(gov.Tg, rel=1e-5) and values["VELM"] == pytest.approx(gov.VELM, rel=1e-5)
-    assert "replace" in comment
+    # every CON a number for the bare positioner (no placeholder left to replace by hand), its basis in the comment
+    a = d["andes"]["HYGOV"]
+    assert values["R"] == pytest.approx(a["R"]) and values["r"] == pytest.approx(a["r"]) and values["qNL"] == 0.0
+    assert values["R"] == pytest.approx(100.0) and values["At"] == pytest.approx(1.0)  # Tn = Sb, dispatch = Tn x gate
+    assert "MBASE 100 MVA" in comment and "transparent" in comment
+
+
+def test_andes_settings_are_numbers_on_the_machine_base_with_their_basis(gov):
+    a = gov.andes(rating_mva=50.0, system_mva=100.0, dispatch_mw=90.0)
+    h4 = a["HYGOV4"]
+    assert all(isinstance(v, float) for v in h4.values())
+    assert h4["Tn"] == 50.0 and h4["Rperm"] == pytest.approx(0.5) and h4["Hdam"] == pytest.approx(2.0)
+    assert h4["Rtemp"] == 0.0 and h4["qNL"] == 0.0
+    x0 = gov.point["position"] / gov.stroke
+    assert a["gate0"] == pytest.approx(x0) and h4["At"] == pytest.approx((90.0 / 50.0) / x0)  # gate starts at x0
+    assert a["setpoint"]["HYGOV4"] == pytest.approx(0.5) and a["gate_output"]["per_pu_gate"] == pytest.approx(0.5)
+    assert a["HYGOV"]["R"] == pytest.approx(50.0) and a["setpoint"]["HYGOV"] == pytest.approx(50.0)
+    assert set(a["basis"]) >= {"Tn", "Sb", "Rperm", "Rtemp", "Hdam", "At", "qNL", "HYGOV_R", "HYGOV_r"}
 
 
 def test_cli_header_is_the_governor_operating_point(tmp_path, capsys):

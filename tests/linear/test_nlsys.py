@@ -114,7 +114,7 @@ def test_round_trip_reproduces_govcheck_linear(cfg):
     assert plant.nstates == 4
     xeq, ueq = find_rest_point(plant, X_OP)
     G = control.linearize(plant, xeq, ueq, copy_names=True)  # forward step: the opening side of the null
-    valve = control.ss([], [], [], [[valve_gain(cfg, "opening")]], inputs=["u_d_V"], outputs=["opening"], name="valve")
+    valve = control.ss([], [], [], [[valve_gain(cfg, "opening")]], inputs=["u_d_V"], outputs=["command_opening_1"], name="valve")
     pid = control.linearize(controller_nlsys(cfg), [0.0, X_OP], [X_OP, X_OP], copy_names=True)[0, :]
     loop = control.interconnect([G, valve, pid], inputs=["reference_m"], outputs=["position_m"], check_unused=False)
     a = analyse(cfg, X_OP, LOAD, gain="opening")

@@ -113,3 +113,22 @@ def test_simulate_cli_writes_csv(tmp_path):
     assert list(df.columns[:7]) == ["time", "position", "reference", "valve_command", "pressure_a", "pressure_b", "supply_pressure"]
     assert len(df) == 1001
     assert df.reference.iloc[-1] == pytest.approx(0.136 + 0.0032)
+
+
+def test_a_saved_configuration_keeps_the_ranges_and_targets_of_the_values_it_did_not_change(tmp_path):
+    """A remedy or a sized proposal written to a file keeps the plant file's declared ranges (its verdicts' bands)
+    and derivation targets, except for the values it changed: those were stated about the old value."""
+    cfg = load_plant("plant-a")
+    ranged = {k for k, a in cfg.assumptions.items() if a.get("range")}
+    derived = {k for k, a in cfg.assumptions.items() if a.get("derived_for")}
+    assert {"valve.saturation_voltage", "friction.static_force"} <= ranged and derived
+    moved = cfg.replace(params={"friction.static_force": 400.0, "controller.kp": 300.0})
+    back = load_plant(save_plant(moved, tmp_path / "moved.toml"))
+    assert set(back.assumptions) == set(cfg.assumptions) - {"friction.static_force"}
+    for k in back.assumptions:
+        a, b = cfg.assumptions[k], back.assumptions[k]
+        assert b["derived_for"] == a["derived_for"]
+        if a["range"]:
+            assert b["range"]["note"] == a["range"]["note"]
+            assert b["range"]["low"] == pytest.approx(a["range"]["low"], rel=1e-9)
+            assert b["range"]["high"] == pytest.approx(a["range"]["high"], rel=1e-9)

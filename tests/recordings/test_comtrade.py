@@ -81,11 +81,15 @@ def test_reads_back_within_the_files_resolution_on_primary_values(tmp_path, run,
         # a value is rounded to the nearest step of the file (half a resolution), plus float64 rounding of a*x+b
         assert err <= 0.5 * res * (1 + 1e-6) + 1e-12 * abs(df[name]).max(), (name, err, res)
         assert res < 1e-4 * max(np.ptp(df[name].to_numpy()), abs(df[name]).max())  # a resolution, not a range
-    assert meta["trigger_time"] == pytest.approx(offset + STEP_AT, abs=1e-6)
+    # trigger_time is measured from the first sample (C37.111: the first stamp dates the first sample), so on the
+    # file's time axis, which starts at the offset here, the trigger is at the first sample's time plus it
+    assert meta["trigger_time"] == pytest.approx(STEP_AT, abs=1e-6)
+    assert t[0] + meta["trigger_time"] == pytest.approx(offset + STEP_AT, abs=1e-6)
     assert meta["comtrade"]["revision"] == VARIANTS[variant][0]
     assert meta["comtrade"]["form"] == ("cff" if VARIANTS[variant][2] else "pair")
     # the comtrade package, an independent reader, sees the same samples: secondary ones where the file says S
     rec = _package_read(path, use_double_precision=True)
+    assert rec.trigger_time == pytest.approx(meta["trigger_time"], abs=1e-6)  # the same reading as the comtrade package
     for name in ("position", "pressure_a"):
         raw = np.asarray(rec.analog[rec.analog_channel_ids.index(name)])
         ratio = ratios.get(name, (1.0, 1.0))
@@ -230,6 +234,21 @@ def test_a_cut_cff_is_refused(tmp_path, run):
     path.write_bytes(data[: data.index(b"--- file type: DAT")])
     with pytest.raises(InputError, match=r"rec\.cff: a \.cff needs a '--- file type: DAT ---' section"):
         read_recording(path)
+
+
+def test_cff_data_section_is_headed_binary_and_the_type_word_is_read_too(tmp_path, run):
+    """C37.111-2013 heads a .cff's binary data 'DAT BINARY: <bytes>' whatever the binary type (the CFG's ft line
+    says BINARY32); govcheck writes that, the comtrade package reads it, and a device's 'DAT BINARY32:' is read too."""
+    path = _write(tmp_path, run, "2013-binary32-cff")
+    data = path.read_bytes()
+    head = data[data.index(b"--- file type: DAT"):].split(b"\r\n", 1)[0]
+    n = len(data) - data.index(head) - len(head) - 2
+    assert head == f"--- file type: DAT BINARY: {n} ---".encode()
+    assert _package_read(path, use_double_precision=True).ft == "BINARY32"
+    frame, _ = read_recording(path)
+    path.write_bytes(data.replace(b"DAT BINARY: ", b"DAT BINARY32: "))
+    again, _ = read_recording(path)
+    np.testing.assert_array_equal(frame["position"].to_numpy(), again["position"].to_numpy())
 
 
 # ----------------------------------------------------------------------------- govcheck simulate -o run.cfg

@@ -91,3 +91,61 @@ def test_tau_window_against_the_stroke_rate_limit_across_procedures():
         ("steps-10", ("IEC61362-TC", "IEEE125-NOFASTER")), ("steps-10-down", ("IEC61362-TC", "IEEE125-NOFASTER"))}
     f = found[0]
     assert "40.5 mm/s > 32.0 mm/s" in f["text"] and "0.316 s > 0.25 s" in f["text"] and "valves out" in f["text"]
+
+
+DISJOINT = """
+schema = "govcheck-requirements/1"
+name = "disjoint"
+[operating_points.mid]
+initial_position = "50 %stroke"
+load = "none"
+[operating_points.low]
+initial_position = "20 %stroke"
+load = "none"
+[procedures.steps-5]
+kind = "steps"
+size = "5 %stroke"
+[requirements.TC]
+title = "time constant"
+clause = "test"
+metric = "time_constant"
+comparator = "within"
+limit = ["0.10 s", "0.25 s"]
+procedures = ["steps-5"]
+operating_points = ["mid"]
+[requirements.TC-B]
+title = "time constant, another purchaser"
+clause = "test"
+metric = "time_constant"
+comparator = "within"
+limit = ["0.30 s", "0.40 s"]
+procedures = ["steps-5"]
+operating_points = ["mid", "low"]
+"""
+
+
+def test_disjoint_windows_on_the_same_steps_are_a_conflict(tmp_path):
+    p = tmp_path / "d.toml"
+    p.write_text(DISJOINT, encoding="utf-8")
+    found = consistency_findings(load_requirements(str(p)), 0.16)
+    conflicts = [f for f in found if f["kind"] == CONFLICT]
+    assert len(conflicts) == 1 and conflicts[0]["requirements"] == ["TC", "TC-B"]
+    assert conflicts[0]["low"] == pytest.approx(0.30) and conflicts[0]["high"] == pytest.approx(0.25)
+    assert "no value lies in both" in conflicts[0]["text"]
+
+
+@pytest.mark.parametrize("edit, expected", [
+    # overlapping windows narrow each other but admit values: no conflict
+    (('["0.30 s", "0.40 s"]', '["0.20 s", "0.40 s"]'), 0),
+    # a point shared only at the edge with both ends closed: the edge value passes both
+    (('["0.30 s", "0.40 s"]', '["0.25 s", "0.40 s"]'), 0),
+    # judged at different operating points only: no shared case, no conflict
+    (('operating_points = ["mid", "low"]', 'operating_points = ["low"]'), 0),
+    # an upper limit below the other's window: a conflict too
+    (('comparator = "within"\nlimit = ["0.30 s", "0.40 s"]', 'comparator = "<="\nlimit = "0.05 s"'), 1),
+])
+def test_disjoint_windows_only_when_no_value_passes_both(tmp_path, edit, expected):
+    p = tmp_path / "d.toml"
+    p.write_text(DISJOINT.replace(*edit), encoding="utf-8")
+    found = consistency_findings(load_requirements(str(p)), 0.16)
+    assert len([f for f in found if f["kind"] == CONFLICT]) == expected

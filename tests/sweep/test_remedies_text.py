@@ -43,3 +43,13 @@ def test_remedies_margins_and_units_are_typeset():
         assert "\u221227.4 %" in text and "-27.4" not in text
         assert "m^3/(s*Pa)" not in text and "8e+05" not in text and "800 kPa" in text
     assert "\u22124.3" in html and "m³/(s·Pa)" in html
+
+
+def test_a_plant_that_passes_gets_no_closest_candidate():
+    """'nothing to change' is the whole answer: no 'closest candidate (does not pass)' after it."""
+    rem = {"status": "already_passes", "note": "every mandatory requirement passes as configured: nothing to change",
+           "evaluated": 1, "sensitivities": [], "remedy": None,
+           "closest": {"changes": [], "change": 0.0, "binding": "TC", "binding_margin_pct": 12.0, "failed_mandatory": []}}
+    for text in (remedies_markdown(rem), section_html("t", remedies=rem)):
+        assert "nothing to change" in text
+        assert "does not pass" not in text and "Closest candidate" not in text

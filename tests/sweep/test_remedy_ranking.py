@@ -9,6 +9,7 @@ import pandas as pd
 import pytest
 
 from compliance.cli import main
+from compliance.model.config import load_plant
 from compliance.sweep.candidates.ranking import candidate_passes, failing_mandatory, rank_key
 from compliance.sweep.remedies.finish import _never_worse
 from compliance.sweep.candidates.results import best_index
@@ -64,7 +65,11 @@ def test_hardware_remedy_is_saved_and_checks_clean(tmp_path, write_sweep, capsys
     assert rem["remedy"]["hardware_values"]["valve.sonic_conductance"] > 2.33e-8  # a larger valve than the 700 NL/min
     assert rem["tolerance_yield"]["units"] == 4 and 0.0 <= rem["tolerance_yield"]["lower_bound"] <= 1.0
     assert {n["option"] for n in rem["not_modelled"]} >= {"meter-in-throttles", "exhaust-back-pressure-valve"}
-    assert main(["check", str(remedy), "-r", str(SMALL_TC), "-q"]) == 0  # accepted unchanged, and passes
+    # accepted unchanged, and passes at its values; it keeps plant A's declared ranges of the values it did not
+    # change (its verdicts' bands), and drops the range of the valve conductance it changed
+    assert main(["check", str(remedy), "-r", str(SMALL_TC), "-q", "--uncertainty", "0"]) == 0
+    saved = load_plant(remedy)
+    assert "valve.saturation_voltage" in saved.assumptions and "valve.sonic_conductance" not in saved.assumptions
 
 
 def test_save_remedy_needs_remedies(tmp_path):
@@ -111,5 +116,8 @@ def test_a_rate_limited_time_constant_is_explained_by_the_ramp():
 
     cfg = load_plant("plant-a").replace(params={"controller.setpoint_opening_rate": 0.0312,
                                                 "controller.setpoint_closing_rate": 0.0315})
-    text = explain("IEC61362-TC", "steps-10-down@tc-mid", cfg, load_requirements("shpp-400kw"), True)
+    shpp = load_requirements("shpp-400kw")
+    text = explain("IEC61362-TC", "steps-10@mid-no-load", cfg, shpp, True)  # a point where the limiter acts
     assert "0.324 s" in text and "31.2 mm/s" in text
+    # at a tc-* point the step is injected downstream of the limiter: the ramp is not the explanation
+    assert "ramps" not in explain("IEC61362-TC", "steps-10-down@tc-mid", cfg, shpp, True)

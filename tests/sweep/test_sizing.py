@@ -42,7 +42,8 @@ def test_throttles_refined_to_plant_a_derived_values():
     """Simulated to 5.00 s at the 5.7 kN set-up load, the throttles are plant A's derived 0.794 / 0.638 dm^3/(s*bar)."""
     duty = load_duty(DUTY)
     cfg, _ = size_servo(duty, load_plant(duty.template))
-    cfg, report = tune_throttles(cfg, load_requirements("shpp-400kw"), {"opening": 5.0, "closing": 5.0})
+    cfg, report = tune_throttles(cfg, load_requirements("shpp-400kw"), {"opening": 5.0, "closing": 5.0},
+                                 setup_force=duty.setup_force)
     plant_a = load_plant("plant-a")
     for d in ("opening", "closing"):
         assert report[d]["achieved"] == pytest.approx(5.0, rel=0.01)

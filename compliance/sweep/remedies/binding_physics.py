@@ -102,7 +102,9 @@ def explain(rid: str | None, where: str | None, cfg, reqset, tried_limiter: bool
                     f"atmosphere; the gate is held until their forces cross and then breaks away with the stored pressure "
                     f"difference - the end-stop surge. Throttles and gains act after it.{lim} The hardware that acts on it "
                     "(an exhaust back-pressure valve, cushioned cylinders) is not modelled (catalogue: not_modelled).")
-    if req.metric == "time_constant" and cfg.setpoint_rate_limited and _step_size(reqset, proc, L):
+    point = reqset.operating_points.get((where or "").split("@")[-1])
+    through_limiter = point is None or point.setpoint_limiter is not False  # a tc point may inject downstream of it
+    if req.metric == "time_constant" and cfg.setpoint_rate_limited and through_limiter and _step_size(reqset, proc, L):
         return _limited_steps(rid, where, cfg, req, _step_size(reqset, proc, L), L)
     if req.metric in ("opening_time", "closing_time", "time_constant"):
         v_c = choked_speed(cfg)

@@ -19,7 +19,7 @@ from compliance.sweep.candidates.runner import run_candidates
 from compliance.requirements.verdict import Severity
 from compliance.sweep.remedies.outcome import RemedyStatus
 
-__all__ = ["CONFIDENCE", "YIELD_TARGET", "as_given", "finish", "remedy_configuration", "remedy_values"]
+__all__ = ["CONFIDENCE", "YIELD_TARGET", "as_given", "finish", "remedy_configuration", "remedy_values", "tolerance_yield"]
 
 YIELD_TARGET = 0.95
 CONFIDENCE = 0.95
@@ -53,6 +53,12 @@ def _never_worse(rem, given) -> None:
     k_close = (len(close["failed_mandatory"]), close.get("total_shortfall", 0.0)) if close else (float("inf"),)
     if k_close > rank_key(given["row"], 0.0)[:2]:
         rem["closest"] = {**given["candidate"], "note": "no candidate judged ranks before the configuration as given"}
+
+
+def tolerance_yield(rem, ctx, cfg, uncertain, run_kw, units) -> dict:
+    """Run the tolerance yield of ``rem``'s remedy and put it in ``rem["tolerance_yield"]`` (returned too)."""
+    _yield(rem, ctx, cfg, uncertain, run_kw, units)
+    return rem["tolerance_yield"]
 
 
 def _yield(rem, ctx, cfg, uncertain, run_kw, units):
@@ -98,7 +104,7 @@ def finish(rem, given, ctx, cfg, reqset, uncertain, catalogue, *, run_kw, yield_
     elif rem["status"] == RemedyStatus.FOUND:
         r = rem["remedy"]
         r.setdefault("cost", SETTINGS_COST * r["change"])
-        if yield_units:
+        if yield_units and "tolerance_yield" not in rem:  # the governor stage yields its designs itself
             _yield(rem, ctx, cfg, uncertain, run_kw, yield_units)
     if catalogue is not None:
         rem["not_modelled"] = [{"option": n, "title": t, "reason": why} for n, t, why in catalogue.not_modelled]
@@ -116,5 +122,10 @@ def remedy_configuration(cfg, rem, paths):
     note = "remedies search of govcheck check --remedies: " + ", ".join(
         f"{c['path']} {c['from']:.4g} -> {c['to']:.4g}" for c in rem["remedy"]["changes"])
     hw = ", ".join(h["title"] for h in rem["remedy"].get("hardware", []))
-    return changed.replace(name=f"{cfg.name}-remedy",
-                           provenance={**cfg.provenance, "remedy": note + (f"; hardware: {hw}" if hw else "")})
+    prov = {**cfg.provenance, "remedy": note + (f"; hardware: {hw}" if hw else "")}
+    y = rem.get("tolerance_yield")
+    if y:
+        prov["remedy_yield"] = (f"tolerance yield {y['pass']} of {y['valid']} delivered units pass every mandatory requirement "
+                                f"(one-sided {100 * y['confidence']:.0f} % lower bound {100 * y['lower_bound']:.1f} %: "
+                                f"{'meets' if y['meets'] else 'does not show'} >= {100 * y['target']:.0f} %)")
+    return changed.replace(name=f"{cfg.name}-remedy", provenance=prov)

@@ -20,9 +20,11 @@ def read_validated(path: Path, model, schema: str, what: str):
     InputError
         Missing file, malformed TOML, a field the model refuses, or another schema (naming file and field).
     """
+    if path.is_dir():
+        raise InputError(f"{path}: is a folder; expected a {what} (TOML file)")
     if not path.is_file():
         raise InputError(f"{path}: {what} not found")
-    data, _ = read_toml(path)
+    data, _ = read_toml(path, what)  # a requirement file or a plant given here is named as such
     try:
         raw = model.model_validate(data)
     except ValidationError as exc:

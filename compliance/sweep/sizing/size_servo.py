@@ -30,7 +30,8 @@ from dataclasses import replace as dc_replace
 
 from compliance.physics.valve_rating import conductance_of_rating, rating_of_conductance
 
-__all__ = ["ISO_15552", "STANDARD_RATINGS", "size_cylinders", "size_servo", "size_valve", "time_constant_target"]
+__all__ = ["ISO_15552", "MAX_BORE_STEPS", "STANDARD_RATINGS", "size_and_check", "size_cylinders", "size_servo", "size_valve",
+           "time_constant_target"]
 
 ISO_15552 = ((0.032, 0.012), (0.040, 0.016), (0.050, 0.020), (0.063, 0.020), (0.080, 0.025), (0.100, 0.025),
              (0.125, 0.032), (0.160, 0.040), (0.200, 0.040), (0.250, 0.050), (0.320, 0.063))  # bore, rod [m]
@@ -46,14 +47,18 @@ def _areas(bore: float, rod: float) -> tuple[float, float]:
     return cap, cap - math.pi * rod * rod / 4.0
 
 
-def size_cylinders(force: float, supply: float, atmosphere: float) -> dict:
-    """Count, bore, rod [m], side area [m^2] and load ratio for ``force`` [N] at ``supply`` [Pa abs]."""
-    need = force / (LOAD_RATIO * (supply - atmosphere))
+def size_cylinders(force: float, supply: float, atmosphere: float, min_area: float = 0.0, count: int | None = None) -> dict:
+    """Count, bore, rod [m], side area [m^2] and load ratio for ``force`` [N] at ``supply`` [Pa abs].
+
+    ``min_area`` [m^2]: take a side area above it (the next size up when a check asks for a lower load share);
+    ``count``: keep that arrangement (2 = the tandem pair, 1 = one cylinder).
+    """
+    need = max(force / (LOAD_RATIO * (supply - atmosphere)), min_area)
     options = []
     for bore, rod in ISO_15552:
         cap, ann = _areas(bore, rod)
         options += [(cap + ann, 0, 2, bore, rod), (min(cap, ann), 1, 1, bore, rod)]  # tandem first on a tie
-    ok = sorted(o for o in options if o[0] >= need)
+    ok = sorted(o for o in options if o[0] >= need and o[0] > min_area and (count is None or o[2] == count))
     if not ok:
         raise ValueError(f"no ISO 15552 pair carries {force:.0f} N at {supply/1e5:.1f} bar abs")
     area, _, count, bore, rod = ok[0]
@@ -106,14 +111,15 @@ def time_constant_target(reqset) -> float:
     return TAU_DEFAULT
 
 
-def size_servo(duty, template, tau: float | None = None) -> tuple:
+def size_servo(duty, template, tau: float | None = None, min_area: float = 0.0, count: int | None = None) -> tuple:
     """(sized configuration, sizing record) for ``duty`` on ``template`` (steady throttle rule).
 
-    The throttles are the steady first guess; :func:`compliance.sweep.sizing.throttle_tuning.tune_throttles`
-    refines them by simulation.
+    The throttles are the steady first guess (:func:`compliance.sweep.sizing.throttle_tuning.tune_throttles`
+    refines them by simulation, as plant A's were derived); ``govcheck size`` then sets the governor
+    (``sizing.governor_design``). ``min_area`` [m^2]: cylinders with a larger side area than this.
     """
     atm = template.params["air.atmospheric_pressure"]
-    cyl = size_cylinders(duty.max_force, duty.supply_pressure, atm)
+    cyl = size_cylinders(duty.max_force, duty.supply_pressure, atm, min_area, count)
     times = [t for t in (duty.opening_time, duty.closing_time) if t]
     speed = duty.stroke / min(times) if times else duty.stroke / 5.0
     ts = template.params["air.supply_temperature"]
@@ -132,3 +138,46 @@ def size_servo(duty, template, tau: float | None = None) -> tuple:
     record = {"cylinders": cyl, "valve": valve, "stroke_speed": speed, "tau_target": tau or TAU_DEFAULT,
               "controller": ctl, "throttles_steady": {k: params[k] for k in params if k.startswith("flow_control.")}}
     return cfg, record
+
+
+MAX_BORE_STEPS = 2  # larger cylinder pairs tried when the proposal's check fails (our choice)
+
+
+def size_and_check(duty, template, reqset, *, workers=None, progress=False) -> tuple:
+    """Size, set the governor, check, and step the cylinders up until the proposal passes.
+
+    The governor design (``sizing.governor_design.design_and_check``) sets the rate limiter, the throttles
+    and the controller on the sized hardware and checks the full campaign with the file's readings. What it
+    cannot meet on a pair of cylinders (the time constant spreading wider than its window, the gate lagging
+    the limiter under load, the tracking error at the rated load) grows with the load's share of the
+    cylinders' force, so the next ISO 15552 size up in the same arrangement is sized (valve resized for it)
+    and designed again, up to ``MAX_BORE_STEPS`` times.
+
+    Returns
+    -------
+    tuple
+        (configuration, sizing record of the last pair, results of its check, rounds): ``rounds`` has one
+        entry per pair tried (bore, load share, status, failing requirements, what the design could not meet).
+    """
+    from compliance.requirements.verdict import Overall
+    from compliance.sweep.sizing.governor_design import design_and_check
+
+    tau = time_constant_target(reqset)
+    rounds, min_area, count = [], 0.0, None
+    for _ in range(MAX_BORE_STEPS + 1):
+        cfg, rec = size_servo(duty, template, tau, min_area, count)
+        cyl = rec["cylinders"]
+        cfg, design, results = design_and_check(cfg, reqset, workers=workers, progress=progress)
+        rec["design"] = design
+        rounds.append({"bore": cyl["bore"], "rod": cyl["rod"], "count": cyl["count"], "load_ratio": cyl["load_ratio"],
+                       "valve_rating": rec["valve"]["rating"], "status": results["summary"]["status"],
+                       "failed_mandatory": results["summary"]["failed_mandatory"] + results["summary"].get("uncertain", []),
+                       "cannot": design.get("cannot")})
+        if results["summary"]["status"] == Overall.PASS:
+            break
+        min_area, count = cyl["area"], cyl["count"]  # the next pair up, same arrangement
+        try:
+            size_cylinders(duty.max_force, duty.supply_pressure, template.params["air.atmospheric_pressure"], min_area, count)
+        except ValueError:
+            break
+    return cfg, rec, results, rounds

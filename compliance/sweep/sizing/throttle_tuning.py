@@ -1,4 +1,4 @@
-"""Throttles of a sized servo refined by simulation: the full stroke's 25-75 % time on target.
+"""Throttles refined by simulation: the manual full stroke's 25-75 % time on target at the set-up load.
 
 The steady rule of ``sizing.size_servo`` ignores the pressure transients of a stroke; here each meter-out
 conductance is corrected by a secant on log C until the simulated full stroke at the set-up
@@ -6,12 +6,13 @@ point (flow-control valves in) takes the target time (within ``TOLERANCE``). Thi
 A's own throttles were derived (models/plant-a.toml, ``derived_for``: 5.0 s at 5.7 kN).
 
 The set-up point is where the flow-control valves are adjusted on site, as a commissioning
-engineer does it (plant paper section 5.2: at the governor set-up load): the operating point at
-which the requirement file judges the independent adjustment of those valves. A file without
-that test sets them at the stroke-time requirement's first point. A stroke-time requirement
-judged at other loads too (no load, rated load) is a check on that one setting, not a second
-target: one throttle cannot be tuned to several loads, and the check that follows sizing judges
-every load the file names.
+engineer does it (plant paper section 5.2: at the governor set-up load): the requirement file's
+operating point with the duty's set-up load when one is given, else the point at which the file
+judges the independent adjustment of those valves, else the stroke-time requirement's first
+point. One throttle cannot be tuned to several loads: a meter-out throttle's speed depends on the
+load, which is why ``govcheck size`` sets the stroke times with the governor's set-point rate
+limiter and keeps the throttles wide open as its backstop (``sizing.governor_design``); this module
+reproduces how plant A's throttles were derived (models/plant-a.toml, ``derived_for``).
 """
 
 from __future__ import annotations
@@ -27,8 +28,12 @@ TOLERANCE = 0.005  # relative stroke-time error accepted
 KEYS = {"opening": "flow_control.opening_conductance", "closing": "flow_control.closing_conductance"}
 
 
-def setup_point(reqset, candidates) -> str:
-    """Name of the operating point among ``candidates`` where the file adjusts the flow-control valves (module note)."""
+def setup_point(reqset, candidates, setup_force: float | None = None) -> str:
+    """Name of the operating point where the file adjusts the flow-control valves (module note)."""
+    if setup_force is not None:
+        for o, op in reqset.operating_points.items():
+            if isinstance(op.load, float) and abs(op.load - setup_force) <= 0.01 * abs(setup_force) and op.flow_control is not False:
+                return o
     for r in reqset.requirements:
         adjusts = any(reqset.procedures[p].kind == "independent_adjustment" for p in r.procedures if p in reqset.procedures)
         if r.enabled and adjusts:
@@ -38,11 +43,11 @@ def setup_point(reqset, candidates) -> str:
     return candidates[0]
 
 
-def stroke_target(reqset, direction: str, stroke: float, given: float | None):
+def stroke_target(reqset, direction: str, stroke: float, given: float | None, setup_force: float | None = None):
     """(target time [s], set-up operating point) of a direction's full stroke: the duty's time, else the window's middle."""
     for r in reqset.requirements:
         if r.metric == f"{direction}_time" and r.enabled and r.operating_points:
-            op = reqset.operating_points[setup_point(reqset, list(r.operating_points))]
+            op = reqset.operating_points[setup_point(reqset, list(r.operating_points), setup_force)]
             if given is None and r.limit is not None:
                 lim = r.resolved_limit(stroke)
                 given = 0.5 * (lim[0] + lim[-1])
@@ -51,16 +56,16 @@ def stroke_target(reqset, direction: str, stroke: float, given: float | None):
 
 
 def _time(cfg, op, direction):
-    df = full_command_stroke(cfg, op, direction, "full", 16.0, True)
+    df = full_command_stroke(cfg, op, direction, "full", 16.0, True, drive="manual")
     t, x = M.frame_columns(df, "time", "position")
     return M.stroke_time(t, x, cfg.params["cylinder.stroke"], direction)[0]
 
 
-def tune_throttles(cfg, reqset, times: dict, iterations: int = 6):
+def tune_throttles(cfg, reqset, times: dict, iterations: int = 6, setup_force: float | None = None):
     """``cfg`` with each throttle refined to its target; returns (cfg, {direction: (target, achieved) or reason})."""
     report = {}
     for d, key in KEYS.items():
-        target, op = stroke_target(reqset, d, cfg.params["cylinder.stroke"], times.get(d))
+        target, op = stroke_target(reqset, d, cfg.params["cylinder.stroke"], times.get(d), setup_force)
         if target is None or op is None or cfg.params[key] <= 0.0:
             report[d] = "kept at the steady rule (no full-stroke requirement to set it against)"
             continue
