@@ -14,7 +14,9 @@ import pytest
 
 from compliance.diagnosis.servo import fit as fit_module
 from compliance.diagnosis.servo.candidates import effect_params
-from compliance.diagnosis.servo.fit import SCREEN_SHARE, FitContext, FitResult, screen_level
+from compliance.diagnosis.servo import recalibration
+from compliance.diagnosis.servo.candidates import base_params
+from compliance.diagnosis.servo.fit import SCREEN_SHARE, SINGLE_SCREEN_SHARE, FitContext, FitResult, screen_level
 from compliance.diagnosis.servo.instrument_candidates import instrument_candidates
 from compliance.diagnosis.servo.effect_sets import full_name, prune, reduced_sets
 from compliance.diagnosis.verdicts.candidate_set import CandidateSet
@@ -96,6 +98,44 @@ def test_a_finding_on_top_does_not_make_another_physics():
 def test_the_screen_level_asks_two_percent_of_the_nominal_excess():
     assert screen_level(1.0e6, N) == pytest.approx(1.0e6 - SCREEN_SHARE * (1.0e6 - N))
     assert screen_level(0.9 * N, N) == pytest.approx(0.9 * N)  # no excess: nothing below the nominal is asked
+
+
+def test_a_single_effect_is_refined_only_when_its_grid_removes_a_tenth_of_the_excess():
+    # below select.MIN_GAIN = 25 % with room for what a refinement adds (+0.13 at most on the practice sets)
+    assert SINGLE_SCREEN_SHARE == pytest.approx(0.10)
+    assert screen_level(3.0 * N, N, SINGLE_SCREEN_SHARE) == pytest.approx(3.0 * N - 0.2 * N)
+
+
+class _Model:
+    size = N
+
+
+class _Ctx:
+    model = _Model()
+    sims = 0
+
+
+def _recalibrate(monkeypatch, scans: dict) -> list:
+    """Refined parameter keys of one recalibration whose scans reach ``scans`` (key -> chi-square; nothing joins)."""
+    refined = []
+    monkeypatch.setattr(recalibration, "least_squares_fit", lambda *a, **k: FitResult("base", (), [], [], 3.0 * N, {}, N))
+    monkeypatch.setattr(recalibration, "_scan", lambda ctx, trials: {fp.key: (scans.get(fp.key, 3.0 * N), fp.nominal, fp)
+                                                                    for fp, _, _ in trials})
+
+    def refine(ctx, chosen, values, fp, start):
+        refined.append(fp.key)
+        return scans.get(fp.key, 3.0 * N), start
+
+    monkeypatch.setattr(recalibration, "_refine_1d", refine)
+    recalibration.forward_select_base(_Ctx(), base_params(load_plant("plant-a")), penalty=100.0)
+    return refined
+
+
+def test_a_recalibration_refines_only_parameters_whose_scan_could_join(monkeypatch):
+    # joining needs JOIN_GAIN x the excess 2 N = 0.5 N; a scan must show a quarter of that (0.125 N) to be refined
+    refined = _recalibrate(monkeypatch, {"friction.level": 2.8 * N, "cylinder.dead_volume": 2.95 * N})
+    assert refined == ["friction.level"]
+    assert _recalibrate(monkeypatch, {"friction.level": 2.9 * N}) == []
 
 
 def test_a_parameter_set_is_replayed_once(monkeypatch):

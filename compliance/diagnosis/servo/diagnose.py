@@ -28,7 +28,7 @@ from compliance.model.parameters import apply
 from compliance.effects import EFFECTS
 from compliance.errors import InputError, SimulationError
 from compliance.diagnosis.servo.candidates import Candidate, base_params, effect_candidate, signature_order
-from compliance.diagnosis.servo.fit import FitContext, FitResult, competing, replays_bound, screen_level
+from compliance.diagnosis.servo.fit import SINGLE_SCREEN_SHARE, FitContext, FitResult, competing, replays_bound, screen_level
 from compliance.diagnosis.servo.fitted_model import fitted_plant, save_fitted
 from compliance.diagnosis.servo.effect_sets import CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_enough, contributions, full_name, prune
 from compliance.diagnosis.evidence.discriminating_test import design_test
@@ -96,7 +96,7 @@ def _fit_singles(st: Stage, names, recalibrate: bool) -> None:
     bparams = base_params(st.rc) if recalibrate and not within else ()
     if bparams:
         tasks.append(RecalibrateBase(bparams, 2.0 * math.log(n) * max(1.0, chi2 / n)))
-    screen = -math.inf if within else screen_level(chi2, n)
+    screen = -math.inf if within else screen_level(chi2, n, SINGLE_SCREEN_SHARE)
     fits = [FitEffect(effect_candidate(e), screen) for e in signature_order(names, excess)]
     fits += [FitEffect(c, -math.inf if within else None) for c in instrument_candidates(st.model.signals, st.setup.closed_loop)]
     _run(st, tasks + sorted(fits, key=lambda t: -replays_bound(t.candidate)))  # the longest fits first
