@@ -50,7 +50,7 @@ class StateFeedbackDrive(PlantKind):
 
     def linear_support(self, cfg: PlantConfig) -> str | None:
         return (f"controller.type = '{self.name}': the linear closed-loop analysis and its python-control form cover "
-                f"the PID only; a {self.title} is designed on its own linear model of the axis (docs/plant-b.md)")
+                f"the PID only; a {self.title} is designed on its own linear model of the axis")
 
     def diagnosis_support(self, cfg: PlantConfig) -> str | None:
         return (f"validate and diagnose replay a closed-loop recording with the PID loop; a {self.title} has no "

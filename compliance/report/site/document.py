@@ -112,7 +112,8 @@ def build_site_report(results: dict, document: dict | None = None) -> tuple[dict
     files += [{"what": "Requirement file", "path": f.get("path"), "digest": f.get("digest")} for f in rs.get("files") or []]
     res = (document or {}).get("results") or {}
     files.append({"what": "Results file", "path": res.get("path") or "not saved (no --json)", "digest": res.get("digest")})
-    ctx = {**_common(results), "results": results, "site": results["site"], "plant": plant, "rs": rs,
+    common = _common(results.get("versions"), results.get("created"), bool(results.get("reproducible")))
+    ctx = {**common, "results": results, "site": results["site"], "plant": plant, "rs": rs,
            "summary": results["summary"], "verdict": results["summary"]["status"], "rows": _summary(results),
            "requirements": [{"e": e, "rows": _rows(e)} for e in results["requirements"] if e["rows"]],
            "tests": tests, "diagnosis": results.get("diagnosis"), "created": fmt_date(results.get("created")),
