@@ -117,7 +117,7 @@ def document_control(result: CheckResult, document: dict | None = None) -> dict:
     for f in rs.files or (FileRecord(path=rs.path, digest=rs.digest),):
         files.append({"what": "Requirement file", "path": f.path, "digest": f.digest})
     res = document.get("results") or {}
-    files.append({"what": "Results file", "path": res.get("path") or "not saved (no --json)", "digest": res.get("digest")})
+    files.append({"what": "Results file", "path": res.get("path") or "not saved (this run wrote no results file)", "digest": res.get("digest")})
     rec = (result.validation or {}).get("recording") or {}
     if rec:
         files.append({"what": "Recording", "path": rec.get("path"), "digest": rec.get("digest")})

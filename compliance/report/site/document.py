@@ -111,7 +111,7 @@ def build_site_report(results: dict, document: dict | None = None) -> tuple[dict
     files += [{"what": "Plant configuration (prediction)", "path": plant.get("path") or plant["name"], "digest": plant.get("digest")}]
     files += [{"what": "Requirement file", "path": f.get("path"), "digest": f.get("digest")} for f in rs.get("files") or []]
     res = (document or {}).get("results") or {}
-    files.append({"what": "Results file", "path": res.get("path") or "not saved (no --json)", "digest": res.get("digest")})
+    files.append({"what": "Results file", "path": res.get("path") or "not saved (this run wrote no results file)", "digest": res.get("digest")})
     common = _common(results.get("versions"), results.get("created"), bool(results.get("reproducible")))
     ctx = {**common, "results": results, "site": results["site"], "plant": plant, "rs": rs,
            "summary": results["summary"], "verdict": results["summary"]["status"], "rows": _summary(results),
