@@ -10,6 +10,7 @@ from pathlib import Path
 from compliance.cli.common import (add_parser, add_plant_argument, plant_from_args, plant_source,
                                    quantity)
 from compliance.errors import InputError
+from compliance.files.atomic import file_bytes
 from compliance.model.force_limit import check_load_force
 from compliance.simulation.profiles import Profile, parse_sine, steps
 
@@ -250,12 +251,7 @@ def frame_bytes(df, path: str) -> bytes:
     if name.endswith(".parquet"):
         df.to_parquet(buf, index=False)
         return buf.getvalue()
-    text = df.to_csv(index=False, float_format="%.9g", lineterminator="\n").encode("utf-8")
-    if name.endswith(".gz"):
-        import gzip
-
-        return gzip.compress(text, mtime=0)
-    return text
+    return file_bytes(name, df.to_csv(index=False, float_format="%.9g", lineterminator="\n"))
 
 
 def plot_bytes(df, path: str, title: str) -> bytes:

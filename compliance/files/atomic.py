@@ -15,7 +15,7 @@ from typing import Callable
 from compliance.processes import raise_if_stopping
 from compliance.files.jsonable import json_text
 
-__all__ = ["write_atomic_with", "write_bytes_atomic", "write_json_atomic", "write_text_atomic"]
+__all__ = ["file_bytes", "write_atomic_with", "write_bytes_atomic", "write_json_atomic", "write_text_atomic"]
 
 
 def _usual_mode() -> int:
@@ -64,9 +64,23 @@ def write_bytes_atomic(path, data: bytes) -> None:
     write_atomic_with(path, _write)
 
 
+def file_bytes(path, text: str) -> bytes:
+    """``text`` as the bytes of the file ``path`` names: UTF-8, gzip-compressed when it ends in ``.gz``.
+
+    The gzip header carries no time stamp (mtime 0): the same text gives the same bytes.
+    """
+    data = text.encode("utf-8")
+    if str(path).lower().endswith(".gz"):
+        import gzip
+
+        return gzip.compress(data, mtime=0)
+    return data
+
+
 def write_text_atomic(path, text: str) -> None:
-    """Write ``text`` (UTF-8) to ``path`` atomically (temp file in the same folder + os.replace)."""
-    write_bytes_atomic(path, text.encode("utf-8"))
+    """Write ``text`` to ``path`` atomically (temp file in the same folder + os.replace): UTF-8, compressed
+    when ``path`` ends in ``.gz`` (:func:`file_bytes`)."""
+    write_bytes_atomic(path, file_bytes(path, text))
 
 
 def write_json_atomic(path, data, *, compact: bool = False) -> None:

@@ -133,15 +133,9 @@ class CheckResult(Record):
 
     def to_json(self, path) -> None:
         """Write the results JSON atomically; gzip-compressed when ``path`` ends in ``.gz``."""
-        from compliance.files.atomic import write_bytes_atomic, write_text_atomic
+        from compliance.files.atomic import write_text_atomic
 
-        if str(path).endswith(".gz"):
-            import gzip
-
-            # mtime 0: the same result gives the same bytes
-            write_bytes_atomic(path, gzip.compress(self.json_text().encode("utf-8"), mtime=0))
-        else:
-            write_text_atomic(path, self.json_text())
+        write_text_atomic(path, self.json_text())
 
     def made_reproducible(self, command_line: str | None = None) -> "CheckResult":
         """This result as ``--reproducible`` writes it: fixed ``created``, no timings, ``command_line`` replaced."""
