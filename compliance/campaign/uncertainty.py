@@ -29,7 +29,7 @@ from compliance.procedures.outcomes import traces_off
 from compliance.procedures.registry import run as run_procedure
 from compliance.requirements.verdict import Status, evaluate
 
-__all__ = ["apply_band", "can_move", "local_bands", "modelled_verdicts", "ranged_parameters", "row_band", "settle_status",
+__all__ = ["apply_band", "can_move", "commissioned_settings", "local_bands", "modelled_verdicts", "ranged_parameters", "row_band", "settle_status",
            "top_assumptions"]
 
 
@@ -94,14 +94,55 @@ def modelled_verdicts(entries) -> list[dict]:
 
 
 def _perturbed_run(ctx, item):
-    """Worker: one run with one parameter moved -> (samples by request key, error)."""
-    cfg, reqset, jobs = ctx
+    """Worker: one run with one parameter moved (and the settings commissioned for it) -> (samples by request key, error)."""
+    cfg, reqset, jobs, settings = ctx
     key, value, j = item
-    moved = cfg.replace(params={key: value}, sources={key: cfg.sources.get(key, "user")})
+    moved = cfg.replace(params={key: value, **settings.get((key, value), {})}, sources={key: cfg.sources.get(key, "user")})
     job = jobs[j]
     with traces_off():
         out = run_procedure(moved, reqset.procedures[job.procedure], reqset.operating_points[job.operating_point], job.requests)
     return out.samples, out.error
+
+
+def _commissioned_corner(ctx, item):
+    """Worker: the settings commissioning makes on the plant with one parameter at one end of its range -> {key: value}."""
+    from compliance.campaign.commissioning import commission
+    from compliance.model.commissioning import SETTINGS
+
+    cfg, reqset = ctx
+    key, value = item
+    moved = cfg.replace(params={key: value}, sources={key: cfg.sources.get(key, "user")})
+    done = commission(moved, reqset, workers=1)
+    keys = [k for n in cfg.commissioning for k in SETTINGS[n].parameters]
+    return {k: done.params[k] for k in keys if done.params[k] != moved.params[k]}
+
+
+def commissioned_settings(cfg, reqset, ranged, *, workers=None, progress=False) -> tuple[dict, dict | None]:
+    """The declared commissioning settings made again at each end of each range (``campaign.commissioning``).
+
+    Returns
+    -------
+    tuple
+        ({(key, value): {setting key: value}}, the ``commissioning`` record of the bands or None when
+        the plant file declares no commissioning settings).
+    """
+    if not cfg.commissioning:
+        return {}, None
+    from compliance.model.commissioning import SETTINGS
+
+    corners = [(k, rng[end]) for k, rng in ranged for end in ("low", "high")]
+    got, _ = map_tasks(_commissioned_corner, (cfg, reqset), corners, workers=workers, progress=progress,
+                       label="commissioning") if corners else ([], None)
+    settings = {c: (g or {}) for c, g in zip(corners, got)}
+    keys = [k for n in cfg.commissioning for k in SETTINGS[n].parameters]
+    spans = {}
+    for k in keys:
+        vals = [cfg.params[k]] + [s[k] for s in settings.values() if k in s]
+        spans[k] = [min(vals), max(vals)]
+    record = {"settings": list(cfg.commissioning), "parameters": keys, "spans": spans,
+              "failed": [{"parameter": k, "value": v} for (k, v), g in zip(corners, got) if g is None],
+              "corners": [{"parameter": k, "value": v, "settings": settings[(k, v)]} for k, v in corners]}
+    return settings, record
 
 
 def _bandable(e: dict, r: dict) -> bool:
@@ -248,11 +289,14 @@ def local_bands(cfg, reqset, jobs, entries, *, workers=None, progress=False) -> 
     ranged = ranged_parameters(cfg)
     index = {j.key: i for i, j in enumerate(jobs)}
     need = sorted({index[r["run"]] for e in entries for r in e["rows"] if _bandable(e, r) and r["run"] in index})
-    movable = {(k, j): can_move(cfg, reqset, k, jobs[j]) for k, _ in ranged for j in need}
+    settings, commissioned = commissioned_settings(cfg, reqset, ranged, workers=workers, progress=progress)
+    # a setting commissioning changed acts on every run, whatever the moved parameter itself could reach
+    recommissioned = {k for (k, _), s in settings.items() if s}
+    movable = {(k, j): k in recommissioned or can_move(cfg, reqset, k, jobs[j]) for k, _ in ranged for j in need}
     # one moved plant's runs at one operating point together: its steps share their full-command strokes (a worker memo)
     need.sort(key=lambda j: (jobs[j].operating_point, jobs[j].procedure))
     items = [(k, rng[end], j) for k, rng in ranged for end in ("low", "high") for j in need if movable[(k, j)]]
-    results, _ = map_tasks(_perturbed_run, (cfg, reqset, list(jobs)), items, workers=workers, progress=progress,
+    results, _ = map_tasks(_perturbed_run, (cfg, reqset, list(jobs), settings), items, workers=workers, progress=progress,
                            label="uncertainty") if items else ([], None)
     got = dict(zip(items, results))
     by_id = {r.id: r for r in reqset.requirements}
@@ -266,9 +310,12 @@ def local_bands(cfg, reqset, jobs, entries, *, workers=None, progress=False) -> 
             r["band"] = row_band(e["comparator"], r, low, high, swings, "local", unmeasured)
         if rows:
             settle_status(e)
-    return {"method": "local", "parameters": [{"parameter": k, **rng} for k, rng in ranged], "runs": len(items),
-            "screened": 2 * sum(1 for v in movable.values() if not v),
-            "top_assumptions": top_assumptions(entries, cfg)}
+    out = {"method": "local", "parameters": [{"parameter": k, **rng} for k, rng in ranged], "runs": len(items),
+           "screened": 2 * sum(1 for v in movable.values() if not v),
+           "top_assumptions": top_assumptions(entries, cfg)}
+    if commissioned is not None:
+        out["commissioning"] = commissioned
+    return out
 
 
 def top_assumptions(entries, cfg, n: int = 3) -> list[dict]:
