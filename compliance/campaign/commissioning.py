@@ -14,7 +14,8 @@ own tests, so what commissioning aims at is what the check judges:
   requirements are run on their full strokes, and each direction's set-point rate scaled by its measured
   time over the centre of the window the two requirements leave together (a rate-limited stroke: T ~ L /
   rate), never so far that the fastest measured straight-part speed passes ``RATE_SHARE`` of the
-  stroke-rate limit; up to ``RATE_ITERATIONS`` rounds.
+  stroke-rate limit (a direction with no stroke time is only slowed below it); up to ``RATE_ITERATIONS``
+  rounds.
 
 :func:`commission` makes the declared settings in the order of ``model.commissioning.ORDER``. The
 uncertainty bands of a commissioned design use it at each end of each declared range
@@ -199,10 +200,10 @@ def tune_limiter_rates(cfg, reqset, record: dict | None = None, *, workers=None)
         new = {}
         for key, d in zip(LIMITER_KEYS, ("opening", "closing")):
             rate = cfg.params[key]
-            if not times[d] or rate <= 0.0:
+            if rate <= 0.0:
                 continue
-            mid = 0.5 * (min(times[d]) + max(times[d]))
-            scale = mid / target
+            # a timed direction is set to the window's centre; one only the stroke-rate limit judges is slowed below it
+            scale = 0.5 * (min(times[d]) + max(times[d])) / target if times[d] else 1.0
             if v_lim and speeds[d]:
                 scale = min(scale, RATE_SHARE * v_lim / max(speeds[d]))
             if abs(scale - 1.0) > 2e-3:
