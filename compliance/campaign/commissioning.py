@@ -1,4 +1,4 @@
-"""Commissioning a design: the settings a plant file declares (``model.commissioning``), made by measurement.
+"""Commissioning a design: the settings a plant file declares (``model.assumptions``), made by measurement.
 
 Each setting is made the way a commissioning engineer makes it on site, with the requirement file's
 own tests, so what commissioning aims at is what the check judges:
@@ -17,7 +17,7 @@ own tests, so what commissioning aims at is what the check judges:
   stroke-rate limit (a direction with no stroke time is only slowed below it); up to ``RATE_ITERATIONS``
   rounds.
 
-:func:`commission` makes the declared settings in the order of ``model.commissioning.ORDER``. The
+:func:`commission` makes the declared settings in the order of ``model.assumptions.ORDER``. The
 uncertainty bands of a commissioned design use it at each end of each declared range
 (``campaign.uncertainty``); ``govcheck size`` and the remedies search use it for their design
 (``sweep.sizing.governor_design``).
@@ -28,6 +28,9 @@ from __future__ import annotations
 import dataclasses
 import math
 
+from compliance.campaign.executor import execute
+from compliance.campaign.judge import judge
+from compliance.campaign.plan import plan
 from compliance.requirements.verdict import Severity, Status
 
 __all__ = ["RATE_ITERATIONS", "RATE_SHARE", "TAU_ITERATIONS", "TAU_MARGIN", "commission", "stroke_window", "tau_range",
@@ -50,6 +53,13 @@ def _mandatory(reqset, metric: str, comparators: tuple) -> list:
             and r.limit is not None and r.comparator in comparators and r.severity == Severity.MANDATORY]
 
 
+def _judged(cfg, reqset, workers) -> list[dict]:
+    """The requirement entries of ``reqset`` run and judged on ``cfg`` (point values: no bands, no vetting)."""
+    jobs = plan(reqset)
+    outcomes, _ = execute(cfg, reqset, jobs, workers=workers, progress=False)
+    return judge(cfg, reqset, list(jobs), list(outcomes))[0]
+
+
 def tau_range(cfg, reqset, *, workers=None) -> dict | None:
     """The file's time-constant requirement run on ``cfg``: its window and the evaluated values by direction.
 
@@ -57,14 +67,11 @@ def tau_range(cfg, reqset, *, workers=None) -> dict | None:
     "rows"}``: ``up`` / ``down`` = (lowest, highest) evaluated value [s] of the steps of each direction
     (None when none was eligible), ``rows`` = (run, step, value) of every evaluated row.
     """
-    from compliance.campaign.run import run_campaign
-
     reqs = _mandatory(reqset, "time_constant", ("within",))
     if not reqs:
         return None
     sub = dataclasses.replace(reqset, requirements=tuple(reqs[:1]))
-    res = run_campaign(cfg, sub, workers=workers, progress=False)
-    e = res["requirements"][0]
+    e = _judged(cfg, sub, workers)[0]
     lo, hi = e["limit"]
     by = {"up": [], "down": []}
     rows = []
@@ -172,8 +179,6 @@ def tune_limiter_rates(cfg, reqset, record: dict | None = None, *, workers=None)
 
     ``record`` (optional) gets each round's measured times and speeds in ``record["strokes"]``.
     """
-    from compliance.campaign.run import run_campaign
-
     record = {} if record is None else record
     record.setdefault("strokes", [])
     L = cfg.params["cylinder.stroke"]
@@ -186,10 +191,10 @@ def tune_limiter_rates(cfg, reqset, record: dict | None = None, *, workers=None)
     sub = dataclasses.replace(reqset, requirements=tuple(reqs))
     target = 0.5 * (window[0] + window[1])
     for _ in range(RATE_ITERATIONS):
-        res = run_campaign(cfg, sub, workers=workers, progress=False)
+        entries = _judged(cfg, sub, workers)
         times = {"opening": [], "closing": []}
         speeds = {"opening": [], "closing": []}
-        for e in res["requirements"]:
+        for e in entries:
             for r in e["rows"]:
                 d = _direction(e["metric"], r.get("which") or "")
                 if d is None or r.get("value") is None or r["status"] not in (Status.PASS, Status.FAIL):
@@ -218,7 +223,7 @@ _TUNERS = {"loop_gain": tune_loop_gain, "limiter_rates": tune_limiter_rates}
 
 
 def commission(cfg, reqset, settings=None, *, workers=None, record: dict | None = None):
-    """``cfg`` with its declared commissioning settings made by measurement (``model.commissioning``).
+    """``cfg`` with its declared commissioning settings made by measurement (``model.assumptions``).
 
     Parameters
     ----------
@@ -226,7 +231,7 @@ def commission(cfg, reqset, settings=None, *, workers=None, record: dict | None 
     reqset : RequirementSet
         The requirement file whose tests set them.
     settings : sequence of str, optional
-        Setting names (default: ``cfg.commissioning``), made in ``model.commissioning.ORDER``.
+        Setting names (default: ``cfg.commissioning``), made in ``model.assumptions.ORDER``.
     workers : int, optional
         Pool size for the measuring campaigns (1: in this process).
     record : dict, optional
@@ -236,7 +241,7 @@ def commission(cfg, reqset, settings=None, *, workers=None, record: dict | None 
     -------
     PlantConfig
     """
-    from compliance.model.commissioning import ORDER
+    from compliance.model.assumptions import ORDER
 
     names = cfg.commissioning if settings is None else tuple(settings)
     for name in ORDER:

@@ -9,7 +9,11 @@ parameter anywhere in its range, the worst combination):
 
     low  = v0 + sum_k min(0, d_k+, d_k-)        high = v0 + sum_k max(0, d_k+, d_k-)
 
-A parameter is not re-run where it cannot act at all (:func:`can_move`: the load curve's scale off the
+When the plant file declares commissioning settings (``[commissioning]``, ``model.assumptions``: the
+loop gain, the limiter rates), the plant at each end of each range is first commissioned as on site
+(``campaign.commissioning``: each setting made again by its own measurement) and then judged: the band
+is the verdict's range over plants that differ in what the file only assumes, each commissioned, and
+the settings it took are reported. A parameter is not re-run where it cannot act at all (:func:`can_move`: the load curve's scale off the
 curve, the stroke start pressures outside the full strokes, the controller and the valve's opening
 curve below saturation in an open-loop full-command stroke): its swing there is zero by structure.
 
@@ -107,7 +111,7 @@ def _perturbed_run(ctx, item):
 def _commissioned_corner(ctx, item):
     """Worker: the settings commissioning makes on the plant with one parameter at one end of its range -> {key: value}."""
     from compliance.campaign.commissioning import commission
-    from compliance.model.commissioning import SETTINGS
+    from compliance.model.assumptions import SETTINGS
 
     cfg, reqset = ctx
     key, value = item
@@ -128,7 +132,7 @@ def commissioned_settings(cfg, reqset, ranged, *, workers=None, progress=False) 
     """
     if not cfg.commissioning:
         return {}, None
-    from compliance.model.commissioning import SETTINGS
+    from compliance.model.assumptions import SETTINGS
 
     corners = [(k, rng[end]) for k, rng in ranged for end in ("low", "high")]
     got, _ = map_tasks(_commissioned_corner, (cfg, reqset), corners, workers=workers, progress=progress,
@@ -142,7 +146,24 @@ def commissioned_settings(cfg, reqset, ranged, *, workers=None, progress=False) 
     record = {"settings": list(cfg.commissioning), "parameters": keys, "spans": spans,
               "failed": [{"parameter": k, "value": v} for (k, v), g in zip(corners, got) if g is None],
               "corners": [{"parameter": k, "value": v, "settings": settings[(k, v)]} for k, v in corners]}
+    record["text"] = _commissioning_text(record, len(corners))
     return settings, record
+
+
+def _commissioning_text(record: dict, plants: int) -> str:
+    """One sentence: which settings were made again, on how many plants, and the span of what they came to."""
+    from compliance.model.parameters import BASE_BY_KEY
+    from compliance.presentation.numbers import fmt_si
+
+    spans = [f"{k.split('.', 1)[1]} {fmt_si(lo, BASE_BY_KEY[k].unit)}–{fmt_si(hi, BASE_BY_KEY[k].unit)}"
+             for k, (lo, hi) in record["spans"].items() if hi > lo * (1 + 1e-9)]
+    text = (f"bands after commissioning: the plant file sets {', '.join(record['settings'])} on site ([commissioning]), so "
+            f"at each end of each declared range ({plants} plants) they were made again by their measurement before the "
+            "tests were judged" + (f"; they came to {', '.join(spans)}" if spans else ""))
+    if record["failed"]:
+        text += (f"; commissioning failed on {len(record['failed'])} plant(s), judged with the file's settings: "
+                 + ", ".join(f"{f['parameter']} = {f['value']:g}" for f in record["failed"]))
+    return text
 
 
 def _bandable(e: dict, r: dict) -> bool:

@@ -20,7 +20,7 @@ from compliance.errors import InputError, did_you_mean
 from compliance.files.atomic import write_text_atomic
 from compliance.files.shipped import resolve_shipped
 from compliance.model.assumptions import parse_model_evidence, read_assumptions
-from compliance.model.commissioning import commissioning_toml, parse_commissioning
+from compliance.model.assumptions import commissioning_toml, parse_commissioning
 from compliance.model.config_fields import SECTIONS, atmosphere_of, effect_values, load_curve_field, section_values
 from compliance.model.parameters import BASE_BY_KEY, BASE_PARAMS, OPTIONS, used_by_model
 from compliance.model.identity import parse_identity
@@ -70,7 +70,7 @@ class PlantConfig:
     assumptions: Mapping[str, Any] = field(default_factory=dict)  # key -> range / derived_for (model/assumptions.py)
     # optional [model_evidence]: the paper and recordings the model answers to (model/assumptions.py)
     model_evidence: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({"paper": None, "recordings": ()}))
-    # optional [commissioning]: the governor settings made on site from measurements (model/commissioning.py)
+    # optional [commissioning]: the governor settings made on site from measurements (model/assumptions.py)
     commissioning: tuple[str, ...] = ()
 
     def p(self, key: str) -> float:
@@ -111,7 +111,7 @@ class PlantConfig:
         return self.piston_area - math.pi * d * d / 4.0
 
     def with_commissioning(self, settings) -> "PlantConfig":
-        """This configuration with the ``[commissioning]`` settings ``settings`` (names of ``model.commissioning.SETTINGS``)."""
+        """This configuration with the ``[commissioning]`` settings ``settings`` (names of ``model.assumptions.SETTINGS``)."""
         return dc_replace(self, commissioning=parse_commissioning({"settings": list(settings)}, self.path or self.name))
 
     def replace(self, *, params=None, effects=None, options=None, name=None, provenance=None, sources=None):

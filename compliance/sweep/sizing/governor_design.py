@@ -28,7 +28,7 @@ windows), so what the design aims at is what the check judges:
    m = ``TAU_MARGIN``; otherwise the design says so with the arithmetic (``spread``).
 
 Steps 4 and 5 are what a commissioning engineer does on site: the designed file declares them
-(``[commissioning] settings = ["loop_gain", "limiter_rates"]``, ``model.commissioning``), so its check
+(``[commissioning] settings = ["loop_gain", "limiter_rates"]``, ``model.assumptions``), so its check
 makes them again at each end of each declared range before judging (``campaign.uncertainty``).
 
 The small-signal stability of the result is checked on the linearised loop against the report's
