@@ -202,6 +202,7 @@ def tune_limiter_rates(cfg, reqset, record: dict | None = None, *, workers=None)
                 (times if e["metric"] in _STROKE_METRICS else speeds)[d].append(r["value"])
         record["strokes"].append({"rates": {k: cfg.params[k] for k in LIMITER_KEYS},
                                   "times": {d: (min(v), max(v)) for d, v in times.items() if v}})
+        record["strokes_why"] = _spread_why(times, window)
         new = {}
         for key, d in zip(LIMITER_KEYS, ("opening", "closing")):
             rate = cfg.params[key]
@@ -217,6 +218,17 @@ def tune_limiter_rates(cfg, reqset, record: dict | None = None, *, workers=None)
             return cfg
         cfg = cfg.replace(params=new)
     return cfg
+
+
+def _spread_why(times: dict, window: tuple) -> str | None:
+    """Why no rate holds a direction's strokes in the window: its times over the file's loads span more than it."""
+    out = []
+    for d, v in times.items():
+        if v and max(v) - min(v) > window[1] - window[0]:
+            out.append(f"the {d} time ranges {min(v):.2f}-{max(v):.2f} s over the file's loads while the window the stroke-time "
+                       f"and stroke-rate limits leave is {window[0]:.2f}-{window[1]:.2f} s: one rate cannot hold both (the "
+                       "gate lags the set-point more under one load than the other; a lower load share narrows it)")
+    return "; ".join(out) or None
 
 
 _TUNERS = {"loop_gain": tune_loop_gain, "limiter_rates": tune_limiter_rates}

@@ -184,6 +184,7 @@ def design_governor(cfg, reqset, *, workers=None, tune=True) -> tuple:
 # or tracking error beyond the accuracy is narrowed by this factor on lc per round (our choice)
 LC_FACTOR = 0.6
 _POSITIONING = ("tracking_max_error", "max_positioning_error")
+_STROKE_METRICS = ("opening_time", "closing_time", "stroke_speed")
 
 
 def _mandatory_failures(results) -> list[dict]:
@@ -270,14 +271,18 @@ def design_and_check(cfg, reqset, *, workers=None, rounds: int = 3, progress=Fal
         new, why = corrections(cfg, reqset, results)
         record["rounds"].append({"failing": failing, "corrections": why})
         record["why_not"] = [w for w in why if "no rate fixes it" in w]
-        if not new or len(record["rounds"]) > rounds:
+        # a stroke time or rate off its limit: the rates are set again on the timed strokes (measured, speed-capped)
+        strokes = any(e["metric"] in _STROKE_METRICS for e in _mandatory_failures(results))
+        if not (new or strokes) or len(record["rounds"]) > rounds:
             break
-        cfg = cfg.replace(params=new)
+        cfg = cfg.replace(params=new) if new else cfg
         if "controller.compensation_width" in new:
             cfg = tune_loop_gain(cfg, reqset, record, workers=workers)
+        if strokes:
+            cfg = tune_limiter_rates(cfg, reqset, record, workers=workers)
     failing = [e for e in _mandatory_failures(results)]
     if failing:
-        parts = ([record["spread"]] if record.get("spread") else []) + list(record.get("why_not") or [])
+        parts = [record[k] for k in ("spread", "strokes_why") if record.get(k)] + list(record.get("why_not") or [])
         for e in failing:
             w = _worst(e)
             parts.append(f"{e['id']} {e['status']} ({w.get('display', {}).get('value') if isinstance(w.get('display'), dict) else w.get('value')} "
