@@ -59,6 +59,19 @@ def _derived(cfg, op, flow_control: bool, stroke_metric: str | None):
     return key, der
 
 
+# the integral action is negligible when, at an error of the requirement's limit, it moves the valve command by less
+# than this over a hold of HOLD_SPAN (our choice: 10 mV, a hundredth of a typical 1 V dead zone)
+INTEGRAL_NEGLIGIBLE = 0.01  # V
+HOLD_SPAN = 10.0  # s
+
+
+def _limit_m(cfg, req) -> float:
+    try:
+        return float(req.resolved_limit(cfg.params["cylinder.stroke"])[-1])
+    except (TypeError, ValueError, IndexError):
+        return 0.0
+
+
 def row_basis(cfg, reqset, req, row) -> tuple[Basis, str]:
     """(basis, basis_reason) of one verdict row (see the module docstring)."""
     if row.get("non_responding") and row.get("status") == Status.FAIL:
@@ -95,10 +108,13 @@ def row_basis(cfg, reqset, req, row) -> tuple[Basis, str]:
                 "its own exhaust path: nothing couples the two directions, so the cross change is zero by construction")
     if req.metric in ("drift", "limit_cycle_amplitude"):
         on = [e for e in _LEAK_EFFECTS if e in cfg.effects]
-        if not on:
+        # an integral action winds the command up while stiction holds the gate, and can move it (hunting)
+        integral = cfg.params.get("controller.ki", 0.0) * HOLD_SPAN * _limit_m(cfg, req) >= INTEGRAL_NEGLIGIBLE
+        if not on and not integral:
             return Basis.BY_CONSTRUCTION, (
-                "no leakage or valve offset is modelled (internal_leakage, external_leakage, valve_offset off): nothing "
-                "moves a held position once stiction holds it, so drift and hunting are zero by construction")
+                "no leakage or valve offset is modelled (internal_leakage, external_leakage, valve_offset off) and the "
+                "integral action is negligible (K_I x 10 s x the limit < 10 mV of command): nothing moves a held position "
+                "once stiction holds it, so drift and hunting are zero by construction")
     if limit_assumed(req):
         return "assumed", (f"the limit is an assumed design target ({req.clause}), not a figure of a standard or of the "
                            "plant owner: the verdict holds against that target only")

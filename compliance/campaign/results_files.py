@@ -115,6 +115,8 @@ def summary_lines(result: CheckResult) -> list[str]:
     if others:
         out.append(f"  requirement set: {others} more finding(s) involving advisory requirements (results JSON, 'findings')")
     out += evidence_lines(result)
+    if s.commissioned:
+        out.append("  " + s.commissioned)
     if s.top_assumptions:
         out.append("  assumptions that matter most: " + "; ".join(f"{a.parameter} ({a.why})" for a in s.top_assumptions))
     out += [f"  {n}" for n in s.notes]

@@ -96,6 +96,7 @@ def summary_section(entries: list[dict], notes: list[str], uncertainty: dict | N
         "coverage": case_coverage(entries),
         "top_assumptions": (uncertainty or {}).get("top_assumptions") or [],
         "notes": notes,
+        **({"commissioned": uncertainty["commissioning"]["text"]} if (uncertainty or {}).get("commissioning") else {}),
     }
 
 

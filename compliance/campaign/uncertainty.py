@@ -9,7 +9,11 @@ parameter anywhere in its range, the worst combination):
 
     low  = v0 + sum_k min(0, d_k+, d_k-)        high = v0 + sum_k max(0, d_k+, d_k-)
 
-A parameter is not re-run where it cannot act at all (:func:`can_move`: the load curve's scale off the
+When the plant file declares commissioning settings (``[commissioning]``, ``model.assumptions``: the
+loop gain, the limiter rates), the plant at each end of each range is first commissioned as on site
+(``campaign.commissioning``: each setting made again by its own measurement) and then judged: the band
+is the verdict's range over plants that differ in what the file only assumes, each commissioned, and
+the settings it took are reported. A parameter is not re-run where it cannot act at all (:func:`can_move`: the load curve's scale off the
 curve, the stroke start pressures outside the full strokes, the controller and the valve's opening
 curve below saturation in an open-loop full-command stroke): its swing there is zero by structure.
 
@@ -29,7 +33,7 @@ from compliance.procedures.outcomes import traces_off
 from compliance.procedures.registry import run as run_procedure
 from compliance.requirements.verdict import Status, evaluate
 
-__all__ = ["apply_band", "can_move", "local_bands", "modelled_verdicts", "ranged_parameters", "row_band", "settle_status",
+__all__ = ["apply_band", "can_move", "commissioned_settings", "local_bands", "modelled_verdicts", "ranged_parameters", "row_band", "settle_status",
            "top_assumptions"]
 
 
@@ -94,14 +98,72 @@ def modelled_verdicts(entries) -> list[dict]:
 
 
 def _perturbed_run(ctx, item):
-    """Worker: one run with one parameter moved -> (samples by request key, error)."""
-    cfg, reqset, jobs = ctx
+    """Worker: one run with one parameter moved (and the settings commissioned for it) -> (samples by request key, error)."""
+    cfg, reqset, jobs, settings = ctx
     key, value, j = item
-    moved = cfg.replace(params={key: value}, sources={key: cfg.sources.get(key, "user")})
+    moved = cfg.replace(params={key: value, **settings.get((key, value), {})}, sources={key: cfg.sources.get(key, "user")})
     job = jobs[j]
     with traces_off():
         out = run_procedure(moved, reqset.procedures[job.procedure], reqset.operating_points[job.operating_point], job.requests)
     return out.samples, out.error
+
+
+def _commissioned_corner(ctx, item):
+    """Worker: the settings commissioning makes on the plant with one parameter at one end of its range -> {key: value}."""
+    from compliance.campaign.commissioning import commission
+    from compliance.model.assumptions import SETTINGS
+
+    cfg, reqset = ctx
+    key, value = item
+    moved = cfg.replace(params={key: value}, sources={key: cfg.sources.get(key, "user")})
+    done = commission(moved, reqset, workers=1)
+    keys = [k for n in cfg.commissioning for k in SETTINGS[n].parameters]
+    return {k: done.params[k] for k in keys if done.params[k] != moved.params[k]}
+
+
+def commissioned_settings(cfg, reqset, ranged, *, workers=None, progress=False) -> tuple[dict, dict | None]:
+    """The declared commissioning settings made again at each end of each range (``campaign.commissioning``).
+
+    Returns
+    -------
+    tuple
+        ({(key, value): {setting key: value}}, the ``commissioning`` record of the bands or None when
+        the plant file declares no commissioning settings).
+    """
+    if not cfg.commissioning:
+        return {}, None
+    from compliance.model.assumptions import SETTINGS
+
+    corners = [(k, rng[end]) for k, rng in ranged for end in ("low", "high")]
+    got, _ = map_tasks(_commissioned_corner, (cfg, reqset), corners, workers=workers, progress=progress,
+                       label="commissioning") if corners else ([], None)
+    settings = {c: (g or {}) for c, g in zip(corners, got)}
+    keys = [k for n in cfg.commissioning for k in SETTINGS[n].parameters]
+    spans = {}
+    for k in keys:
+        vals = [cfg.params[k]] + [s[k] for s in settings.values() if k in s]
+        spans[k] = [min(vals), max(vals)]
+    record = {"settings": list(cfg.commissioning), "parameters": keys, "spans": spans,
+              "failed": [{"parameter": k, "value": v} for (k, v), g in zip(corners, got) if g is None],
+              "corners": [{"parameter": k, "value": v, "settings": settings[(k, v)]} for k, v in corners]}
+    record["text"] = _commissioning_text(record, len(corners))
+    return settings, record
+
+
+def _commissioning_text(record: dict, plants: int) -> str:
+    """One sentence: which settings were made again, on how many plants, and the span of what they came to."""
+    from compliance.model.parameters import BASE_BY_KEY
+    from compliance.presentation.numbers import fmt_si
+
+    spans = [f"{k.split('.', 1)[1]} {fmt_si(lo, BASE_BY_KEY[k].unit)}–{fmt_si(hi, BASE_BY_KEY[k].unit)}"
+             for k, (lo, hi) in record["spans"].items() if hi > lo * (1 + 1e-9)]
+    text = (f"bands after commissioning: the plant file sets {', '.join(record['settings'])} on site ([commissioning]), so "
+            f"at each end of each declared range ({plants} plants) they were made again by their measurement before the "
+            "tests were judged" + (f"; they came to {', '.join(spans)}" if spans else ""))
+    if record["failed"]:
+        text += (f"; commissioning failed on {len(record['failed'])} plant(s), judged with the file's settings: "
+                 + ", ".join(f"{f['parameter']} = {f['value']:g}" for f in record["failed"]))
+    return text
 
 
 def _bandable(e: dict, r: dict) -> bool:
@@ -248,11 +310,14 @@ def local_bands(cfg, reqset, jobs, entries, *, workers=None, progress=False) -> 
     ranged = ranged_parameters(cfg)
     index = {j.key: i for i, j in enumerate(jobs)}
     need = sorted({index[r["run"]] for e in entries for r in e["rows"] if _bandable(e, r) and r["run"] in index})
-    movable = {(k, j): can_move(cfg, reqset, k, jobs[j]) for k, _ in ranged for j in need}
+    settings, commissioned = commissioned_settings(cfg, reqset, ranged, workers=workers, progress=progress)
+    # a setting commissioning changed acts on every run, whatever the moved parameter itself could reach
+    recommissioned = {k for (k, _), s in settings.items() if s}
+    movable = {(k, j): k in recommissioned or can_move(cfg, reqset, k, jobs[j]) for k, _ in ranged for j in need}
     # one moved plant's runs at one operating point together: its steps share their full-command strokes (a worker memo)
     need.sort(key=lambda j: (jobs[j].operating_point, jobs[j].procedure))
     items = [(k, rng[end], j) for k, rng in ranged for end in ("low", "high") for j in need if movable[(k, j)]]
-    results, _ = map_tasks(_perturbed_run, (cfg, reqset, list(jobs)), items, workers=workers, progress=progress,
+    results, _ = map_tasks(_perturbed_run, (cfg, reqset, list(jobs), settings), items, workers=workers, progress=progress,
                            label="uncertainty") if items else ([], None)
     got = dict(zip(items, results))
     by_id = {r.id: r for r in reqset.requirements}
@@ -266,9 +331,12 @@ def local_bands(cfg, reqset, jobs, entries, *, workers=None, progress=False) -> 
             r["band"] = row_band(e["comparator"], r, low, high, swings, "local", unmeasured)
         if rows:
             settle_status(e)
-    return {"method": "local", "parameters": [{"parameter": k, **rng} for k, rng in ranged], "runs": len(items),
-            "screened": 2 * sum(1 for v in movable.values() if not v),
-            "top_assumptions": top_assumptions(entries, cfg)}
+    out = {"method": "local", "parameters": [{"parameter": k, **rng} for k, rng in ranged], "runs": len(items),
+           "screened": 2 * sum(1 for v in movable.values() if not v),
+           "top_assumptions": top_assumptions(entries, cfg)}
+    if commissioned is not None:
+        out["commissioning"] = commissioned
+    return out
 
 
 def top_assumptions(entries, cfg, n: int = 3) -> list[dict]:

@@ -238,23 +238,26 @@ def margins(loop, floor_hz: float = 0.0, n: int = 600) -> dict:
     The loop is evaluated from its state space on ``n`` log-spaced frequencies (from
     ``floor_hz`` to the Nyquist frequency, or 100x the fastest pole) and the margins are taken from
     that frequency-response data: python-control's 'poly' method goes through polynomial
-    coefficients, which lose all accuracy for a sampled loop with several poles near z = 1.
-    Phase crossovers below ``floor_hz`` are ignored: with integral action on an integrating
+    coefficients, which lose all accuracy for a sampled loop with several poles near z = 1. A gain
+    crossover below ``floor_hz`` (an integral action strong enough to reach it) is looked for from
+    1e-3 rad/s. Phase crossovers below ``floor_hz`` are ignored: with integral action on an integrating
     plant the loop phase tends to -180 deg as w -> 0 (type-2 loop) without crossing it. The least
     margin of the remaining crossings is returned; a margin that does not exist is None.
     """
     dt = loop.dt if loop.dt not in (None, 0, True) else None
-    lo = max(2 * math.pi * floor_hz, 1e-3)
     if dt:
         hi = math.pi / dt * (1 - 1e-9)
     else:
         hi = 100.0 * max([1.0] + [abs(p) for p in np.atleast_1d(loop.poles())] + [abs(z) for z in np.atleast_1d(loop.zeros())])
-    w = np.logspace(math.log10(lo), math.log10(hi), n)
-    fr = control.frequency_response(loop, w)
-    data = control.frd(fr.complex.reshape(-1), w, dt=dt if dt else 0)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", UserWarning)
-        gm, pm, _, wpc, wgc, _ = control.stability_margins(data, returnall=True)
+    for lo in (max(2 * math.pi * floor_hz, 1e-3), 1e-3):
+        w = np.logspace(math.log10(lo), math.log10(hi), n)
+        fr = control.frequency_response(loop, w)
+        data = control.frd(fr.complex.reshape(-1), w, dt=dt if dt else 0)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)
+            gm, pm, _, wpc, wgc, _ = control.stability_margins(data, returnall=True)
+        if np.any(np.isfinite(np.atleast_1d(pm))):
+            break  # else a strong integral action put the gain crossover below the floor: look from 1e-3 rad/s
     gm, wpc = np.atleast_1d(gm), np.atleast_1d(wpc)
     keep = (wpc >= 2 * math.pi * floor_hz) & np.isfinite(gm) & (gm > 0)
     out = {"gain_margin_db": None, "phase_crossover_hz": None, "phase_margin_deg": None, "gain_crossover_hz": None}
@@ -293,7 +296,9 @@ def _figures(cfg, op, plant, gmin, Lc, Ld, T, Td, n_freq, detail):
     # closed loop
     pcl = T.poles()
     lam, r = _modes(T)
-    amp = np.abs(r / lam)  # size of each mode in the step response
+    # size of each mode in the step response; a pole at the origin (an integrator state K_I = 0 leaves unused) has none
+    with np.errstate(divide="ignore", invalid="ignore"):
+        amp = np.where(np.abs(lam) > 1e-12, np.abs(r / np.where(lam == 0, 1.0, lam)), 0.0)
     sig = amp >= 0.05 * max(np.max(amp), 1e-300)
     dom = lam[sig][np.argmin(np.abs(lam[sig].real))]
     f["dominant_time_constant"] = -1.0 / dom.real if dom.real < 0 else None

@@ -20,12 +20,13 @@ from compliance.errors import InputError, did_you_mean
 from compliance.files.atomic import write_text_atomic
 from compliance.files.shipped import resolve_shipped
 from compliance.model.assumptions import parse_model_evidence, read_assumptions
+from compliance.model.assumptions import commissioning_toml, parse_commissioning
 from compliance.model.config_fields import SECTIONS, atmosphere_of, effect_values, load_curve_field, section_values
 from compliance.model.parameters import BASE_BY_KEY, BASE_PARAMS, OPTIONS, used_by_model
 from compliance.model.identity import parse_identity
 from compliance.model.toml_file import read_toml
 
-_TOP_KEYS = {"name", "description", "provenance", "effects", "identity", "model_evidence"}
+_TOP_KEYS = {"name", "description", "provenance", "effects", "identity", "model_evidence", "commissioning"}
 
 
 
@@ -69,6 +70,8 @@ class PlantConfig:
     assumptions: Mapping[str, Any] = field(default_factory=dict)  # key -> range / derived_for (model/assumptions.py)
     # optional [model_evidence]: the paper and recordings the model answers to (model/assumptions.py)
     model_evidence: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({"paper": None, "recordings": ()}))
+    # optional [commissioning]: the governor settings made on site from measurements (model/assumptions.py)
+    commissioning: tuple[str, ...] = ()
 
     def p(self, key: str) -> float:
         """SI value of a base parameter."""
@@ -106,6 +109,10 @@ class PlantConfig:
         """Rod-side annulus area A_rod [m^2]."""
         d = self.params["cylinder.rod_diameter"]
         return self.piston_area - math.pi * d * d / 4.0
+
+    def with_commissioning(self, settings) -> "PlantConfig":
+        """This configuration with the ``[commissioning]`` settings ``settings`` (names of ``model.assumptions.SETTINGS``)."""
+        return dc_replace(self, commissioning=parse_commissioning({"settings": list(settings)}, self.path or self.name))
 
     def replace(self, *, params=None, effects=None, options=None, name=None, provenance=None, sources=None):
         """Return a new configuration with some values changed (validated the same way).
@@ -210,6 +217,7 @@ def plant_from_dict(data: dict[str, Any], where: str = "<configuration>", digest
         identity=parse_identity(data.get("identity"), where),
         assumptions=MappingProxyType(read_assumptions(data, where, params, atmosphere_of(data, where))),
         model_evidence=parse_model_evidence(data.get("model_evidence"), where, None if where.startswith("<") else where),
+        commissioning=parse_commissioning(data.get("commissioning"), where),
     )
     _check_physical(cfg, where)
     return cfg
@@ -289,6 +297,7 @@ def plant_to_toml(cfg: PlantConfig) -> str:
         lines.append("force = { values = [" + ", ".join(_fmt(f) for f in fs) + '], unit = "N" }')
         lines.append("")
     lines += _model_evidence_toml(cfg)
+    lines += commissioning_toml(cfg.commissioning)
     for ename, vals in cfg.effects.items():
         eff = EFFECTS[ename]
         lines.append(f"[effects.{ename}]")

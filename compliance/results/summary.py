@@ -85,5 +85,7 @@ class Summary(Record):
     coverage: CaseCoverage | None = key(default=None, read=CaseCoverage.from_dict)
     top_assumptions: tuple[TopAssumption, ...] = key(default=(), read=records(TopAssumption))
     notes: tuple[str, ...] = key(default=(), read=tuple_of(str))
+    # the bands were judged on plants commissioned as on site (campaign.uncertainty, [commissioning]): what that means
+    commissioned: str | None = key(omit_none=True, default=None)
     qualifiers: tuple[Qualifier, ...] = key("qualifier", default=(), read=_qualifiers, write=_qualifier_text)
     extra: FrozenDict = key(factory=FrozenDict)  # a site's partial requirements and agreement with the model

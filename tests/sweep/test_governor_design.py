@@ -30,7 +30,7 @@ def test_limiter_rates_and_backstop(shpp):
     rate = RATE_SHARE * min(0.160 / 4.75, 0.032)
     assert values["controller.setpoint_opening_rate"] == pytest.approx(rate) == pytest.approx(0.03168)
     assert values["controller.setpoint_closing_rate"] == pytest.approx(rate)
-    assert values["controller.setpoint_lead_limit"] == pytest.approx(0.08 * 0.160)
+    assert values["controller.setpoint_lead_limit"] == pytest.approx(0.04 * 0.160)  # 6.4 mm ramp hold
     c = cfg.params["valve.sonic_conductance"]
     assert values["flow_control.opening_conductance"] == pytest.approx(2 * c)
     # the series exhaust path keeps 1 / sqrt(1 + 1/4) of the valve's conductance (ISO 6358 series rule)

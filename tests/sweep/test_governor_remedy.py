@@ -1,11 +1,10 @@
 """The remedies' governor design on a small file: plant A's throttles cannot hold its stroke times under the
 load curve, the set-point rate limiter can, and the remedy found is the one ``check`` then passes.
 
-Plant A opens in 9.9 s (full rate) under its load curve through the throttles set for 5 s at 5.7 kN; with
-the limiter at 0.99 x 32 mm/s = 31.68 mm/s the gate follows the ramp: 160 mm / 31.68 mm/s = 5.05 s, and a
-few per cent more as it lags the ramp while the load curve rises from 4 to 12 kN (plant A's 125 mm pair:
-about 4 %, which the 5 s +/-5 % window of shpp-400kw cannot absorb; this file allows 5.5 s), under the
-32 mm/s stroke-rate limit.
+Plant A opens in 9.9 s (full rate) under its load curve through the throttles set for 5 s at 5.7 kN; the
+governor design's set-point rate limiter, its rate set on the timed stroke (``campaign.commissioning``),
+holds the opening time at the centre of what this file's 4.75-5.5 s window and its 32 mm/s stroke-rate
+limit admit together (5.0-5.5 s).
 """
 
 import pytest
@@ -78,12 +77,14 @@ def test_governor_design_is_the_remedy_and_check_passes_it(tmp_path):
     assert rem["status"] == "found" and rem["remedy"]["verified"]["status"] == "pass"
     assert rem["stages"][0]["stage"] == "governor design" and not rem["remedy"]["hardware"]
     values = remedy_values(rem)
-    assert values["controller.setpoint_opening_rate"] == pytest.approx(0.99 * 0.032)
+    assert values["controller.setpoint_opening_rate"] < 0.032  # set on the timed stroke, under the stroke-rate limit
     assert values["flow_control.opening_conductance"] == pytest.approx(2 * cfg.params["valve.sonic_conductance"])
     fixed = remedy_configuration(cfg, rem, {k: param_handle(k, "test") for k in values})
     res = run_campaign(fixed, reqset, workers=2, progress=False)
     ent = {e["id"]: e for e in res["requirements"]}
     assert res["summary"]["status"] == "pass"
-    # the gate follows the limited set-point: 160 mm / 31.68 mm/s = 5.05 s, lagging it 2-6 % under the load curve
-    assert 5.05 * 1.02 <= ent["TOPEN"]["worst"]["value"] <= 5.05 * 1.06
+    # commissioning sets the opening rate so the timed stroke sits at the centre of what TOPEN and RATE admit
+    # together: 160 mm / 32 mm/s = 5.0 s .. 5.5 s -> 5.25 s (within the 0.2 % rate step it stops at, plus a round)
+    assert ent["TOPEN"]["worst"]["value"] == pytest.approx(5.25, rel=0.01)
+    assert fixed.commissioning == ("loop_gain", "limiter_rates")
     assert ent["RATE"]["worst"]["value"] <= 0.032

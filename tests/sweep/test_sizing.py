@@ -62,7 +62,10 @@ def test_size_check_remedies_end_to_end(tmp_path):
     code = main(["size", str(SMALL_TC), "--duty", str(DUTY), "--out", str(sized), "--remedies", "--catalogue", "none",
                  "--yield-units", "0", "--json", str(out), "-j", "2", "-q"])
     res = json.loads(out.read_text())
-    assert res["sizing"]["record"]["cylinders"]["bore"] == 0.125 and "remedies" in res
+    rounds = res["sizing"]["rounds"]
+    assert rounds[0]["bore"] == 0.125 and "remedies" in res  # the smallest pair that carries the duty is tried first
+    assert res["sizing"]["record"]["cylinders"]["bore"] == rounds[-1]["bore"]  # the proposal is the last pair tried
+    assert all(a["bore"] < b["bore"] for a, b in zip(rounds, rounds[1:]))  # each further pair is larger
     assert code == (0 if res["summary"]["status"] == "pass" else 1)
     assert main(["check", str(sized), "-r", str(SMALL_TC), "-q"]) == code  # the written proposal checks the same
 

@@ -128,4 +128,6 @@ def remedy_configuration(cfg, rem, paths):
         prov["remedy_yield"] = (f"tolerance yield {y['pass']} of {y['valid']} delivered units pass every mandatory requirement "
                                 f"(one-sided {100 * y['confidence']:.0f} % lower bound {100 * y['lower_bound']:.1f} %: "
                                 f"{'meets' if y['meets'] else 'does not show'} >= {100 * y['target']:.0f} %)")
-    return changed.replace(name=f"{cfg.name}-remedy", provenance=prov)
+    changed = changed.replace(name=f"{cfg.name}-remedy", provenance=prov)
+    # the governor design's settings are made on site by measurement: the saved file says so ([commissioning])
+    return changed.with_commissioning(rem["remedy"]["commissioning"]) if rem["remedy"].get("commissioning") else changed

@@ -57,13 +57,39 @@ def _yield_text(stage) -> str:
     return str(stage["status"])
 
 
-def _attempt(cfg, reqset, option, workers):
+def _attempt(cfg, reqset, options, workers):
     from compliance.sweep.sizing.governor_design import design_and_check
 
-    hw = option.values(cfg) if option else {}
+    hw = {k: v for o in options for k, v in o.values(cfg).items()}
     base = cfg.replace(params=hw) if hw else cfg
     designed, record, results = design_and_check(base, reqset, workers=workers)
     return hw, designed, record, results
+
+
+def _valve_for(cfg, option, catalogue, reqset):
+    """The cheapest catalogue valve that fills ``option``'s larger cylinders at the stroke rate, or None.
+
+    A larger bore needs proportionally more flow for the same stroke speed (``sizing.size_servo.size_valve``:
+    the filling flow at supply density times the valve authority), so a cylinder option is tried with the
+    first valve that supplies it when the configuration's own valve does not.
+    """
+    from compliance.campaign.commissioning import stroke_window
+    from compliance.physics.valve_rating import rating_of_conductance
+    from compliance.sweep.sizing.size_servo import size_valve
+
+    moved = cfg.replace(params=option.values(cfg))
+    p = moved.params
+    window = stroke_window(reqset, p["cylinder.stroke"])
+    speed = p["cylinder.stroke"] / (window[0] if window else 5.0)
+    area = moved.piston_area + moved.rod_side_area if moved.options.get("cylinder.arrangement") == "tandem" else \
+        min(moved.piston_area, moved.rod_side_area)
+    atm, b = p["air.atmospheric_pressure"], p["valve.critical_pressure_ratio"]
+    need = size_valve(area, speed, p["air.supply_pressure"], p["air.supply_temperature"], atm, b)["rating_needed"]
+    if rating_of_conductance(p["valve.sonic_conductance"], atm, b) >= need:
+        return None
+    valves = sorted((o for o in catalogue.options if o.valve_rating is not None and o.valve_rating >= need
+                     and o.applies_to(cfg) is None), key=lambda o: o.cost)
+    return valves[0] if valves else None
 
 
 def _binding(results) -> tuple:
@@ -84,25 +110,29 @@ def governor_stage(ctx, cfg, reqset, catalogue, *, workers=None, uncertain=(), r
     from compliance.sweep.remedies.finish import tolerance_yield
     from compliance.sweep.sizing.governor_design import LIMITER_KEYS, THROTTLE_KEYS
 
-    keys = list(LIMITER_KEYS) + list(THROTTLE_KEYS) + ["controller.kp", "controller.kd", "controller.compensation_width",
+    keys = list(LIMITER_KEYS) + list(THROTTLE_KEYS) + ["controller.kp", "controller.ki", "controller.kd",
+                                                       "controller.compensation_width",
                                                        "controller.compensation_slope_negative"]
     share0 = load_share(cfg, reqset)
-    tries = [(None, "as given")]
+    tries = [((), "as given")]
     skipped = []
     for o in sorted((o for o in (catalogue.options if catalogue else ()) if o.applies_to(cfg) is None), key=lambda o: o.cost):
         s = load_share(cfg.replace(params=o.values(cfg)), reqset)
         if s < share0 - 1e-9:
-            tries.append((o, f"{o.title}: the load's share of the force {share0:.2f} -> {s:.2f}"))
+            valve = _valve_for(cfg, o, catalogue, reqset) if o.group == "cylinder_bore" else None
+            tries.append(((o, valve) if valve else (o,), f"{o.title}: the load's share of the force {share0:.2f} -> {s:.2f}"
+                          + (f", with the {valve.title} its filling flow needs" if valve else "")))
         else:
             skipped.append({"option": o.name, "title": o.title,
                             "reason": f"does not lower the load's share of the cylinders' force ({share0:.2f} -> {s:.2f})"})
     stages, closest, best = [], None, None
-    for option, why in tries:
-        hw, designed, record, results = _attempt(cfg, reqset, option, workers)
+    for options, why in tries:
+        hw, designed, record, results = _attempt(cfg, reqset, options, workers)
         bind, bind_margin = _binding(results)
         failing = results["summary"]["failed_mandatory"] + results["summary"].get("uncertain", [])
         status = results["summary"]["status"]
-        stage = {"stage": "governor design" + (f" with {option.name}" if option else ""), "why": why,
+        named = " + ".join(o.name for o in options)
+        stage = {"stage": "governor design" + (f" with {named}" if options else ""), "why": why,
                  "status": status, "failed_mandatory": failing, "design": {k: v for k, v in record.items() if k != "tau"},
                  "tau_iterations": record.get("tau", [])}
         stages.append(stage)
@@ -115,10 +145,11 @@ def governor_stage(ctx, cfg, reqset, catalogue, *, workers=None, uncertain=(), r
             "binding": failing[0] if failing else bind,
             "binding_margin_pct": None if failing else bind_margin,
             "failed_mandatory": failing,
-            "hardware": [{"option": option.name, "group": option.group, "title": option.title, "cost": option.cost}] if option else [],
+            "hardware": [{"option": o.name, "group": o.group, "title": o.title, "cost": o.cost} for o in options],
             "hardware_values": hw,
-            "cost": option.cost if option else 0.0,
+            "cost": sum(o.cost for o in options),
             "design": record,
+            "commissioning": list(designed.commissioning),
         }
         for p in list(pick["values"]) + list(hw):
             ctx.paths.setdefault(p, param_handle(p, "remedy"))
@@ -131,7 +162,8 @@ def governor_stage(ctx, cfg, reqset, catalogue, *, workers=None, uncertain=(), r
             before = "".join(f" {s['stage']}: {s['design'].get('cannot') or _yield_text(s)}." for s in stages[:-1])
             found["note"] = ("the governor design (set-point rate limiter, flow-control valves wide open, time constant "
                              f"tuned on the file's own test) passes a full campaign ({len(results['runs'])} runs) "
-                             + (f"with {option.title} ({why})." if option else "with the hardware as given.") + before)
+                             + (f"with {' + '.join(o.title for o in options)} ({why})." if options else
+                                "with the hardware as given.") + before)
             if y is None or y["meets"]:
                 return found
             best = found if best is None or y["lower_bound"] > best["tolerance_yield"]["lower_bound"] else best
