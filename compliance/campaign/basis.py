@@ -16,6 +16,7 @@ A mandatory requirement whose passing rows are all by construction does not coun
 from __future__ import annotations
 
 from compliance.model.parameters import used_by_model
+from compliance.model.assumptions import SETTINGS
 from compliance.requirements.verdict import Basis, Overall, Severity, Status
 from compliance.results.summary import Qualifier
 
@@ -120,6 +121,11 @@ def row_basis(cfg, reqset, req, row) -> tuple[Basis, str]:
                            "plant owner: the verdict holds against that target only")
     if op.load == "curve" and cfg.sources.get("load.curve") == "assumed":
         return Basis.ASSUMED, "the load at this point comes from the plant's assumed load curve (load.curve, source assumed)"
+    tuned = [n for n in getattr(cfg, "commissioning", ()) if req.metric in SETTINGS[n].metrics]
+    if tuned:
+        return Basis.MODELLED, (
+            f"simulated with the plant model; the plant file sets {', '.join(tuned)} on site by this test ([commissioning]), "
+            "so the verdict says the adjustment reaches the limit, at the file's values and at each end of each range")
     return Basis.MODELLED, "simulated with the plant model at this operating point"
 
 

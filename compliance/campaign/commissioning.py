@@ -202,7 +202,7 @@ def tune_limiter_rates(cfg, reqset, record: dict | None = None, *, workers=None)
                 (times if e["metric"] in _STROKE_METRICS else speeds)[d].append(r["value"])
         record["strokes"].append({"rates": {k: cfg.params[k] for k in LIMITER_KEYS},
                                   "times": {d: (min(v), max(v)) for d, v in times.items() if v}})
-        record["strokes_why"] = _spread_why(times, window)
+        record["strokes_why"] = _spread_why(times, speeds, window, v_lim)
         new = {}
         for key, d in zip(LIMITER_KEYS, ("opening", "closing")):
             rate = cfg.params[key]
@@ -220,14 +220,21 @@ def tune_limiter_rates(cfg, reqset, record: dict | None = None, *, workers=None)
     return cfg
 
 
-def _spread_why(times: dict, window: tuple) -> str | None:
-    """Why no rate holds a direction's strokes in the window: its times over the file's loads span more than it."""
+def _spread_why(times: dict, speeds: dict, window: tuple, v_lim: float | None) -> str | None:
+    """Why no rate holds a direction's strokes in the window: its times over the file's loads span more than it,
+    or the stroke-rate limit holds the rate back while the stroke under another load is still too slow."""
     out = []
     for d, v in times.items():
-        if v and max(v) - min(v) > window[1] - window[0]:
+        if not v:
+            continue
+        if max(v) - min(v) > window[1] - window[0]:
             out.append(f"the {d} time ranges {min(v):.2f}-{max(v):.2f} s over the file's loads while the window the stroke-time "
                        f"and stroke-rate limits leave is {window[0]:.2f}-{window[1]:.2f} s: one rate cannot hold both (the "
                        "gate lags the set-point more under one load than the other; a lower load share narrows it)")
+        elif max(v) > window[1] and v_lim and speeds.get(d) and max(speeds[d]) >= RATE_SHARE * v_lim * (1 - 2e-3):
+            out.append(f"the {d} stroke reaches {max(speeds[d]) * 1e3:.1f} mm/s under one of the file's loads (the stroke-rate "
+                       f"limit {v_lim * 1e3:.1f} mm/s holds the rate there) and takes {max(v):.2f} s under another, beyond "
+                       f"{window[1]:.2f} s: one rate cannot hold both (a lower load share narrows the difference)")
     return "; ".join(out) or None
 
 

@@ -244,17 +244,19 @@ class Setting:
     meaning: str
     parameters: tuple[str, ...]
     measured_by: str
+    metrics: tuple[str, ...]  # the metrics whose tests set it (their verdicts say the adjustment reaches the limit)
 
 
 SETTINGS = {s.name: s for s in (
     Setting("limiter_rates", "the set-point rate limiter's opening and closing rates, one per direction",
             ("controller.setpoint_opening_rate", "controller.setpoint_closing_rate"),
-            "the requirement file's opening and closing times and stroke rate, timed on its full strokes"),
+            "the requirement file's opening and closing times and stroke rate, timed on its full strokes",
+            ("opening_time", "closing_time", "stroke_speed")),
     Setting("loop_gain", "the position loop's gain K_P (K_I, K_D and the dead-zone inverse's width in proportion) "
             "and the closing side's slope",
             ("controller.kp", "controller.ki", "controller.kd", "controller.compensation_width",
              "controller.compensation_slope_negative"),
-            "the requirement file's time-constant steps, with the limiting devices not acting"),
+            "the requirement file's time-constant steps, with the limiting devices not acting", ("time_constant",)),
 )}
 # the order commissioning makes them in: the gain first, since the stroke's lag behind the limiter depends on it
 ORDER = ("loop_gain", "limiter_rates")

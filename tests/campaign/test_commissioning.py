@@ -99,6 +99,10 @@ def test_bands_are_those_of_the_commissioned_machine(case):
     assert 0.10 < b_comm["low"] and b_comm["high"] < 0.25
     assert "bands after commissioning" in comm["summary"]["commissioned"]
     assert "commissioned" not in raw["summary"]
+    # a verdict on the test that sets the gain says what it shows: the adjustment reaches the window
+    judged = [r for r in comm["requirements"][0]["rows"] if r.get("basis") == "modelled"]
+    assert judged and all("sets loop_gain on site by this test" in r["basis_reason"] for r in judged)
+    assert all("on site" not in (r.get("basis_reason") or "") for r in raw["requirements"][0]["rows"])
 
 
 def test_commissioning_table_is_data(tmp_path):

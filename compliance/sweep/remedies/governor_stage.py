@@ -108,7 +108,7 @@ def governor_stage(ctx, cfg, reqset, catalogue, *, workers=None, uncertain=(), r
     its yield) only when no later one does better.
     """
     from compliance.sweep.remedies.finish import tolerance_yield
-    from compliance.sweep.sizing.governor_design import LIMITER_KEYS, THROTTLE_KEYS
+    from compliance.sweep.sizing.governor_design import LIMITER_KEYS, THROTTLE_KEYS, mandatory_uncertain
 
     keys = list(LIMITER_KEYS) + list(THROTTLE_KEYS) + ["controller.kp", "controller.ki", "controller.kd",
                                                        "controller.compensation_width",
@@ -129,7 +129,7 @@ def governor_stage(ctx, cfg, reqset, catalogue, *, workers=None, uncertain=(), r
     for options, why in tries:
         hw, designed, record, results = _attempt(cfg, reqset, options, workers)
         bind, bind_margin = _binding(results)
-        failing = results["summary"]["failed_mandatory"] + results["summary"].get("uncertain", [])
+        failing = results["summary"]["failed_mandatory"] + mandatory_uncertain(results)
         status = results["summary"]["status"]
         named = " + ".join(o.name for o in options)
         stage = {"stage": "governor design" + (f" with {named}" if options else ""), "why": why,

@@ -45,7 +45,7 @@ from compliance.campaign.commissioning import (RATE_SHARE, TAU_MARGIN, tau_range
 from compliance.requirements.verdict import Severity, Status
 
 __all__ = ["INTEGRAL_TIME_FACTOR", "LEAD_FRACTION", "RATE_SHARE", "STABILITY", "TAU_MARGIN", "THROTTLE_OPEN",
-           "design_governor", "limiter_settings", "stability", "tau_range"]
+           "design_governor", "limiter_settings", "mandatory_uncertain", "stability", "tau_range"]
 
 LEAD_FRACTION = 0.04
 THROTTLE_OPEN = 2.0
@@ -190,6 +190,11 @@ _STROKE_METRICS = ("opening_time", "closing_time", "stroke_speed")
 def _mandatory_failures(results) -> list[dict]:
     return [e for e in results["requirements"]
             if e["severity"] == Severity.MANDATORY and e["status"] in (Status.FAIL, Status.UNCERTAIN)]
+
+
+def mandatory_uncertain(results) -> list[str]:
+    """Mandatory requirements whose band straddles their limit (an advisory one stops neither a design nor a remedy)."""
+    return [e["id"] for e in results["requirements"] if e["severity"] == Severity.MANDATORY and e["status"] == Status.UNCERTAIN]
 
 
 def _worst(e) -> dict:

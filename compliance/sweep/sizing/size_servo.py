@@ -160,7 +160,7 @@ def size_and_check(duty, template, reqset, *, workers=None, progress=False) -> t
         entry per pair tried (bore, load share, status, failing requirements, what the design could not meet).
     """
     from compliance.requirements.verdict import Overall
-    from compliance.sweep.sizing.governor_design import design_and_check
+    from compliance.sweep.sizing.governor_design import design_and_check, mandatory_uncertain
 
     tau = time_constant_target(reqset)
     rounds, min_area, count = [], 0.0, None
@@ -171,7 +171,7 @@ def size_and_check(duty, template, reqset, *, workers=None, progress=False) -> t
         rec["design"] = design
         rounds.append({"bore": cyl["bore"], "rod": cyl["rod"], "count": cyl["count"], "load_ratio": cyl["load_ratio"],
                        "valve_rating": rec["valve"]["rating"], "status": results["summary"]["status"],
-                       "failed_mandatory": results["summary"]["failed_mandatory"] + results["summary"].get("uncertain", []),
+                       "failed_mandatory": results["summary"]["failed_mandatory"] + mandatory_uncertain(results),
                        "cannot": design.get("cannot")})
         if results["summary"]["status"] == Overall.PASS:
             break

@@ -5,7 +5,9 @@ parameter (each uniform over its range, the same ranges the local bands use), ju
 sweep machinery (one campaign per candidate, no traces, linear requirements off), and replaces the
 local band of every modelled verdict by the spread of the candidates' worst values. The deciding
 parameters are ranked by the change of the value across each range estimated from a least-squares
-fit of the candidates (a linear response surface). docs/requirements.md, "Uncertainty".
+fit of the candidates (a linear response surface). A plant file's ``[commissioning]`` settings are not made
+again per plant here (the local bands make them at each range end): the band's method says so.
+docs/requirements.md, "Uncertainty".
 """
 
 from __future__ import annotations
@@ -69,6 +71,7 @@ def monte_carlo_bands(cfg, reqset, entries: list[dict], n: int, *, seed: int = 0
             continue
         vals = [v for _, v in got]
         lo, hi = min(vals + [e["worst"]["value"]]), max(vals + [e["worst"]["value"]])
-        apply_band(e, lo, hi, _swings([c for c, _ in got], vals, ranged), f"monte carlo (latin hypercube, {len(got)} plants)")
+        apply_band(e, lo, hi, _swings([c for c, _ in got], vals, ranged), f"monte carlo (latin hypercube, {len(got)} plants"
+                   + (", settings as the file gives them, not commissioned per plant)" if cfg.commissioning else ")"))
     return {"method": "monte_carlo", "samples": n, "judged": len(ok), "invalid": n - len(ok), "seed": seed,
             "parameters": [{"parameter": k, **rng} for k, rng in ranged], "top_assumptions": top_assumptions(entries, cfg)}
