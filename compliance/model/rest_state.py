@@ -84,20 +84,22 @@ def set_rest_internal_states(P: np.ndarray, y: np.ndarray, lx: np.ndarray, ly: n
         y[slot] = min(max(z, -zmax), zmax)
 
 
-def initial_state(cfg: PlantConfig, P: np.ndarray, x0: float, pressures: tuple[float, float] | None = None) -> np.ndarray:
+def initial_state(cfg: PlantConfig, P: np.ndarray, x0: float, pressures: tuple[float, float] | None = None, *,
+                  held: bool = True) -> np.ndarray:
     """State at rest at ``x0``: pressures balance the load with mean (p_s + p_atm)/2, T = T_s.
 
     This is the practice emulator's convention (ANSWERS.md) and the trim a test bench
     reaches after holding a position. Given ``pressures`` (p_A, p_B) [Pa abs] replace the
     balance; the effects put their states at rest (``Effect.rest``); either way the bristles and
     the load-sharing states start deflected so that the servo is held where it is
-    (``set_rest_internal_states``).
+    (``set_rest_internal_states``), unless ``held`` is False (a caller that sets them itself once
+    it has put the other states in place: a replay's restart).
     """
     y = np.zeros(N_STATES)
     y[S_X] = x0
     lx, ly = load_curve_arrays(cfg)
-    f_load = load_force(P, x0, lx, ly)
     ps, patm = P[P_PS], P[P_PATM]
+    f_load = load_force(P, x0, lx, ly) if pressures is None else 0.0  # the balance's load; given pressures need none
     if pressures is not None:
         pa, pb = pressures
     elif P[P_ARR] == 0.0:
@@ -114,5 +116,6 @@ def initial_state(cfg: PlantConfig, P: np.ndarray, x0: float, pressures: tuple[f
     y[S_PA] = pa
     y[S_PB] = pb
     at_rest(P, y, rest_of(P, y, lx, ly))  # the effects' states at rest (gas at T_s, reservoir at p_s, ...)
-    set_rest_internal_states(P, y, lx, ly)  # held at rest: bristles carry the net force, the link its share
+    if held:
+        set_rest_internal_states(P, y, lx, ly)  # held at rest: bristles carry the net force, the link its share
     return y

@@ -21,12 +21,46 @@ _PRESSURE_QUALIFIER = re.compile(r"\s*(\(?\s*(abs|absolute|a|gauge|g)\s*\)?)\s*$
 
 @lru_cache(maxsize=1)
 def registry():
-    """Return the single shared pint registry (created lazily: it takes ~0.3 s)."""
+    """Return the single shared pint registry (created lazily).
+
+    Parsing pint's definition files takes ~0.3 s, most of a short command's set-up; pint keeps the
+    parsed definitions in its disk cache (``cache_folder``, keyed by the files' contents), here in the
+    package's ``__pycache__`` beside the compiled core (``_definitions_cache``).
+    """
     import pint
 
-    ureg = pint.UnitRegistry(autoconvert_offset_to_baseunit=True)
+    ureg = pint.UnitRegistry(autoconvert_offset_to_baseunit=True, cache_folder=_definitions_cache(pint))
     ureg.define("percent_stroke = [] = %stroke")
     return ureg
+
+
+def _definitions_cache(pint) -> str | None:
+    """pint's disk cache of this pint version, or None (no cache: a read-only install).
+
+    pint writes its cache files in place; a folder is made whole in a private one and renamed into place in
+    one step, so processes starting together (a worker pool, parallel tests) never read a half-written file.
+    """
+    import os
+    import shutil
+    import sys
+    import tempfile
+    from pathlib import Path
+
+    here = Path(__file__).resolve().parents[1] / "__pycache__"
+    folder = here / f"pint-{pint.__version__}-py{sys.version_info[0]}{sys.version_info[1]}"
+    if folder.is_dir():
+        return str(folder)
+    try:
+        here.mkdir(exist_ok=True)
+        fresh = tempfile.mkdtemp(prefix=".pint-", dir=here)
+        pint.UnitRegistry(cache_folder=fresh)  # parses the definitions and writes the cache
+        try:
+            os.rename(fresh, folder)
+        except OSError:  # another process renamed its own first: use that one
+            shutil.rmtree(fresh, ignore_errors=True)
+    except OSError:
+        return None
+    return str(folder) if folder.is_dir() else None
 
 
 def _split_pressure_qualifier(text: str):

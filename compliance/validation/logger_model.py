@@ -132,6 +132,53 @@ class LoggerModel:
         return out
 
 
+class LoggedPrefix:
+    """The logger applied to a replay while it runs: logged values of the samples whose inputs are all final.
+
+    ``LoggerModel.apply`` on the whole replay gives the same numbers bit for bit: the filter runs on, chunk
+    after chunk, from the state it ended in (``lfilter``'s ``zi``/``zf``), a delayed sample interpolates
+    between the same two simulated samples, and the calibration is the same arithmetic. A sample's logged
+    value is final once the samples it reads are: its own and earlier ones (filter, delay >= 0), or up to
+    ``lead`` samples later (a negative delay: the channel shows what the plant does later).
+
+    Parameters
+    ----------
+    logger : LoggerModel
+    ts : float
+        Controller period [s].
+    n : int
+        Samples of the replay.
+    """
+
+    def __init__(self, logger: LoggerModel, ts: float, n: int):
+        self.logger, self.ts = logger, ts
+        self.t = np.arange(n) * ts
+        ahead = max((-d for d in logger.delay.values()), default=0.0)
+        self.lead = int(math.ceil(ahead / ts)) + 1 if ahead > 0.0 else 0
+        self._filtered: dict = {}  # channel -> [samples filtered so far, filter state, how many, coefficients]
+
+    def values(self, name: str, x: np.ndarray, final: int, idx: np.ndarray) -> np.ndarray:
+        """Logged channel ``name`` at samples ``idx`` (each below ``final - lead``); ``x`` is the simulated
+        channel, final up to sample ``final`` (exclusive)."""
+        lg = self.logger
+        fc = lg.cutoff.get(name)
+        if fc:
+            if name not in self._filtered:
+                b, a = _coefficients(fc, self.ts)
+                self._filtered[name] = [np.empty(self.t.size), np.array([x[0] * (1.0 - b[0])]), 0, (b, a)]
+            buf, zi, done, (b, a) = self._filtered[name]
+            if final > done:
+                buf[done:final], zi = lfilter(b, a, x[done:final], zi=zi)
+                self._filtered[name][1:3] = [zi, final]
+            x = buf
+        d = lg.delay.get(name, 0.0)
+        v = np.interp(self.t[idx] - d, self.t[:final], x[:final]) if d else x[idx]
+        g, o = lg.gain.get(name, 1.0), lg.offset.get(name, 0.0)
+        if g != 1.0 or o:
+            v = (ATMOSPHERE_PA + g * (v - ATMOSPHERE_PA) if name in PRESSURES else g * v) + o
+        return v
+
+
 def _coefficients(cutoff: float, ts: float) -> tuple[np.ndarray, np.ndarray]:
     wc = 2.0 / ts * math.tan(math.pi * cutoff * ts)  # prewarped: the discrete filter's -3 dB point is the cutoff
     k = 2.0 / ts

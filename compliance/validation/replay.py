@@ -196,9 +196,9 @@ def run_replay(cfg: PlantConfig, setup: ReplaySetup, *, noise: np.ndarray | None
         Position noise to inject instead of the recording's [m].
     stop : callable, optional
         ``stop(out, k)`` after each segment (``out``: the (n + 1, N_OUT) outputs, filled up to sample
-        ``k``): True ends the replay there and ``run_replay`` returns None (a residual that has
-        already decided; ``diagnosis.evidence.residuals.Bound``). Not called when the logger filters
-        or delays a channel (a sample's logged value then depends on later ones).
+        ``k``, samples before ``k`` final; the simulated values, before the logger and the transducers'
+        full scale): True ends the replay there and ``run_replay`` returns None (a residual that has
+        already decided; ``diagnosis.evidence.residuals.Bound``).
 
     Raises
     ------
@@ -215,8 +215,6 @@ def run_replay(cfg: PlantConfig, setup: ReplaySetup, *, noise: np.ndarray | None
     quiet = np.zeros(n + 1)
     bounds = list(setup.resets) + [n]
     kp, ki = P[P_KP], P[P_KI]
-    if stop is not None and setup.logger is not None and setup.logger.active:
-        stop = None
     for i in range(len(setup.resets)):
         k0, k1 = int(bounds[i]), int(bounds[i + 1])
         if k1 <= k0:

@@ -62,7 +62,7 @@ def reset_state(cfg, P: np.ndarray, setup, k: int, previous: np.ndarray, lx, ly)
     measured = {s: float(st[s][k]) for s in st if _readable(setup, s, k)}
     simulated = dict(zip(OUTPUT_COLUMNS, previous[k].tolist()))
     pa, pb = (measured.get(s, simulated[s]) for s in ("pressure_a", "pressure_b"))
-    y = initial_state(cfg, P, min(max(x, 0.0), P[P_STROKE]), (pa, pb))
+    y = initial_state(cfg, P, min(max(x, 0.0), P[P_STROKE]), (pa, pb), held=False)  # held below, once all is set
     # a meter-out throttle holds a chamber above the supply while the load drives the piston into it:
     # the measured (or carried) pressure stands, not the rest state's clamp to the supply
     y[S_PA], y[S_PB] = pa, pb

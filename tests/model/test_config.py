@@ -38,6 +38,24 @@ def test_models_and_package_copies_identical():
     assert (ROOT / "compliance" / "data" / "plants" / "plant-a.toml").exists()
 
 
+def test_units_from_the_cached_definitions_read_as_pints_own(tmp_path):
+    """The registry parses pint's definitions once into its disk cache; a registry read from that cache, and one
+    made cold in a fresh folder (the first run on a machine), convert exactly as pint without a cache does."""
+    import pint
+
+    from compliance.units.quantities import _definitions_cache, registry
+
+    cold = pint.UnitRegistry(autoconvert_offset_to_baseunit=True, cache_folder=str(tmp_path / "first"))
+    plain = pint.UnitRegistry(autoconvert_offset_to_baseunit=True)
+    for text, unit in (("125 mm", "m"), ("8 bar", "Pa"), ("20 degC", "K"), ("3.5 l/min", "m^3/s"), ("12 kN", "N"),
+                       ("0.7 psi", "Pa"), ("2.2e-9 m^3/(s*Pa)", "m^3/(s*Pa)"), ("45 ms", "s")):
+        want = plain.Quantity(text).to(unit).magnitude
+        assert registry().Quantity(text).to(unit).magnitude == want
+        assert cold.Quantity(text).to(unit).magnitude == want
+    folder = _definitions_cache(pint)
+    assert folder is None or Path(folder).is_dir() and any(Path(folder).glob("*.pickle"))
+
+
 def test_gauge_and_absolute_pressures():
     assert parse_quantity("7 bar gauge", "Pa", "x", pressure=True) == pytest.approx(7e5 + 101325.0)
     assert parse_quantity("8 bar abs", "Pa", "x", pressure=True) == pytest.approx(8e5)

@@ -94,3 +94,26 @@ def test_noise_share_is_what_the_filter_passes_of_white_noise():
     share = m.noise_share("position", 1e-3)
     assert share == pytest.approx(np.std(first_order_filter(n, 80.0, 1e-3)), rel=0.02)
     assert 0.40 < share < 0.50 and m.noise_share("pressure_a", 1e-3) == 1.0
+
+
+@pytest.mark.parametrize("delay", [0.0, 0.0025, -0.0035])
+def test_logged_prefix_gives_the_whole_replays_logged_values_from_final_samples_only(delay):
+    """A replay stopped early is judged on what the logger makes of the samples simulated so far: the same
+    numbers, bit for bit, as the logger on the whole replay (filter state carried across chunks, delays
+    interpolated between the same samples), and never a sample not simulated yet (NaN beyond ``final``)."""
+    from compliance.validation.logger_model import LoggedPrefix
+
+    ts, n = 1e-3, 3001
+    rng = np.random.default_rng(3)
+    sim = {"position": 0.06 + np.cumsum(rng.normal(0.0, 1e-5, n)), "pressure_a": 4e5 + np.cumsum(rng.normal(0.0, 300.0, n))}
+    lg = LoggerModel(cutoff={"position": 150.0, "pressure_a": 80.0}, delay={"position": delay, "pressure_a": -delay},
+                     gain={"pressure_a": 1.01}, offset={"position": 2e-5})
+    whole = lg.apply(sim, ts)
+    prefix = LoggedPrefix(lg, ts, n)
+    assert prefix.lead == (math.ceil(abs(delay) / ts) + 1 if delay else 0)
+    for final in (400, 401, 1700, 3001):  # the checks a stopping replay makes as its segments end
+        idx = np.arange(0, final - prefix.lead, 4)
+        for name, x in sim.items():
+            partial = np.where(np.arange(n) < final, x, np.nan)  # what is not simulated yet
+            got = prefix.values(name, partial, final, idx)
+            assert np.array_equal(got, whole[name][idx]), (name, final)

@@ -23,6 +23,7 @@ from compliance.validation.replay_conditions import load_at_start
 from compliance.validation.replay import ReplaySetup, prepare_replay, run_replay
 from compliance.validation.replay_setup import clip_to_full_scale
 from compliance.validation.fit_metrics import nrmse
+from compliance.validation.logger_model import LoggedPrefix
 from compliance.simulation.rk4 import OUTPUT_COLUMNS
 
 # lowest floors we accept (instrument resolution a logger rarely beats): keeps one signal from
@@ -314,12 +315,15 @@ class Bound:
     whose value can no longer matter to the search asking for it (``servo.simplex``, the grid scans
     of ``servo.fit``) is known to be worse once that partial sum exceeds the limit, and the rest of
     the recording is not replayed. ``vec`` holds the residuals so far (zeros beyond): its sum of
-    squares is the partial chi-square, a lower bound of the full one.
+    squares is the partial chi-square, a lower bound of the full one. A recording's logger (anti-alias
+    filter, delays, calibration: ``validation.logger_model``) is applied to the samples replayed so far as
+    the whole replay would be (``LoggedPrefix``: the same values).
     """
 
-    def __init__(self, model: ResidualModel, limit: float, full_scale: dict | None = None):
+    def __init__(self, model: ResidualModel, limit: float, full_scale: dict | None = None, logged: LoggedPrefix | None = None):
         self.model, self.limit = model, limit
         self.full_scale = full_scale or {}
+        self.logged = logged
         self.vec = np.zeros(model.size)
         self.chi2 = 0.0
         self.done = 0  # fitted samples accounted for (positions in model.index)
@@ -329,7 +333,8 @@ class Bound:
     def __call__(self, out: np.ndarray, k: int) -> bool:
         """True when the residuals of the samples before ``k`` (final once a segment ends at ``k``) exceed the limit."""
         m = self.model
-        j = int(np.searchsorted(m.index, k, side="left"))
+        # samples before k are final (the next segment starts on sample k); a logged one reads ``lead`` samples on
+        j = int(np.searchsorted(m.index, k - (self.logged.lead if self.logged is not None else 0), side="left"))
         if j - self.done < self.every:
             return False
         idx = m.index[self.done:j]
@@ -338,7 +343,8 @@ class Bound:
             scale = m.scale(s)
             if not np.isscalar(scale):
                 scale = scale[self.done:j]
-            sim = out[idx, col] if s not in self.full_scale else clip_to_full_scale(out[idx, col], self.full_scale[s])
+            sim = out[idx, col] if self.logged is None else self.logged.values(s, out[:, col], k, idx)
+            sim = sim if s not in self.full_scale else clip_to_full_scale(sim, self.full_scale[s])
             r = (m.recorded[s][idx] - sim) / scale
             self.vec[i * size + self.done:i * size + j] = r
             self.chi2 += float(np.dot(r, r))
@@ -352,7 +358,12 @@ def evaluate(model: ResidualModel, cfg: PlantConfig, setup: ReplaySetup, limit: 
     With a finite ``limit`` the replay stops at the first segment where its chi-square exceeds it
     (``Bound``); the vector then holds the residuals so far, zeros beyond.
     """
-    bound = Bound(model, limit, setup.full_scale) if math.isfinite(limit) else None
+    bound = None
+    if math.isfinite(limit):
+        active = setup.logger is not None and setup.logger.active
+        # the period run_replay hands the logger, so the filter and the delays are the same arithmetic
+        logged = LoggedPrefix(setup.logger, cfg.p("controller.sample_time"), setup.n_samples + 1) if active else None
+        bound = Bound(model, limit, setup.full_scale, logged)
     try:
         sim = run_replay(cfg, setup, stop=bound)
     except SimulationError:

@@ -278,21 +278,30 @@ def least_squares_fit(ctx: FitContext, name: str, params: tuple[ParamHandle, ...
     return out
 
 
-def scan_points(ctx: FitContext, params, points: list[list[float]], keep: float | None = None) -> list[float]:
+def scan_points(ctx: FitContext, params, points: list[list[float]], keep: float | None = None,
+                runner_up: bool = False) -> list[float]:
     """Chi-square (data + prior) at each point of a scan (SI values per point).
 
     ``keep``: only points within ``keep`` times the best so far matter to the caller (the argmin: 1;
     a second start within ``SECOND_START`` of the best: that ratio); a replay stops once its point
     is known to be beyond, and its value is then a lower bound above that level.
+
+    ``runner_up``: besides the argmin the caller needs only the best point of another main-parameter
+    value (``points[i][0]``; ``fit_candidate``'s second start), so a point also stops once beyond the
+    second-lowest of the main values' best points so far: it can then be neither.
     """
     out = []
     best = math.inf
+    by_main: dict = {}  # main-parameter value -> its best point's chi-square so far
     for values in points:
         prior = sum(fp.prior_residual(v) ** 2 for fp, v in zip(params, values))
-        limit = keep * best - prior if keep is not None and math.isfinite(best) else math.inf
-        vec, _ = ctx.residual(params, values, limit)
+        level = keep * best if keep is not None and math.isfinite(best) else math.inf
+        if runner_up and len(by_main) >= 2:
+            level = min(level, sorted(by_main.values())[1])
+        vec, _ = ctx.residual(params, values, level - prior)
         out.append(float(np.dot(vec, vec)) + prior)
         best = min(best, out[-1])
+        by_main[values[0]] = min(by_main.get(values[0], math.inf), out[-1])
     return out
 
 
@@ -332,7 +341,8 @@ def fit_candidate(ctx: FitContext, cand: Candidate, base_fit: FitResult | None, 
     for g in grid:
         points.append([g.get(fp.name, d) for fp, d in zip(eparams, defaults)] + bvalues)
     all_params = tuple(eparams) + bparams
-    chis = scan_points(ctx, all_params, points, keep=SECOND_START)
+    # a second start (several parameters) needs the best point of another main value within SECOND_START of the best
+    chis = scan_points(ctx, all_params, points, keep=SECOND_START if len(eparams) > 1 else 1.0, runner_up=len(eparams) > 1)
     best = int(np.argmin(chis))
     if screen is not None and chis[best] > screen:
         vec, _ = ctx.residual(all_params, points[best])

@@ -139,17 +139,24 @@ def _run_task(context: PerProcess, task):
     return res, vec
 
 
+def fit_context(payload) -> PerProcess:
+    """The workers' fit context of ``payload`` (plant TOML text, replay set-up, residual model), built once per process."""
+    return PerProcess(_fit_context, *payload)
+
+
 def run_fits(tasks, jobs: int, payload, scheduler: str | None = None, client=None) -> list:
     """(result, residual vector) of every fit task, in task order, on ``jobs`` processes (or Dask: the
     ``scheduler`` address, or the run's Dask ``client`` from ``processes.dask_session``).
 
-    ``payload`` is (plant TOML text, replay set-up, residual model); a task that raises raises here.
+    ``payload`` is (plant TOML text, replay set-up, residual model), or its ``fit_context``; a task that
+    raises raises here.
     """
-    results, stats = map_tasks(_run_task, PerProcess(_fit_context, *payload), list(tasks), workers=jobs,
+    context = payload if isinstance(payload, PerProcess) else fit_context(payload)
+    results, stats = map_tasks(_run_task, context, list(tasks), workers=jobs,
                                scheduler=scheduler, client=client, progress=False, label="fits", retries=0)
     stats.raise_if_failed()
     return results
 
 
 __all__ = ["ExtendSet", "FitEffect", "FitWithBase", "RecalibrateBase", "RefitSet", "ScreenAddition", "SecondStart", "ValleyPoint",
-           "run_fits"]
+           "fit_context", "run_fits"]

@@ -16,7 +16,8 @@ from compliance.model.config import PlantConfig, plant_to_toml
 from compliance.effects import EFFECTS
 from compliance.errors import InputError
 from compliance.diagnosis.servo.fit import FitResult, chi2_parts
-from compliance.diagnosis.servo.parallel_fits import run_fits
+from compliance.diagnosis.servo.parallel_fits import fit_context, run_fits
+from compliance.processes import PerProcess
 from compliance.validation.replay import ReplaySetup, prepare_replay, run_replay
 from compliance.diagnosis.evidence.residuals import build_residual_model, signal_fit, with_fail_level
 from compliance.diagnosis.evidence.locate_misfit import locate_mismatch
@@ -42,10 +43,19 @@ class Stage:
     sims: int = 2
     rebased: bool = False  # the friction law's other form is the base (servo/friction_form.py)
     client: object = None  # the run's Dask client (--scheduler); None: the local pool of ``jobs`` processes
+    context: PerProcess | None = None  # the workers' fit context (``parallel_fits``), one for every stage
 
     def run_fits(self, tasks) -> list:
-        """``parallel_fits.run_fits`` of ``tasks`` on this diagnosis' workers."""
-        return run_fits(tasks, self.jobs, self.payload, client=self.client)
+        """``parallel_fits.run_fits`` of ``tasks`` on this diagnosis' workers.
+
+        The fit context is built once, here, before the local pool forks: each stage's workers inherit it
+        instead of building it from the plant's TOML again (a Dask worker builds its own from the recipe).
+        """
+        if self.context is None:
+            self.context = fit_context(self.payload)
+        if self.client is None:
+            self.context.get()
+        return run_fits(tasks, self.jobs, self.context, client=self.client)
 
 
 def check_effects(cfg: PlantConfig, effects) -> list[str]:
