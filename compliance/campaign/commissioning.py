@@ -31,10 +31,11 @@ import math
 from compliance.campaign.executor import execute
 from compliance.campaign.judge import judge
 from compliance.campaign.plan import plan
+from compliance.model.assumptions import ORDER, SETTINGS
 from compliance.requirements.verdict import Severity, Status
 
-__all__ = ["RATE_ITERATIONS", "RATE_SHARE", "TAU_ITERATIONS", "TAU_MARGIN", "commission", "stroke_window", "tau_range",
-           "tune_limiter_rates", "tune_loop_gain"]
+__all__ = ["CENTRE_TOLERANCE", "RATE_ITERATIONS", "RATE_SHARE", "TAU_ITERATIONS", "TAU_MARGIN", "commission", "rate_limit",
+           "spread_text", "stroke_window", "tau_range", "tune_limiter_rates", "tune_loop_gain"]
 
 TAU_ITERATIONS = 4
 # each end of the window kept 15 % clear: the delivered-unit tolerances the remedies' yield draws move the time
@@ -44,7 +45,7 @@ TAU_MARGIN = 0.15
 CENTRE_TOLERANCE = 0.03  # the measured range's geometric centre within 3 % of the window's (our choice)
 RATE_ITERATIONS = 3
 RATE_SHARE = 0.99  # a stroke's speed kept just under the stroke-rate limit (our choice)
-LIMITER_KEYS = ("controller.setpoint_opening_rate", "controller.setpoint_closing_rate")
+LIMITER_KEYS = SETTINGS["limiter_rates"].parameters  # opening, closing
 _STROKE_METRICS = ("opening_time", "closing_time")
 
 
@@ -157,13 +158,14 @@ def stroke_window(reqset, stroke: float) -> tuple[float, float] | None:
     if not lows:
         return None
     lo, hi = max(lows), min(highs)
-    v_lim = _rate_limit(reqset, stroke)
+    v_lim = rate_limit(reqset, stroke)
     if v_lim:
         lo = max(lo, stroke / v_lim)
     return lo, hi
 
 
-def _rate_limit(reqset, stroke: float) -> float | None:
+def rate_limit(reqset, stroke: float) -> float | None:
+    """The tightest mandatory stroke-rate limit [m/s] (``stroke_speed``), or None."""
     vals = [r.resolved_limit(stroke)[-1] for r in _mandatory(reqset, "stroke_speed", ("<=", "<"))]
     return min(vals) if vals else None
 
@@ -185,7 +187,7 @@ def tune_limiter_rates(cfg, reqset, record: dict | None = None, *, workers=None)
     window = stroke_window(reqset, L)
     if window is None or not cfg.setpoint_rate_limited:
         return cfg
-    v_lim = _rate_limit(reqset, L)
+    v_lim = rate_limit(reqset, L)
     reqs = [r for m in _STROKE_METRICS for r in _mandatory(reqset, m, ("within",))]
     reqs += _mandatory(reqset, "stroke_speed", ("<=", "<"))
     sub = dataclasses.replace(reqset, requirements=tuple(reqs))
@@ -260,8 +262,6 @@ def commission(cfg, reqset, settings=None, *, workers=None, record: dict | None 
     -------
     PlantConfig
     """
-    from compliance.model.assumptions import ORDER
-
     names = cfg.commissioning if settings is None else tuple(settings)
     for name in ORDER:
         if name in names:

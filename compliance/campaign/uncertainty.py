@@ -27,6 +27,7 @@ band of the deciding row by a Latin-hypercube Monte Carlo over the same ranges
 
 from __future__ import annotations
 
+from compliance.model.assumptions import SETTINGS
 from compliance.processes import map_tasks
 from compliance.campaign.judge import judge_row
 from compliance.procedures.outcomes import traces_off
@@ -111,14 +112,17 @@ def _perturbed_run(ctx, item):
 def _commissioned_corner(ctx, item):
     """Worker: the settings commissioning makes on the plant with one parameter at one end of its range -> {key: value}."""
     from compliance.campaign.commissioning import commission
-    from compliance.model.assumptions import SETTINGS
 
     cfg, reqset = ctx
     key, value = item
     moved = cfg.replace(params={key: value}, sources={key: cfg.sources.get(key, "user")})
     done = commission(moved, reqset, workers=1)
-    keys = [k for n in cfg.commissioning for k in SETTINGS[n].parameters]
-    return {k: done.params[k] for k in keys if done.params[k] != moved.params[k]}
+    return {k: done.params[k] for k in _setting_keys(cfg) if done.params[k] != moved.params[k]}
+
+
+def _setting_keys(cfg) -> list[str]:
+    """The parameters of the plant file's declared commissioning settings (``model.assumptions.SETTINGS``)."""
+    return [k for n in cfg.commissioning for k in SETTINGS[n].parameters]
 
 
 def commissioned_settings(cfg, reqset, ranged, *, workers=None, progress=False) -> tuple[dict, dict | None]:
@@ -132,13 +136,11 @@ def commissioned_settings(cfg, reqset, ranged, *, workers=None, progress=False) 
     """
     if not cfg.commissioning:
         return {}, None
-    from compliance.model.assumptions import SETTINGS
-
     corners = [(k, rng[end]) for k, rng in ranged for end in ("low", "high")]
     got, _ = map_tasks(_commissioned_corner, (cfg, reqset), corners, workers=workers, progress=progress,
                        label="commissioning") if corners else ([], None)
     settings = {c: (g or {}) for c, g in zip(corners, got)}
-    keys = [k for n in cfg.commissioning for k in SETTINGS[n].parameters]
+    keys = _setting_keys(cfg)
     spans = {}
     for k in keys:
         vals = [cfg.params[k]] + [s[k] for s in settings.values() if k in s]

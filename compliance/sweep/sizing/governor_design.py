@@ -40,8 +40,9 @@ from __future__ import annotations
 
 import math
 
-from compliance.campaign.commissioning import (RATE_SHARE, TAU_MARGIN, tau_range, tune_limiter_rates,
+from compliance.campaign.commissioning import (RATE_SHARE, TAU_MARGIN, rate_limit, tau_range, tune_limiter_rates,
                                                tune_loop_gain)
+from compliance.model.assumptions import SETTINGS
 from compliance.requirements.verdict import Severity, Status
 
 __all__ = ["INTEGRAL_TIME_FACTOR", "LEAD_FRACTION", "RATE_SHARE", "STABILITY", "TAU_MARGIN", "THROTTLE_OPEN",
@@ -57,7 +58,7 @@ INTEGRAL_TIME_FACTOR = 3.0
 # positioning accuracy (our choice: half, so a stall band and a tracking lag of the same size still fit)
 STALL_SHARE = 0.5
 STABILITY = {"phase_margin_deg": 30.0, "gain_margin_db": 6.0}  # the report's criterion (report.acceptance.MARGIN_CRITERION)
-LIMITER_KEYS = ("controller.setpoint_opening_rate", "controller.setpoint_closing_rate", "controller.setpoint_lead_limit")
+LIMITER_KEYS = (*SETTINGS["limiter_rates"].parameters, "controller.setpoint_lead_limit")  # opening, closing, ramp hold
 THROTTLE_KEYS = ("flow_control.opening_conductance", "flow_control.closing_conductance")
 
 
@@ -69,18 +70,10 @@ def _window(reqset, metric: str, stroke: float):
     return None
 
 
-def _rate_limit(reqset, stroke: float) -> float | None:
-    """The tightest mandatory stroke-rate limit [m/s] (``stroke_speed``), or None."""
-    vals = [r.resolved_limit(stroke)[-1] for r in reqset.requirements
-            if r.enabled and r.limit is not None and r.metric == "stroke_speed" and r.comparator in ("<=", "<")
-            and r.severity == Severity.MANDATORY]
-    return min(vals) if vals else None
-
-
 def limiter_settings(cfg, reqset) -> tuple[dict, dict]:
     """(parameter values, record) of steps 1-2 of the module note: limiter rates, ramp hold, throttles wide open."""
     L = cfg.params["cylinder.stroke"]
-    v_lim = _rate_limit(reqset, L)
+    v_lim = rate_limit(reqset, L)
     values, record = {}, {}
     if v_lim is None and not any(_window(reqset, m, L) for m in ("opening_time", "closing_time")):
         return values, {"limiter": "none: the file sets no stroke time or stroke rate for it to hold"}
@@ -209,7 +202,7 @@ def corrections(cfg, reqset, results) -> tuple[dict, list[str]]:
     inverse's smoothing width (its stall band) narrowed by :data:`LC_FACTOR`. Empty when no rule applies.
     """
     L = cfg.params["cylinder.stroke"]
-    v_lim = _rate_limit(reqset, L)
+    v_lim = rate_limit(reqset, L)
     new, why = {}, []
     for e in _mandatory_failures(results):
         w = _worst(e)
