@@ -34,7 +34,7 @@ from compliance.campaign.plan import plan
 from compliance.model.assumptions import ORDER, SETTINGS
 from compliance.requirements.verdict import Severity, Status
 
-__all__ = ["CENTRE_TOLERANCE", "RATE_ITERATIONS", "RATE_SHARE", "TAU_ITERATIONS", "TAU_MARGIN", "commission", "rate_limit",
+__all__ = ["CENTRE_TOLERANCE", "RATE_ITERATIONS", "RATE_SHARE", "TAU_ITERATIONS", "TAU_MARGIN", "commission", "mandatory_requirements", "rate_limit",
            "spread_text", "stroke_window", "tau_range", "tune_limiter_rates", "tune_loop_gain"]
 
 TAU_ITERATIONS = 4
@@ -49,7 +49,8 @@ LIMITER_KEYS = SETTINGS["limiter_rates"].parameters  # opening, closing
 _STROKE_METRICS = ("opening_time", "closing_time")
 
 
-def _mandatory(reqset, metric: str, comparators: tuple) -> list:
+def mandatory_requirements(reqset, metric: str, comparators: tuple) -> list:
+    """The enabled, simulated, mandatory requirements of ``metric`` with a limit and one of ``comparators``."""
     return [r for r in reqset.requirements if r.metric == metric and r.enabled and r.source == "simulation"
             and r.limit is not None and r.comparator in comparators and r.severity == Severity.MANDATORY]
 
@@ -68,7 +69,7 @@ def tau_range(cfg, reqset, *, workers=None) -> dict | None:
     "rows"}``: ``up`` / ``down`` = (lowest, highest) evaluated value [s] of the steps of each direction
     (None when none was eligible), ``rows`` = (run, step, value) of every evaluated row.
     """
-    reqs = _mandatory(reqset, "time_constant", ("within",))
+    reqs = mandatory_requirements(reqset, "time_constant", ("within",))
     if not reqs:
         return None
     sub = dataclasses.replace(reqset, requirements=tuple(reqs[:1]))
@@ -151,7 +152,7 @@ def stroke_window(reqset, stroke: float) -> tuple[float, float] | None:
     """
     lows, highs = [], []
     for metric in _STROKE_METRICS:
-        for r in _mandatory(reqset, metric, ("within",)):
+        for r in mandatory_requirements(reqset, metric, ("within",)):
             lim = r.resolved_limit(stroke)
             lows.append(lim[0])
             highs.append(lim[-1])
@@ -166,7 +167,7 @@ def stroke_window(reqset, stroke: float) -> tuple[float, float] | None:
 
 def rate_limit(reqset, stroke: float) -> float | None:
     """The tightest mandatory stroke-rate limit [m/s] (``stroke_speed``), or None."""
-    vals = [r.resolved_limit(stroke)[-1] for r in _mandatory(reqset, "stroke_speed", ("<=", "<"))]
+    vals = [r.resolved_limit(stroke)[-1] for r in mandatory_requirements(reqset, "stroke_speed", ("<=", "<"))]
     return min(vals) if vals else None
 
 
@@ -188,8 +189,8 @@ def tune_limiter_rates(cfg, reqset, record: dict | None = None, *, workers=None)
     if window is None or not cfg.setpoint_rate_limited:
         return cfg
     v_lim = rate_limit(reqset, L)
-    reqs = [r for m in _STROKE_METRICS for r in _mandatory(reqset, m, ("within",))]
-    reqs += _mandatory(reqset, "stroke_speed", ("<=", "<"))
+    reqs = [r for m in _STROKE_METRICS for r in mandatory_requirements(reqset, m, ("within",))]
+    reqs += mandatory_requirements(reqset, "stroke_speed", ("<=", "<"))
     sub = dataclasses.replace(reqset, requirements=tuple(reqs))
     target = 0.5 * (window[0] + window[1])
     for _ in range(RATE_ITERATIONS):

@@ -40,8 +40,8 @@ from __future__ import annotations
 
 import math
 
-from compliance.campaign.commissioning import (RATE_SHARE, TAU_MARGIN, rate_limit, tau_range, tune_limiter_rates,
-                                               tune_loop_gain)
+from compliance.campaign.commissioning import (RATE_SHARE, TAU_MARGIN, mandatory_requirements, rate_limit, tau_range,
+                                               tune_limiter_rates, tune_loop_gain)
 from compliance.model.assumptions import SETTINGS
 from compliance.requirements.verdict import Severity, Status
 
@@ -144,8 +144,7 @@ def design_governor(cfg, reqset, *, workers=None, tune=True) -> tuple:
         range cannot fit the window with its margin, else None).
     """
     values, why = limiter_settings(cfg, reqset)
-    tau_reqs = [r for r in reqset.requirements if r.metric == "time_constant" and r.enabled and r.limit is not None
-                and r.comparator == "within" and r.severity == Severity.MANDATORY]
+    tau_reqs = mandatory_requirements(reqset, "time_constant", ("within",))
     if tau_reqs:
         lo, hi = tau_reqs[0].resolved_limit(cfg.params["cylinder.stroke"])
         t_i = INTEGRAL_TIME_FACTOR * math.sqrt(lo * hi)
