@@ -34,8 +34,9 @@ from compliance.campaign.plan import plan
 from compliance.model.assumptions import ORDER, SETTINGS
 from compliance.requirements.verdict import Severity, Status
 
-__all__ = ["CENTRE_TOLERANCE", "RATE_ITERATIONS", "RATE_SHARE", "TAU_ITERATIONS", "TAU_MARGIN", "commission", "mandatory_requirements", "rate_limit",
-           "spread_text", "stroke_window", "tau_range", "tune_limiter_rates", "tune_loop_gain"]
+__all__ = ["CENTRE_TOLERANCE", "RATE_ITERATIONS", "RATE_SHARE", "TAU_ITERATIONS", "TAU_MARGIN", "commission",
+           "mandatory_requirements", "rate_limit", "spread_text", "stroke_window", "tau_range", "tune_limiter_rates",
+           "tune_loop_gain"]
 
 TAU_ITERATIONS = 4
 # each end of the window kept 15 % clear: the delivered-unit tolerances the remedies' yield draws move the time
