@@ -9,9 +9,9 @@
 """
 
 from compliance.processes.dask_cluster import dask_session, parse_scheduler
-from compliance.processes.executor import PerProcess, RunStats, available_cores, map_tasks
+from compliance.processes.executor import AFTER, AHEAD, PerProcess, RunStats, available_cores, map_tasks
 from compliance.processes.stopping import (GRACE, Terminated, raise_if_stopping, stop_on_signals, stop_signal,
                                            worker_pool)
 
-__all__ = ["GRACE", "PerProcess", "RunStats", "Terminated", "available_cores", "dask_session", "map_tasks",
+__all__ = ["AFTER", "AHEAD", "GRACE", "PerProcess", "RunStats", "Terminated", "available_cores", "dask_session", "map_tasks",
            "parse_scheduler", "raise_if_stopping", "stop_on_signals", "stop_signal", "worker_pool"]

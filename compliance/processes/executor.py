@@ -16,6 +16,12 @@ that each worker receives once:
 A context that must be built in each worker (a fit context compiled from a plant file) is a
 :class:`PerProcess`: sent as its recipe, built once per process on first use.
 
+A finished task may add follow-up items (``follow``): they run on the same workers, before the items
+not started yet or once every item has started (a stage whose last items leave a worker idle fills it
+with work the next stage would otherwise run alone), each only while the caller still wants its result
+(``wanted``); one no longer wanted is dropped, and if it is already running its worker is stopped with
+the pool.
+
 A task that raises (or whose worker dies: ``BrokenProcessPool``, Dask's ``KilledWorker``) is
 submitted again, up to ``retries`` times; :class:`RunStats` counts done, failed and retried so
 a run never drops an item silently. Progress: tqdm on a terminal, plain periodic lines
@@ -24,6 +30,7 @@ otherwise (CI logs).
 
 from __future__ import annotations
 
+import math
 import os
 import sys
 import time
@@ -32,7 +39,7 @@ from dataclasses import dataclass, field
 from compliance.errors import GovcheckError
 from compliance.processes.dask_cluster import dask_client, parse_scheduler
 
-__all__ = ["PerProcess", "RunStats", "available_cores", "map_tasks"]
+__all__ = ["AFTER", "AHEAD", "PerProcess", "RunStats", "available_cores", "map_tasks"]
 
 _CTX: dict = {}  # set before the pool forks: workers read the context without pickling it
 _PLAIN_EVERY = 15.0  # seconds between plain progress lines when stderr is not a terminal
@@ -126,22 +133,68 @@ class _Progress:
             self.bar.close()
 
 
-class _Sink:
-    """Where finished tasks go: the results list, the counts, the progress bar and the caller's callback."""
+AFTER, AHEAD = 1, 2  # a follow-up's urgency (``map_tasks``' ``wanted``): once the items given have started, or before
 
-    def __init__(self, n: int, bar: _Progress, stats: RunStats, retries: int, on_result):
-        self.results: list = [None] * n
+
+class _Abandon(Exception):
+    """Only follow-ups no longer wanted are running: the pool stops with them."""
+
+
+class _Sink:
+    """Where finished tasks go: the results list, the counts, the progress bar and the caller's callbacks;
+    what is left to start (``map_tasks``' items, and the follow-ups finished tasks added)."""
+
+    def __init__(self, items: list, bar: _Progress, stats: RunStats, retries: int, on_result, follow=None, wanted=None):
+        self.items = items
+        self.results: list = [None] * len(items)
         self.bar, self.stats, self.retries, self.on_result = bar, stats, retries, on_result
+        self.follow, self.wanted = follow, wanted
         self.attempts: dict = {}
-        self.pending = set(range(n))
+        self.pending = set(range(len(items)))
+        self.extra: dict = {}  # index -> follow-up item (indices after the items given)
+        self.todo: list = list(range(len(items)))  # items given not started yet
+        self.queue: list = []  # follow-ups not started yet, in the order they were added
+
+    def item(self, i: int):
+        return self.items[i] if i < len(self.items) else self.extra[i]
+
+    def restart(self) -> None:
+        """A new pool: everything pending starts again (an item that failed, a follow-up lost with its worker)."""
+        self.todo = sorted(i for i in self.pending if i < len(self.items))
+        self.queue = sorted(j for j in self.pending if j in self.extra)
+
+    def urgency(self, j: int) -> int:
+        return int(self.wanted(self.extra[j])) if self.wanted is not None else AFTER
+
+    def next_task(self) -> int | None:
+        """What starts next: a follow-up wanted ``AHEAD``, else the next item given, else a follow-up still wanted."""
+        self.drop_unwanted()
+        ahead = next((j for j in self.queue if self.urgency(j) >= AHEAD), None)
+        i = ahead if ahead is not None else self.todo.pop(0) if self.todo else self.queue[0] if self.queue else None
+        if i in self.queue:
+            self.queue.remove(i)
+        return i
 
     def done(self, i: int, out) -> None:
         self.results[i] = out
         self.pending.discard(i)
         self.stats.done += 1
-        self.bar.step()
+        if i < len(self.items):
+            self.bar.step()
         if self.on_result is not None:
             self.on_result(i, out)
+        for item in (self.follow(i, out) if self.follow is not None else ()):
+            j = len(self.results)
+            self.results.append(None)
+            self.extra[j] = item
+            self.pending.add(j)
+            self.queue.append(j)
+
+    def drop_unwanted(self) -> None:
+        """Follow-ups whose results the caller no longer wants leave the run (their results stay None)."""
+        for j in sorted(j for j in self.pending if j in self.extra and not self.urgency(j)):
+            self.pending.discard(j)
+        self.queue = [j for j in self.queue if j in self.pending]
 
     def failed(self, i: int, exc: BaseException) -> bool:
         """Count a failed attempt; True when the item should run again."""
@@ -154,8 +207,14 @@ class _Sink:
         if self.stats.first_error is None:
             self.stats.first_error = exc
         self.pending.discard(i)
-        self.bar.step()
+        if i < len(self.items):
+            self.bar.step()
         return False
+
+    def wanted_running(self, running) -> bool:
+        """Whether any of the ``running`` indices is still wanted (False: stop what runs)."""
+        self.drop_unwanted()
+        return any(i in self.pending for i in running)
 
 
 def _call(i: int):
@@ -163,11 +222,19 @@ def _call(i: int):
     return i, _CTX["fn"](_CTX["context"], _CTX["items"][i])
 
 
+def _call_item(i: int, item):
+    """Worker side of the local pool for a follow-up item (added after the fork: sent pickled)."""
+    return i, _CTX["fn"](_CTX["context"], item)
+
+
 def _run_serial(fn, context, items, sink: _Sink):
-    for i, item in enumerate(items):
+    while True:  # the follow-ups after every item given: each is asked whether it is wanted once all are known
+        i = sink.todo.pop(0) if sink.todo else sink.next_task()
+        if i is None:
+            return
         while True:
             try:
-                out = fn(context, item)
+                out = fn(context, sink.item(i))
             except GovcheckError:
                 raise  # bad input is the user's to fix, not a lost task
             except Exception as exc:  # a failed task is retried, then counted
@@ -179,9 +246,6 @@ def _run_serial(fn, context, items, sink: _Sink):
 
 
 def _run_pool(fn, context, items, sink: _Sink):
-    from concurrent.futures import as_completed
-    from concurrent.futures.process import BrokenProcessPool
-
     from compliance.processes.stopping import worker_pool
 
     outer = dict(_CTX)  # a map_tasks inside a worker of another one: give the outer context back after
@@ -189,44 +253,89 @@ def _run_pool(fn, context, items, sink: _Sink):
     _CTX.update(fn=fn, context=context, items=items)
     try:
         while sink.pending:  # a dead worker breaks the pool: start a new one for what is left
-            with worker_pool(sink.stats.workers) as pool:
-                futures = {pool.submit(_call, i): i for i in sorted(sink.pending)}
-                for fut in as_completed(futures):
-                    i = futures[fut]
-                    try:
-                        _, out = fut.result()
-                    except GovcheckError:
-                        raise
-                    except (BrokenProcessPool, Exception) as exc:
-                        sink.failed(i, exc)
-                        continue
-                    sink.done(i, out)
+            sink.restart()
+            try:
+                with worker_pool(sink.stats.workers) as pool:
+                    _drive_pool(pool, sink)
+            except _Abandon:
+                pass
     finally:
         _CTX.clear()
         _CTX.update(outer)
+
+
+def _in_flight(sink: _Sink) -> float:
+    """Tasks a driver keeps submitted: all at once, or with follow-ups one per worker (the next one is chosen
+    when a worker comes free)."""
+    return sink.stats.workers if sink.follow is not None else math.inf
+
+
+def _drive_pool(pool, sink: _Sink) -> None:
+    """The tasks on ``pool``; returns when nothing wanted is left running (what failed and may run again is
+    left pending for a new pool)."""
+    from concurrent.futures import FIRST_COMPLETED, wait
+    from concurrent.futures.process import BrokenProcessPool
+
+    futures: dict = {}
+    broken = False
+    while True:
+        while not broken and len(futures) < _in_flight(sink) and (i := sink.next_task()) is not None:
+            fut = pool.submit(_call, i) if i < len(sink.items) else pool.submit(_call_item, i, sink.extra[i])
+            futures[fut] = i
+        if not sink.wanted_running(futures.values()):
+            if futures:
+                raise _Abandon()  # stop their workers with the pool
+            return
+        finished, _ = wait(futures, return_when=FIRST_COMPLETED)
+        for fut in sorted(finished, key=futures.get):
+            i = futures.pop(fut)
+            if i not in sink.pending:
+                continue  # dropped while it ran
+            try:
+                _, out = fut.result()
+            except GovcheckError:
+                raise
+            except (BrokenProcessPool, Exception) as exc:
+                broken = broken or isinstance(exc, BrokenProcessPool)
+                sink.failed(i, exc)
+                continue
+            sink.done(i, out)
 
 
 def _run_dask(client, fn, context, items, sink: _Sink):
     from distributed import as_completed
 
     ctx = client.scatter(context, broadcast=True, hash=False)
-    futures = {client.submit(fn, ctx, items[i], pure=False): i for i in range(len(items))}
-    stream = as_completed(list(futures))
+    futures: dict = {}
+    stream = as_completed()
+
+    def submit(i: int):
+        fut = client.submit(fn, ctx, sink.item(i), pure=False)
+        futures[fut] = i
+        stream.add(fut)
+
+    while len(futures) < _in_flight(sink) and (i := sink.next_task()) is not None:
+        submit(i)
     for fut in stream:
         i = futures.pop(fut)
-        try:
-            out = fut.result()
-        except GovcheckError:
-            raise
-        except Exception as exc:  # task error or KilledWorker: submit again, counted
-            if sink.failed(i, exc):
-                if ctx.status != "finished":  # every worker holding the context died: send it again
-                    ctx = client.scatter(context, broadcast=True, hash=False)
-                again = client.submit(fn, ctx, items[i], pure=False)
-                futures[again] = i
-                stream.add(again)
-            continue
-        sink.done(i, out)
+        if i in sink.pending:  # else dropped while it ran
+            try:
+                out = fut.result()
+            except GovcheckError:
+                raise
+            except Exception as exc:  # task error or KilledWorker: submit again, counted
+                if sink.failed(i, exc):
+                    if ctx.status != "finished":  # every worker holding the context died: send it again
+                        ctx = client.scatter(context, broadcast=True, hash=False)
+                    submit(i)
+            else:
+                sink.done(i, out)
+        while len(futures) < _in_flight(sink) and (j := sink.next_task()) is not None:
+            submit(j)
+        if not sink.wanted_running(futures.values()):
+            for f in futures:  # only follow-ups no longer wanted still run
+                f.cancel()
+            return
 
 
 def _local_workers(workers: int | None, n: int) -> int:
@@ -238,7 +347,8 @@ def _local_workers(workers: int | None, n: int) -> int:
 
 
 def map_tasks(fn, context, items: list, *, scheduler: str | None = None, workers: int | None = None,
-              progress: bool = True, label: str = "tasks", retries: int = 2, client=None, on_result=None):
+              progress: bool = True, label: str = "tasks", retries: int = 2, client=None, on_result=None,
+              follow=None, wanted=None):
     """Run ``fn(context, item)`` for every item, locally or on Dask; results in item order.
 
     Parameters
@@ -261,11 +371,22 @@ def map_tasks(fn, context, items: list, *, scheduler: str | None = None, workers
         Use this client instead of connecting (a whole run's session, tests, benchmarks).
     on_result : callable, optional
         ``on_result(index, result)`` in this process as each task finishes (in finishing order).
+    follow : callable, optional
+        ``follow(index, result) -> items``, in this process as each task finishes (follow-ups' too): follow-up
+        items, run on the same workers (``wanted``) in the order they were added; their results follow the
+        items' in that order (index ``len(items)`` on). With follow-ups, a task is submitted when a worker comes
+        free (without, all at once).
+    wanted : callable, optional
+        ``wanted(item) -> int`` of a follow-up, asked before it starts and as tasks finish: 0 (False; it must
+        then stay 0) drops it, its result ``None``, its worker stopped if it runs (the local pool ends with it);
+        ``AFTER`` (1, True) starts it once every item given has started; ``AHEAD`` (2) before the items given
+        not started yet (in this process, ``workers=1``, every follow-up waits for every item given). Default:
+        every follow-up ``AFTER``.
 
     Returns
     -------
     tuple
-        (results, :class:`RunStats`); a task that failed every attempt leaves ``None``.
+        (results, :class:`RunStats`); a task that failed every attempt, or a follow-up dropped, leaves ``None``.
     """
     t0 = time.perf_counter()
     n = len(items)
@@ -274,13 +395,13 @@ def map_tasks(fn, context, items: list, *, scheduler: str | None = None, workers
     try:
         if kind == "local":
             stats = RunStats("local", _local_workers(workers, n))
-            sink = _Sink(n, bar, stats, retries, on_result)
+            sink = _Sink(items, bar, stats, retries, on_result, follow, wanted)
             (_run_serial if stats.workers == 1 else _run_pool)(fn, context, items, sink)
         else:
             own, cluster = (client, None) if client is not None else dask_client(kind, target)
             try:
                 stats = RunStats("dask", len(own.scheduler_info().get("workers", {})) or 1)
-                sink = _Sink(n, bar, stats, retries, on_result)
+                sink = _Sink(items, bar, stats, retries, on_result, follow, wanted)
                 _run_dask(own, fn, context, items, sink)
             finally:
                 if client is None:

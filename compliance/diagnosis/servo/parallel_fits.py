@@ -55,6 +55,9 @@ class SecondStart:
     first: FitResult
 
     def fit(self, ctx: FitContext) -> FitResult:
+        # as in a fresh worker: its replays (and their count) never depend on what this process fitted before
+        # (a speculative second start may follow its own candidate's first fit in the same worker)
+        ctx.memo.clear()
         return second_start(ctx, self.first)
 
 
@@ -144,16 +147,17 @@ def fit_context(payload) -> PerProcess:
     return PerProcess(_fit_context, *payload)
 
 
-def run_fits(tasks, jobs: int, payload, scheduler: str | None = None, client=None) -> list:
+def run_fits(tasks, jobs: int, payload, scheduler: str | None = None, client=None, follow=None, wanted=None) -> list:
     """(result, residual vector) of every fit task, in task order, on ``jobs`` processes (or Dask: the
     ``scheduler`` address, or the run's Dask ``client`` from ``processes.dask_session``).
 
     ``payload`` is (plant TOML text, replay set-up, residual model), or its ``fit_context``; a task that
-    raises raises here.
+    raises raises here. ``follow``, ``wanted``: follow-up tasks as in ``processes.map_tasks`` (their
+    results after the tasks', None where dropped).
     """
     context = payload if isinstance(payload, PerProcess) else fit_context(payload)
-    results, stats = map_tasks(_run_task, context, list(tasks), workers=jobs,
-                               scheduler=scheduler, client=client, progress=False, label="fits", retries=0)
+    results, stats = map_tasks(_run_task, context, list(tasks), workers=jobs, scheduler=scheduler, client=client,
+                               progress=False, label="fits", retries=0, follow=follow, wanted=wanted)
     stats.raise_if_failed()
     return results
 

@@ -45,8 +45,8 @@ class Stage:
     client: object = None  # the run's Dask client (--scheduler); None: the local pool of ``jobs`` processes
     context: PerProcess | None = None  # the workers' fit context (``parallel_fits``), one for every stage
 
-    def run_fits(self, tasks) -> list:
-        """``parallel_fits.run_fits`` of ``tasks`` on this diagnosis' workers.
+    def run_fits(self, tasks, follow=None, wanted=None) -> list:
+        """``parallel_fits.run_fits`` of ``tasks`` (and of the follow-ups ``follow`` adds) on this diagnosis' workers.
 
         The fit context is built once, here, before the local pool forks: each stage's workers inherit it
         instead of building it from the plant's TOML again (a Dask worker builds its own from the recipe).
@@ -55,7 +55,7 @@ class Stage:
             self.context = fit_context(self.payload)
         if self.client is None:
             self.context.get()
-        return run_fits(tasks, self.jobs, self.context, client=self.client)
+        return run_fits(tasks, self.jobs, self.context, client=self.client, follow=follow, wanted=wanted)
 
 
 def check_effects(cfg: PlantConfig, effects) -> list[str]:
