@@ -125,3 +125,74 @@ def test_progress_is_plain_lines_when_not_a_terminal(monkeypatch, capsys):
     assert "candidates: 3/3 done" in err and "\r" not in err
     map_tasks(_square, None, [1, 2, 3], workers=1, progress=False)
     assert capsys.readouterr().err == ""
+
+
+def _square_or_follow(ctx, item):
+    """A number: its square; a follow-up (value, seconds): sleeps, then ("followed", value)."""
+    import time
+
+    if isinstance(item, tuple):
+        time.sleep(item[1])
+        return ("followed", item[0])
+    return item * item
+
+
+@pytest.mark.parametrize("backend", ["serial", "pool", "dask"])
+def test_follow_ups_run_while_wanted_and_come_after_the_items_in_the_order_added(backend, request):
+    from compliance.processes import AFTER
+
+    added = []
+
+    def follow(i, out):
+        if i >= 4:
+            return []
+        added.append((out, 0.0))
+        return [added[-1]]
+
+    def wanted(item):  # the follow-ups of odd squares are not wanted
+        return 0 if item[0] % 2 else AFTER
+
+    where = {"serial": {"workers": 1}, "pool": {"workers": 2}, "dask": {"client": None}}[backend]
+    if backend == "dask":
+        where = {"client": request.getfixturevalue("dask_client")}
+    out, stats = map_tasks(_square_or_follow, None, [1, 2, 3, 4], progress=False, follow=follow, wanted=wanted, **where)
+    assert out[:4] == [1, 4, 9, 16] and len(out) == 8 and sorted(a[0] for a in added) == [1, 4, 9, 16]
+    assert out[4:] == [None if v % 2 else ("followed", v) for v, _ in added]
+    assert stats.done == 6 and stats.failed == 0
+
+
+def test_a_running_follow_up_no_longer_wanted_is_stopped_with_the_pool():
+    import time
+
+    from compliance.processes import AFTER
+
+    known = set()
+
+    def follow(i, out):
+        known.add(i)
+        return [(-1, 60.0)] if i == 0 else []  # a minute's follow-up, wanted until item 1 is known
+
+    t0 = time.perf_counter()
+    out, stats = map_tasks(_square_or_follow, None, [0, (1, 1.0)], workers=2, progress=False, follow=follow,
+                           wanted=lambda item: 0 if 1 in known else AFTER)
+    assert out == [0, ("followed", 1), None] and stats.failed == 0
+    assert time.perf_counter() - t0 < 20.0  # not the follow-up's minute
+
+
+def _started(ctx, item):
+    import time
+
+    t = time.time()
+    time.sleep(item[1])
+    return item[0], t
+
+
+def test_a_follow_up_wanted_ahead_starts_before_the_items_not_started_yet():
+    from compliance.processes import AHEAD
+
+    items = [("quick", 0.0)] + [(f"item{k}", 0.4) for k in range(4)]
+    out, _ = map_tasks(_started, None, items, workers=2, progress=False,
+                       follow=lambda i, out: [("ahead", 0.0)] if i == 0 else [], wanted=lambda item: AHEAD)
+    start = dict(out)
+    # two workers: "quick" and item0 start first; the follow-up of "quick" then comes before items 1 to 3
+    assert start["ahead"] < min(start["item1"], start["item2"], start["item3"])

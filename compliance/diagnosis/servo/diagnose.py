@@ -131,7 +131,7 @@ def _run_with_second_starts(st: Stage, tasks: list) -> None:
         if i >= len(tasks):
             return []
         firsts.append(out[0])
-        return [SecondStart(out[0])] if out[0].second_from and wanted(SecondStart(out[0])) else []
+        return [SecondStart(out[0])] if out[0].second_from else []  # the executor asks ``wanted`` before it starts
 
     def wanted(task: SecondStart) -> int:
         if not any(f is task.first for f in competing(firsts)):
