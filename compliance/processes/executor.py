@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 
 from compliance.errors import GovcheckError
 from compliance.processes.dask_cluster import dask_client, parse_scheduler
+from compliance.processes.ledger import AFTER, AHEAD, Abandon, Ledger
 
 __all__ = ["AFTER", "AHEAD", "PerProcess", "RunStats", "available_cores", "map_tasks"]
 
@@ -133,90 +134,6 @@ class _Progress:
             self.bar.close()
 
 
-AFTER, AHEAD = 1, 2  # a follow-up's urgency (``map_tasks``' ``wanted``): once the items given have started, or before
-
-
-class _Abandon(Exception):
-    """Only follow-ups no longer wanted are running: the pool stops with them."""
-
-
-class _Sink:
-    """Where finished tasks go: the results list, the counts, the progress bar and the caller's callbacks;
-    what is left to start (``map_tasks``' items, and the follow-ups finished tasks added)."""
-
-    def __init__(self, items: list, bar: _Progress, stats: RunStats, retries: int, on_result, follow=None, wanted=None):
-        self.items = items
-        self.results: list = [None] * len(items)
-        self.bar, self.stats, self.retries, self.on_result = bar, stats, retries, on_result
-        self.follow, self.wanted = follow, wanted
-        self.attempts: dict = {}
-        self.pending = set(range(len(items)))
-        self.extra: dict = {}  # index -> follow-up item (indices after the items given)
-        self.todo: list = list(range(len(items)))  # items given not started yet
-        self.queue: list = []  # follow-ups not started yet, in the order they were added
-
-    def item(self, i: int):
-        return self.items[i] if i < len(self.items) else self.extra[i]
-
-    def restart(self) -> None:
-        """A new pool: everything pending starts again (an item that failed, a follow-up lost with its worker)."""
-        self.todo = sorted(i for i in self.pending if i < len(self.items))
-        self.queue = sorted(j for j in self.pending if j in self.extra)
-
-    def urgency(self, j: int) -> int:
-        return int(self.wanted(self.extra[j])) if self.wanted is not None else AFTER
-
-    def next_task(self) -> int | None:
-        """What starts next: a follow-up wanted ``AHEAD``, else the next item given, else a follow-up still wanted."""
-        self.drop_unwanted()
-        ahead = next((j for j in self.queue if self.urgency(j) >= AHEAD), None)
-        i = ahead if ahead is not None else self.todo.pop(0) if self.todo else self.queue[0] if self.queue else None
-        if i in self.queue:
-            self.queue.remove(i)
-        return i
-
-    def done(self, i: int, out) -> None:
-        self.results[i] = out
-        self.pending.discard(i)
-        self.stats.done += 1
-        if i < len(self.items):
-            self.bar.step()
-        if self.on_result is not None:
-            self.on_result(i, out)
-        for item in (self.follow(i, out) if self.follow is not None else ()):
-            j = len(self.results)
-            self.results.append(None)
-            self.extra[j] = item
-            self.pending.add(j)
-            self.queue.append(j)
-
-    def drop_unwanted(self) -> None:
-        """Follow-ups whose results the caller no longer wants leave the run (their results stay None)."""
-        for j in sorted(j for j in self.pending if j in self.extra and not self.urgency(j)):
-            self.pending.discard(j)
-        self.queue = [j for j in self.queue if j in self.pending]
-
-    def failed(self, i: int, exc: BaseException) -> bool:
-        """Count a failed attempt; True when the item should run again."""
-        self.attempts[i] = self.attempts.get(i, 0) + 1
-        if self.attempts[i] <= self.retries:
-            self.stats.retried += 1
-            return True
-        self.stats.failed += 1
-        self.stats.errors.append((i, f"{type(exc).__name__}: {exc}"))
-        if self.stats.first_error is None:
-            self.stats.first_error = exc
-        self.pending.discard(i)
-        if i < len(self.items):
-            self.bar.step()
-        return False
-
-    def wanted_running(self, running) -> bool:
-        """Whether any of the ``running`` indices is still wanted (False: stop what runs)."""
-        self.drop_unwanted()
-        return any(i in self.pending for i in running)
-
-
 def _call(i: int):
     """Worker side of the local pool: the context was set before the fork."""
     return i, _CTX["fn"](_CTX["context"], _CTX["items"][i])
@@ -227,7 +144,7 @@ def _call_item(i: int, item):
     return i, _CTX["fn"](_CTX["context"], item)
 
 
-def _run_serial(fn, context, items, sink: _Sink):
+def _run_serial(fn, context, items, sink: Ledger):
     while True:  # the follow-ups after every item given: each is asked whether it is wanted once all are known
         i = sink.todo.pop(0) if sink.todo else sink.next_task()
         if i is None:
@@ -245,7 +162,7 @@ def _run_serial(fn, context, items, sink: _Sink):
             break
 
 
-def _run_pool(fn, context, items, sink: _Sink):
+def _run_pool(fn, context, items, sink: Ledger):
     from compliance.processes.stopping import worker_pool
 
     outer = dict(_CTX)  # a map_tasks inside a worker of another one: give the outer context back after
@@ -257,20 +174,20 @@ def _run_pool(fn, context, items, sink: _Sink):
             try:
                 with worker_pool(sink.stats.workers) as pool:
                     _drive_pool(pool, sink)
-            except _Abandon:
+            except Abandon:
                 pass
     finally:
         _CTX.clear()
         _CTX.update(outer)
 
 
-def _in_flight(sink: _Sink) -> float:
+def _in_flight(sink: Ledger) -> float:
     """Tasks a driver keeps submitted: all at once, or with follow-ups one per worker (the next one is chosen
     when a worker comes free)."""
     return sink.stats.workers if sink.follow is not None else math.inf
 
 
-def _drive_pool(pool, sink: _Sink) -> None:
+def _drive_pool(pool, sink: Ledger) -> None:
     """The tasks on ``pool``; returns when nothing wanted is left running (what failed and may run again is
     left pending for a new pool)."""
     from concurrent.futures import FIRST_COMPLETED, wait
@@ -284,7 +201,7 @@ def _drive_pool(pool, sink: _Sink) -> None:
             futures[fut] = i
         if not sink.wanted_running(futures.values()):
             if futures:
-                raise _Abandon()  # stop their workers with the pool
+                raise Abandon()  # stop their workers with the pool
             return
         finished, _ = wait(futures, return_when=FIRST_COMPLETED)
         for fut in sorted(finished, key=futures.get):
@@ -302,7 +219,7 @@ def _drive_pool(pool, sink: _Sink) -> None:
             sink.done(i, out)
 
 
-def _run_dask(client, fn, context, items, sink: _Sink):
+def _run_dask(client, fn, context, items, sink: Ledger):
     from distributed import as_completed
 
     ctx = client.scatter(context, broadcast=True, hash=False)
@@ -395,13 +312,13 @@ def map_tasks(fn, context, items: list, *, scheduler: str | None = None, workers
     try:
         if kind == "local":
             stats = RunStats("local", _local_workers(workers, n))
-            sink = _Sink(items, bar, stats, retries, on_result, follow, wanted)
+            sink = Ledger(items, bar, stats, retries, on_result, follow, wanted)
             (_run_serial if stats.workers == 1 else _run_pool)(fn, context, items, sink)
         else:
             own, cluster = (client, None) if client is not None else dask_client(kind, target)
             try:
                 stats = RunStats("dask", len(own.scheduler_info().get("workers", {})) or 1)
-                sink = _Sink(items, bar, stats, retries, on_result, follow, wanted)
+                sink = Ledger(items, bar, stats, retries, on_result, follow, wanted)
                 _run_dask(own, fn, context, items, sink)
             finally:
                 if client is None:

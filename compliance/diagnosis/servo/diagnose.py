@@ -28,7 +28,7 @@ from compliance.model.parameters import apply
 from compliance.effects import EFFECTS
 from compliance.errors import InputError, SimulationError
 from compliance.diagnosis.servo.candidates import Candidate, base_params, effect_candidate, signature_order
-from compliance.diagnosis.servo.fit import COMPETE, SINGLE_SCREEN_SHARE, FitContext, FitResult, competing, replays_bound, screen_level
+from compliance.diagnosis.servo.fit import SINGLE_SCREEN_SHARE, FitContext, FitResult, replays_bound, screen_level
 from compliance.diagnosis.servo.fitted_model import fitted_plant, save_fitted
 from compliance.diagnosis.servo.effect_sets import CANDIDATES_PER_ROUND, MAX_EFFECTS, adds_enough, contributions, full_name, prune
 from compliance.diagnosis.evidence.discriminating_test import design_test
@@ -44,11 +44,11 @@ from compliance.diagnosis.servo.selection import (AMBIGUOUS_BIC, EXPLAINED_ENOUG
 from compliance.diagnosis.servo.report_data import SCHEMA, Diagnosis
 from compliance.diagnosis.evidence.locate_misfit import event_rms, mask_agreement, where_words
 from compliance.diagnosis.servo.parallel_fits import (ExtendSet, FitEffect, FitWithBase, RecalibrateBase, RefitSet, ScreenAddition,
-                                                     SecondStart, ValleyPoint)
+                                                     ValleyPoint)
 from compliance.diagnosis.verdicts.candidate_set import BASE, CandidateSet
 from compliance.diagnosis.verdicts.verdict import EXPLAINED, INCOMPLETE, DiagnosisVerdict
-from compliance.diagnosis.servo.stage import Stage, check_effects, prepare_recording
-from compliance.processes import AFTER, AHEAD, available_cores, dask_session
+from compliance.diagnosis.servo.stage import Stage, check_effects, first_fits, prepare_recording, record
+from compliance.processes import available_cores, dask_session
 
 COMBINE_LEVEL = 3.0  # chi2/N of the best single explanation above which effects are refitted with the recalibration
 COMBINE_TOP = 1  # how many effects are refitted with the recalibration
@@ -79,15 +79,7 @@ def _based_search(cfg: PlantConfig, frame, meta: dict, stride: int, jobs: int, n
 
 def _run(st: Stage, tasks) -> None:
     tasks = list(tasks)
-    _record(st, tasks, st.run_fits(tasks))
-
-
-def _record(st: Stage, tasks: list, results: list) -> None:
-    """The fits' results (``Stage.run_fits``' (result, residual vector) of each task) into the diagnosis."""
-    for task, (res, v) in zip(tasks, results):
-        st.sims += res.sims - (task.first.sims if isinstance(task, SecondStart) else 0)  # a second start counts its first fit's too
-        st.fits[res.name] = res
-        st.vecs[res.name] = v
+    record(st, tasks, st.run_fits(tasks))
 
 
 def _fit_singles(st: Stage, names, recalibrate: bool) -> None:
@@ -104,47 +96,13 @@ def _fit_singles(st: Stage, names, recalibrate: bool) -> None:
     screen = -math.inf if within else screen_level(chi2, n, SINGLE_SCREEN_SHARE)
     fits = [FitEffect(effect_candidate(e), screen) for e in signature_order(names, excess)]
     fits += [FitEffect(c, -math.inf if within else None) for c in instrument_candidates(st.model.signals, st.setup.closed_loop)]
-    _run_with_second_starts(st, tasks + sorted(fits, key=lambda t: -replays_bound(t.candidate)))  # the longest fits first
+    first_fits(st, tasks + sorted(fits, key=lambda t: -replays_bound(t.candidate)))  # the longest fits first
     base_fit = st.fits.get("base")
     singles = [f for f in st.fits.values() if f.name != "nominal"]
     best = min(singles, key=lambda f: f.chi2, default=None)
     if base_fit is not None and base_fit.k > 0 and best is not None and best.chi2 / n > COMBINE_LEVEL:
         top = sorted((f for f in singles if f.name in EFFECTS), key=lambda f: f.chi2)[:COMBINE_TOP]
         _run(st, [FitWithBase(Candidate(CandidateSet.parse(f.name).plus(BASE).name), f, base_fit) for f in top])
-
-
-def _run_with_second_starts(st: Stage, tasks: list) -> None:
-    """The first fits ``tasks``, then a second local fit where it can still matter: a candidate with a second start
-    (``FitResult.second_from``) within COMPETE of the best first fit (``fit.competing``).
-
-    The second starts run speculatively on the same workers as the first fits, each once its candidate's first fit
-    is known and only while it still competes with the best first fit so far (the best only improves: one that
-    stops competing never competes again). One whose first fit is near the floors (chi-square within COMPETE of the
-    residual count: it would take a rival halving an already small misfit) starts before the first fits not
-    started yet, the others once every first fit has started (our choice of priority: it changes the wall time,
-    never a result). Which second starts are used depends on the final first fits only, never on finishing order,
-    and only theirs count in the replays.
-    """
-    firsts: list[FitResult] = []
-
-    def follow(i: int, out) -> list:
-        if i >= len(tasks):
-            return []
-        firsts.append(out[0])
-        return [SecondStart(out[0])] if out[0].second_from else []  # the executor asks ``wanted`` before it starts
-
-    def wanted(task: SecondStart) -> int:
-        if not any(f is task.first for f in competing(firsts)):
-            return 0
-        return AHEAD if task.first.chi2 <= COMPETE * st.model.size else AFTER
-
-    out = st.run_fits(tasks, follow, wanted)
-    _record(st, tasks, out[:len(tasks)])
-    speculative = {r.name: (r, v) for (r, v) in (o for o in out[len(tasks):] if o is not None)}
-    seconds = [SecondStart(f) for f in competing([f for k, f in st.fits.items() if k != "nominal"]) if f.second_from]
-    missing = [t for t in seconds if t.first.name not in speculative]
-    speculative.update({r.name: (r, v) for r, v in st.run_fits(missing)} if missing else {})
-    _record(st, seconds, [speculative[t.first.name] for t in seconds])
 
 
 def _search_sets(st: Stage, winner: str) -> list[dict]:
