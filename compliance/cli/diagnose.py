@@ -100,8 +100,10 @@ def run(args) -> int:
     cfg = load_plant(plant)
     check_sidecar_conditions(cfg, frame, meta, args.recordings[0])
     check_scheduler(args)  # a bad address is exit 2 before any work
+    from compliance.diagnosis.servo.stage import check_effects
     from compliance.cli.progress import progress
 
+    check_effects(cfg, effects)  # an unknown effect name is exit 2 before the progress bar and any replay
     with progress(1, "diagnose", quiet=args.quiet, unit="stage", first="replay, locate, fit every candidate") as bar:
         diag = diagnose(cfg, frame, meta, effects=effects, jobs=args.jobs, recalibrate=not args.no_recalibration,
                         suggest_test=args.suggest_test, scheduler=args.scheduler)

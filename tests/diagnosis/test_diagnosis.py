@@ -200,10 +200,12 @@ def test_cli_writes_json_and_a_fitted_model_with_provenance(cfg, tmp_path):
     assert main(args) == 2
 
 
-def test_cli_rejects_unknown_effects_and_unusable_files(tmp_path, cfg):
+def test_cli_rejects_unknown_effects_and_unusable_files(tmp_path, cfg, capsys):
     frame, meta = _recording(cfg)
     rec, _ = write_recording(frame, meta, tmp_path / "r.csv")
     assert main(["diagnose", str(rec), "--plant", "plant-a", "--effects", "heat_transfr", "--jobs", "1"]) == 2
+    err = capsys.readouterr().err
+    assert "'heat_transfr' is not a declared effect" in err and "fit every candidate" not in err  # refused before the progress starts
     bad = tmp_path / "nothing.csv"
     bad.write_text("time,position\n0,0.01\n0.001,0.01\n")
     assert main(["diagnose", str(bad), "--plant", "plant-a"]) == 2
